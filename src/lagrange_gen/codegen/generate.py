@@ -1,0 +1,86 @@
+"""The generation pipeline for one model file: load -> derive -> kernels -> render -> write."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..derive import derive
+from ..errors import GenerationError
+from ..model import load_model
+from .key import generator_hash, make_key, model_hash, read_key
+from .render import render_module
+from .spec import make_kernels
+from .write import write_if_changed
+
+
+@dataclass
+class GenerationResult:
+    path: Path
+    written: bool
+    key: str
+
+
+def output_path(model_name: str, out_dir) -> Path:
+    return Path(out_dir) / f"{model_name}.py"
+
+
+def _command(model_path, out_dir, options):
+    cmd = f"lagrange-gen {model_path}"
+    if str(out_dir) != "generated":
+        cmd += f" -o {out_dir}"
+    for k, v in sorted(options.items()):
+        cmd += f" --set {k}={v}"
+    return cmd
+
+
+def _methods(requested):
+    from ..steppers.registry import METHODS
+    if requested is None:
+        return list(METHODS)
+    unknown = [m for m in requested if m not in METHODS]
+    if unknown:
+        raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
+    return [m for m in METHODS if m in requested]
+
+
+def generate_text(model, out_dir="generated", methods=None):
+    """Return (module text, KEY) for a loaded Model; nothing is written."""
+    from ..steppers.registry import glue_source
+    methods = _methods(methods)
+    options = {"build": dict(sorted(model.build_options.items())), "methods": methods}
+    model_sha, gen_sha = model_hash(model.source_text), generator_hash()
+    key = make_key(model_sha, gen_sha, options)
+    dyn = derive(model)
+    kernels = make_kernels(dyn)
+    target = output_path(model.name, out_dir)
+    source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
+    text = render_module(dyn, kernels, key=key, model_sha=model_sha, gen_sha=gen_sha,
+                         options=options, source_rel=source_rel,
+                         command=_command(model.source_path, out_dir, model.build_options),
+                         methods=methods, glue="\n\n".join(glue_source(m) for m in methods))
+    return text, key, target
+
+
+def generate_model(model_path, out_dir="generated", methods=None, options=None) -> GenerationResult:
+    """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched)."""
+    model = load_model(model_path, **(options or {}))
+    text, key, target = generate_text(model, out_dir, methods)
+    written = write_if_changed(target, text)
+    return GenerationResult(target, written, key)
+
+
+def expected_key(model_path, out_dir="generated", methods=None, options=None):
+    """(target path, KEY the model would get now) without deriving: for --check."""
+    model = load_model(model_path, **(options or {}))
+    methods = _methods(methods)
+    opts = {"build": dict(sorted(model.build_options.items())), "methods": methods}
+    key = make_key(model_hash(model.source_text), generator_hash(), opts)
+    return output_path(model.name, out_dir), key
+
+
+def is_current(model_path, out_dir="generated", methods=None, options=None):
+    """(target, True when target exists and carries the KEY the model would get now)."""
+    target, key = expected_key(model_path, out_dir, methods, options)
+    return target, read_key(target) == key

@@ -1,0 +1,44 @@
+"""Exception hierarchy (DESIGN.md section 7).
+
+User errors carry a one-line message that names the file, symbol, step or value; the CLI prints
+that line and exits non-zero without a traceback (``--debug`` shows it).
+"""
+
+
+class LagrangeGenError(Exception):
+    """Base class of every error lagrange-gen raises on purpose."""
+
+
+class ModelError(LagrangeGenError):
+    """The model file or the Model it defines is invalid."""
+
+
+class GenerationError(LagrangeGenError):
+    """Derivation or code generation failed, or a generated file is missing or stale."""
+
+
+class StaleModuleError(GenerationError):
+    """A generated module does not match its model or the installed generator."""
+
+
+class SimulationError(LagrangeGenError):
+    """A simulation could not proceed; subclasses name the numerical failure."""
+
+    def __init__(self, message, step=None, time=None, state=None, residual=None):
+        super().__init__(message)
+        self.step = step
+        self.time = time
+        self.state = state
+        self.residual = residual
+
+
+class NewtonDivergence(SimulationError):
+    """Newton's method did not converge within its iteration cap."""
+
+
+class SingularMass(SimulationError):
+    """The generalized inertia H(q) (or the augmented KKT matrix) is singular."""
+
+
+class BlowUp(SimulationError):
+    """The state became non-finite."""
