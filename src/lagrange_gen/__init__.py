@@ -14,3 +14,7 @@ __all__ = [
     "LagrangeGenError", "ModelError", "GenerationError", "StaleModuleError", "SimulationError",
     "NewtonDivergence", "SingularMass", "BlowUp",
 ]
+
+from .loader import import_generated, load  # noqa: E402
+
+__all__ += ["import_generated", "load"]

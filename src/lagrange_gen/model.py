@@ -7,7 +7,6 @@ families such as the n-link pendulum). :func:`load_model` executes such a file a
 
 from __future__ import annotations
 
-import itertools
 import keyword
 import runpy
 import traceback
@@ -26,7 +25,11 @@ __all__ = [
 #: The time symbol. Forces and potentials may depend on it; T and constraints may not.
 t = sp.Symbol("t", real=True)
 
-_parameter_order = itertools.count()
+# Defaults of declared parameters, by name, in declaration order. Defaults are not stored on the
+# symbols: sympy caches expressions, so an "equal" symbol from another model file can come back
+# from the cache, and it must not bring another file's default or position with it. load_model
+# starts each file with an empty table.
+_declared: dict = {}
 
 
 class Coordinate(sp.Symbol):
@@ -48,15 +51,10 @@ class Velocity(sp.Symbol):
 
 
 class Parameter(sp.Symbol):
-    """A model parameter with an optional default value (``.default``; None means required)."""
+    """A model parameter; its default value is recorded by :func:`parameters`."""
 
-    def __new__(cls, name, default=None):
-        # Uncached constructor: the default lives on the object, so two parameters of the same
-        # name in different model files must not share one cached instance.
-        obj = sp.Symbol.__xnew__(cls, name, real=True)
-        obj.default = None if default is None else float(default)
-        obj.order = next(_parameter_order)
-        return obj
+    def __new__(cls, name):
+        return super().__new__(cls, name, real=True)
 
 
 @dataclass(frozen=True)
@@ -110,7 +108,10 @@ def parameters(names, defaults=None):
         values = list(defaults)
         if len(values) != len(names):
             raise ModelError(f"parameters({' '.join(names)!r}): {len(names)} names but {len(values)} defaults")
-    params = [Parameter(n, v) for n, v in zip(names, values)]
+    for n, v in zip(names, values):
+        _check_name("parameter", n)
+        _declared[n] = None if v is None else float(v)
+    params = [Parameter(n) for n in names]
     return params[0] if len(params) == 1 else params
 
 
@@ -211,16 +212,19 @@ class Model:
             for s in expr.free_symbols:
                 if isinstance(s, Parameter):
                     found.setdefault(s.name, s)
+        self.param_defaults = {name: _declared.get(name) for name in found}
         if explicit is not None:
             explicit = list(explicit)
             for s in explicit:
                 if not isinstance(s, Parameter):
                     raise ModelError(f"model {self.name}: params entry {s} is not a Parameter")
+                self.param_defaults.setdefault(s.name, _declared.get(s.name))
             missing = sorted(set(found) - {s.name for s in explicit})
             if missing:
                 raise ModelError(f"model {self.name}: parameter(s) {', '.join(missing)} used but not in params=")
             return explicit
-        return sorted(found.values(), key=lambda s: (s.order, s.name))
+        position = {name: i for i, name in enumerate(_declared)}
+        return sorted(found.values(), key=lambda s: (position.get(s.name, len(position)), s.name))
 
     def _validate(self):
         names = {}
@@ -255,7 +259,7 @@ class Model:
 
     def defaults(self):
         """Default parameter values in PARAMS order (None where a value is required)."""
-        return [p.default for p in self.params]
+        return [self.param_defaults[p.name] for p in self.params]
 
     def __repr__(self):
         return (f"Model({self.name!r}, coords={[c.name for c in self.coords]}, "
@@ -335,6 +339,7 @@ def load_model(path, **options) -> Model:
         compile(source, str(path), "exec")
     except SyntaxError as exc:
         raise ModelError(f"{path}:{exc.lineno}: not valid Python: {exc.msg}") from None
+    _declared.clear()
     try:
         namespace = runpy.run_path(str(path), run_name=f"lagrange_gen_model_{path.stem}")
         model = _pick_model(path, namespace, options)

@@ -14,7 +14,7 @@ from ..errors import StaleModuleError
 
 _PACKAGE = Path(__file__).resolve().parent.parent
 # Sources whose change alters generated text or the compiled code a generated module pulls in.
-_GENERATOR_PARTS = ("model.py", "linalg.py", "derive", "codegen", "steppers", "nonsmooth")
+_GENERATOR_PARTS = ("model.py", "linalg.py", "params.py", "status.py", "errors.py", "derive", "codegen", "steppers", "nonsmooth")
 
 
 def _version():

@@ -68,8 +68,8 @@ def module_docstring(dyn, source_rel, methods) -> str:
     lines.append("Coordinates (index in q / qd):")
     lines += [f"    {i}: {c.name}" for i, c in enumerate(dyn.q)]
     lines.append("Parameters (index in p; default):")
-    lines += [f"    {k}: {s.name} = {s.default if s.default is not None else 'required'}"
-              for k, s in enumerate(dyn.params)]
+    lines += [f"    {k}: {s.name} = {d if d is not None else 'required'}"
+              for k, (s, d) in enumerate(zip(dyn.params, m.defaults()))]
     if dyn.m:
         lines.append("Constraints Phi(q) = 0 (index in phi / rows of J):")
         lines += [f"    {i}: {sp.sstr(c)}" for i, c in enumerate(dyn.Phi)]
@@ -92,15 +92,18 @@ def forward_dynamics(q, qd, t, p, H, qdd):
     return OK
 
 
-def accelerations(q, qd, t=0.0, p=None):
-    """Python convenience: qddot (n,) at one state; raises SingularMass instead of returning NaN."""
+def accelerations(q, qd, t=0.0, params=None):
+    """Python convenience: qddot (n,) at one state; raises SingularMass instead of returning NaN.
+    params: None (defaults), a dict by name, or a full vector in PARAMS order."""
     q = np.ascontiguousarray(q, dtype=np.float64)
     qd = np.ascontiguousarray(qd, dtype=np.float64)
-    p = DEFAULT_PARAMS if p is None else np.ascontiguousarray(p, dtype=np.float64)
+    if q.shape != (N_COORDS,) or qd.shape != (N_COORDS,):
+        raise ValueError(f"{NAME}: q and qd must have {N_COORDS} entries ({', '.join(COORDS)})")
+    p = resolve_params(PARAMS, DEFAULTS, params, NAME)
     H = np.empty((N_COORDS, N_COORDS))
     qdd = np.empty(N_COORDS)
     if forward_dynamics(q, qd, float(t), p, H, qdd) != OK:
-        raise SingularMass(f"{NAME}: singular mass matrix H(q) at q = {list(q)}", state=q.copy())
+        raise SingularMass(f"{NAME}: singular mass matrix H(q) at q = {q.tolist()}", state=q.copy())
     return qdd
 '''
 
@@ -109,7 +112,7 @@ def render_module(dyn, kernels, *, key, model_sha, gen_sha, options, source_rel,
                   methods, glue) -> str:
     """The whole generated module as text. ``glue`` is the per-stepper source to append."""
     names = symbol_table(dyn)
-    defaults = [s.default for s in dyn.params]
+    defaults = dyn.model.defaults()
     default_arr = ", ".join("float('nan')" if d is None else repr(d) for d in defaults)
     parts = [
         f"# lagrange-gen generated module. DO NOT EDIT. KEY = {key}",
@@ -129,6 +132,7 @@ def render_module(dyn, kernels, *, key, model_sha, gen_sha, options, source_rel,
         "from lagrange_gen.codegen.key import check_fresh",
         "from lagrange_gen.errors import SingularMass",
         "from lagrange_gen.linalg import cholesky_inplace, cholesky_solve_inplace",
+        "from lagrange_gen.params import resolve_params",
         "from lagrange_gen.status import OK, SINGULAR_MASS",
         "",
         f"check_fresh(__file__, KEY, MODEL_SHA, GENERATOR_SHA, MODEL_PATH, OPTIONS, {command!r})",

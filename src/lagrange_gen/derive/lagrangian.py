@@ -39,9 +39,9 @@ def derive_lagrangian(model, check_samples=8):
                 E=model.T + model.V)
 
 
-def sample_values(model, rng):
+def sample_values(model):
     """Parameter values for numeric checks: defaults, or 1.0 where a value is required."""
-    return [1.0 if p.default is None else p.default for p in model.params]
+    return [1.0 if d is None else d for d in model.defaults()]
 
 
 def _check_quadratic_and_definite(model, H, samples):
@@ -50,7 +50,7 @@ def _check_quadratic_and_definite(model, H, samples):
         return
     q, qd, params = list(model.coords), list(model.velocities), list(model.params)
     rng = np.random.default_rng(20261122)
-    pvals = sample_values(model, rng)
+    pvals = sample_values(model)
     f_H = sp.lambdify([q, params], H, modules="numpy")
     residual = model.T - (sp.Matrix(qd).T * H * sp.Matrix(qd))[0, 0] / 2
     f_res = sp.lambdify([q, qd, params], residual, modules="numpy")

@@ -1,0 +1,132 @@
+"""Command line: `lagrange-gen MODEL.py ...` generates; subcommands simulate and bench.
+
+The CLI only chains the pipeline stages; every user error is one line on stderr and a non-zero
+exit (``--debug`` shows the traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from .errors import LagrangeGenError
+
+SUBCOMMANDS = ("simulate", "bench")
+
+_EPILOG = """\
+examples:
+  lagrange-gen models/cart_pendulum.py            write generated/cart_pendulum.py
+  lagrange-gen models/*.py                        every model
+  lagrange-gen models/n_link_pendulum.py --set n=8
+  lagrange-gen --check models/*.py                exit 1 if a generated file is missing or stale
+  lagrange-gen --methods verlet,midpoint models/double_pendulum.py
+  lagrange-gen simulate models/cart_pendulum.py --method midpoint --h 1e-3 --t-end 10
+  lagrange-gen bench --help
+
+A model file builds a lagrange_gen.Model from SymPy expressions and assigns it to `model`
+(see models/cart_pendulum.py). The generated module holds numba kernels (dynamics, energy,
+Jacobians, constraints), forward dynamics and one run_<method> function per stepper; import it,
+or use `lagrange-gen simulate`.
+"""
+
+
+def _parse_options(pairs):
+    options = {}
+    for pair in pairs or []:
+        if "=" not in pair:
+            raise LagrangeGenError(f"--set {pair}: expected NAME=VALUE")
+        key, value = pair.split("=", 1)
+        for convert in (int, float):
+            try:
+                value = convert(value)
+                break
+            except ValueError:
+                continue
+        options[key.strip()] = value
+    return options
+
+
+def generate_parser():
+    p = argparse.ArgumentParser(
+        prog="lagrange-gen",
+        description="Derive equations of motion from SymPy model files and write numba kernels "
+                    "into generated/. Subcommands: simulate, bench (lagrange-gen SUBCOMMAND --help).",
+        epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
+    p.add_argument("-o", "--out-dir", default="generated", metavar="DIR",
+                   help="directory for generated modules (default: generated)")
+    p.add_argument("--check", action="store_true",
+                   help="write nothing; exit 1 when a generated file is missing or stale")
+    p.add_argument("--methods", metavar="M1,M2",
+                   help="emit glue only for these steppers (default: all)")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE", dest="options",
+                   help="option passed to the model file's build() (e.g. n=8), repeatable")
+    p.add_argument("--debug", action="store_true", help="show tracebacks")
+    return p
+
+
+def run_generate(args) -> int:
+    from .codegen.generate import generate_model, is_current
+    methods = args.methods.split(",") if args.methods else None
+    options = _parse_options(args.options)
+    if args.check:
+        bad = 0
+        for path in args.models:
+            target, current = is_current(path, args.out_dir, methods, options)
+            if not current:
+                state = "stale" if target.exists() else "missing"
+                print(f"{target}: {state} (run lagrange-gen {path})")
+                bad += 1
+            else:
+                print(f"{target}: current")
+        return 1 if bad else 0
+    for path in args.models:
+        start = time.perf_counter()
+        result = generate_model(path, args.out_dir, methods, options)
+        what = "written" if result.written else "unchanged"
+        print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
+    return 0
+
+
+def _subcommand_parser(name):
+    p = argparse.ArgumentParser(prog="lagrange-gen")
+    sub = p.add_subparsers(dest="command", required=True)
+    if name == "simulate":
+        from .cli_simulate import add_parser
+    else:
+        from .bench.cli import add_parser
+    add_parser(sub)
+    return p
+
+
+def _run_subcommand(args) -> int:
+    if args.command == "simulate":
+        from .cli_simulate import run
+    else:
+        from .bench.cli import run
+    return run(args)
+
+
+def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in argv
+    try:
+        if argv and argv[0] in SUBCOMMANDS:
+            argv = [a for a in argv if a != "--debug"]
+            args = _subcommand_parser(argv[0]).parse_args(argv)
+            return _run_subcommand(args)
+        args = generate_parser().parse_args(argv)
+        return run_generate(args)
+    except LagrangeGenError as exc:
+        if debug:
+            raise
+        print(f"lagrange-gen: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("lagrange-gen: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
