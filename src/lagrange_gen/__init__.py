@@ -3,18 +3,33 @@
 Public API (explicit re-exports)::
 
     from lagrange_gen import Model, coordinates, parameters, t, PointForce, load_model
+    from lagrange_gen import load, import_generated, simulate
+
+The modelling names load sympy on first use only, so that importing a generated module (which
+imports lagrange_gen for its runtime helpers) stays fast.
 """
+
+from importlib import import_module
 
 from .errors import (BlowUp, GenerationError, LagrangeGenError, ModelError, NewtonDivergence,
                      SimulationError, SingularMass, StaleModuleError)
-from .model import Model, PointForce, coordinates, load_model, parameters, t
 
-__all__ = [
-    "Model", "PointForce", "coordinates", "parameters", "t", "load_model",
+_LAZY = {
+    "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
+    "t": "model", "load_model": "model",
+    "import_generated": "loader", "load": "loader",
+    "simulate": "simulate", "Trajectory": "simulate",
+}
+
+__all__ = sorted(_LAZY) + [
     "LagrangeGenError", "ModelError", "GenerationError", "StaleModuleError", "SimulationError",
     "NewtonDivergence", "SingularMass", "BlowUp",
 ]
 
-from .loader import import_generated, load  # noqa: E402
 
-__all__ += ["import_generated", "load"]
+def __getattr__(name):
+    if name in _LAZY:
+        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'lagrange_gen' has no attribute {name!r}")

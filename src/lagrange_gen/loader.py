@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
 import sys
 from pathlib import Path
@@ -15,7 +16,8 @@ def import_generated(path):
     path = Path(path).resolve()
     if not path.is_file():
         raise GenerationError(f"{path}: no generated module here (run lagrange-gen on its model)")
-    name = f"lagrange_gen_generated_{abs(hash(str(path))):x}_{path.stem}"
+    # The name must be the same in every process: numba's cache refers to globals by module name.
+    name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
     if name in sys.modules:
         return sys.modules[name]
     spec = importlib.util.spec_from_file_location(name, path)
@@ -36,7 +38,7 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True)
     into ``out_dir`` first when its module is missing or stale (``regenerate=False``: raise instead).
     """
     from .codegen.generate import generate_model, is_current
-    from .codegen.key import read_key
+    from .keys import read_key
     path = Path(path)
     if read_key(path) is not None:
         return import_generated(path)
@@ -46,3 +48,24 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True)
             raise StaleModuleError(f"{target} is missing or stale: run lagrange-gen {path}")
         target = generate_model(path, out_dir, methods, options).path
     return import_generated(target)
+
+
+def compile_all(module):
+    """Call every kernel of a generated module once on zeros so numba compiles (or loads from its
+    cache) all of them now rather than inside the first simulation step."""
+    import numpy as np
+    n, m = module.N_COORDS, module.N_CONSTRAINTS
+    q, qd, w, lam = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(m)
+    p = np.ones(module.N_PARAMS)
+    A, B = np.empty((n, n)), np.empty((n, n))
+    v = np.empty(n)
+    module.mass_matrix(q, p, A)
+    module.dynamics(q, qd, 0.0, p, A, v)
+    module.energy(q, qd, 0.0, p)
+    module.momentum_rate(q, qd, 0.0, p, v)
+    module.rhs_jacobian(q, qd, 0.0, p, A, B)
+    module.momentum_rate_jacobian(q, qd, 0.0, p, A, B)
+    module.mass_matvec_dq(q, w, p, A)
+    module.constraints(q, qd, p, np.empty(m), np.empty((m, n)), np.empty(m))
+    module.constraint_dq(q, w, lam, p, np.empty((m, n)), A)
+    module.forward_dynamics(q, qd, 0.0, p, A, v)

@@ -9,7 +9,8 @@ import pytest
 
 from conftest import MODELS_DIR, ROOT
 from lagrange_gen import StaleModuleError
-from lagrange_gen.codegen import generate_model, read_key
+from lagrange_gen.codegen import generate_model
+from lagrange_gen.keys import read_key
 from lagrange_gen.loader import import_generated
 
 

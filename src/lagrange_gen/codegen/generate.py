@@ -9,7 +9,7 @@ from pathlib import Path
 from ..derive import derive
 from ..errors import GenerationError
 from ..model import load_model
-from .key import generator_hash, make_key, model_hash, read_key
+from ..keys import generator_hash, make_key, model_hash, read_key
 from .render import render_module
 from .spec import make_kernels
 from .write import write_if_changed

@@ -1,4 +1,4 @@
-"""The KEY of a generated module: what it was generated from, and the stale check on import."""
+"""The KEY of a generated module (no sympy import: generated modules call check_fresh): what it was generated from, and the stale check on import."""
 
 from __future__ import annotations
 
@@ -7,27 +7,25 @@ import json
 from importlib import metadata
 from pathlib import Path
 
-import numba
-import sympy
+from .errors import StaleModuleError
 
-from ..errors import StaleModuleError
-
-_PACKAGE = Path(__file__).resolve().parent.parent
+_PACKAGE = Path(__file__).resolve().parent
 # Sources whose change alters generated text or the compiled code a generated module pulls in.
-_GENERATOR_PARTS = ("model.py", "linalg.py", "params.py", "status.py", "errors.py", "derive", "codegen", "steppers", "nonsmooth")
+_GENERATOR_PARTS = ("model.py", "linalg.py", "params.py", "status.py", "errors.py", "keys.py", "derive", "codegen", "steppers", "nonsmooth")
 
 
-def _version():
+def _version(dist):
     try:
-        return metadata.version("lagrange-gen")
+        return metadata.version(dist)
     except metadata.PackageNotFoundError:
-        return "0+unknown"
+        return "unknown"
 
 
 def generator_hash() -> str:
     """sha256 of the generator's own sources, its version and the sympy / numba versions."""
     h = hashlib.sha256()
-    h.update(f"lagrange-gen {_version()} sympy {sympy.__version__} numba {numba.__version__}".encode())
+    # Versions from package metadata: a generated module checks this at import without sympy.
+    h.update(" ".join(f"{d} {_version(d)}" for d in ("lagrange-gen", "sympy", "numba")).encode())
     for part in _GENERATOR_PARTS:
         path = _PACKAGE / part
         files = sorted(path.rglob("*.py")) if path.is_dir() else [path] if path.exists() else []

@@ -1,0 +1,1 @@
+"""`lagrange-gen bench`: measurements that belong in reports, never in test assertions."""
