@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sympy as sp
 
+from .backend import jacobian
+
 
 def derive_constraints(model):
     """Return dict(Phi (m, 1), J (m, n), gamma (m, 1)).
@@ -14,8 +16,8 @@ def derive_constraints(model):
     q, qd = list(model.coords), list(model.velocities)
     n = len(q)
     Phi = sp.Matrix(model.constraints) if model.constraints else sp.zeros(0, 1)
-    J = Phi.jacobian(q) if model.constraints else sp.zeros(0, n)
+    J = jacobian(Phi, q) if model.constraints else sp.zeros(0, n)
     qd_vec = sp.Matrix(qd)
     Jv = J * qd_vec
-    gamma = -Jv.jacobian(q) * qd_vec if model.constraints else sp.zeros(0, 1)
+    gamma = -jacobian(Jv, q) * qd_vec if model.constraints else sp.zeros(0, 1)
     return dict(Phi=Phi, J=J, gamma=gamma)

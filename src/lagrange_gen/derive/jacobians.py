@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sympy as sp
 
+from .backend import jacobian
+
 
 def derive_jacobians(dyn):
     """Return (jacobians, auxiliary symbols).
@@ -21,15 +23,15 @@ def derive_jacobians(dyn):
     w = sp.Matrix(sp.symbols(f"w_0:{n}", real=True)) if n else sp.zeros(0, 1)
     lam = sp.Matrix(sp.symbols(f"lam_0:{m}", real=True)) if m else sp.zeros(0, 1)
     jac = {
-        "drhs_dq": dyn.rhs.jacobian(q),
-        "drhs_dqd": dyn.rhs.jacobian(qd),
-        "dmom_dq": dyn.momentum_rate.jacobian(q),
-        "dmom_dqd": dyn.momentum_rate.jacobian(qd),
-        "dHw_dq": (dyn.H * w).jacobian(q),
+        "drhs_dq": jacobian(dyn.rhs, q),
+        "drhs_dqd": jacobian(dyn.rhs, qd),
+        "dmom_dq": jacobian(dyn.momentum_rate, q),
+        "dmom_dqd": jacobian(dyn.momentum_rate, qd),
+        "dHw_dq": jacobian(dyn.H * w, q),
     }
     if m:
-        jac["dJw_dq"] = (dyn.J * w).jacobian(q)
-        jac["dJTlam_dq"] = (dyn.J.T * lam).jacobian(q)
+        jac["dJw_dq"] = jacobian(dyn.J * w, q)
+        jac["dJTlam_dq"] = jacobian(dyn.J.T * lam, q)
     else:
         jac["dJw_dq"] = sp.zeros(0, n)
         jac["dJTlam_dq"] = sp.zeros(n, n)

@@ -6,6 +6,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
+from .backend import gradient, jacobian
 
 
 def derive_lagrangian(model, check_samples=8):
@@ -19,22 +20,28 @@ def derive_lagrangian(model, check_samples=8):
     q, qd = list(model.coords), list(model.velocities)
     n = len(q)
     qd_vec = sp.Matrix(qd)
-    H = sp.Matrix(n, n, lambda i, j: sp.diff(model.T, qd[i], qd[j]) if j >= i else 0)
-    H = H + H.T - sp.diag(*[H[i, i] for i in range(n)])
+    H = jacobian(gradient(model.T, qd), qd)
+    H = sp.Matrix(n, n, lambda i, j: H[min(i, j), max(i, j)])   # exactly symmetric
     bad = sorted(str(s) for s in H.free_symbols & set(qd))
     if bad:
         raise ModelError(f"model {model.name}: T is not quadratic in the velocities "
                          f"(d2T/dqdot2 still depends on {', '.join(bad)})")
     _check_quadratic_and_definite(model, H, check_samples)
 
-    dH = [H.diff(qi) for qi in q]                      # n matrices (n, n)
+    # dH/dq_i for all i from one Jacobian of the upper triangle of H.
+    upper = [(j, k) for j in range(n) for k in range(j, n)]
+    dU = jacobian([H[j, k] for j, k in upper], q)
+    dH = [sp.zeros(n, n) for _ in range(n)]
+    for row, (j, k) in enumerate(upper):
+        for i in range(n):
+            dH[i][j, k] = dH[i][k, j] = dU[row, i]
     Hdot = sp.zeros(n, n)
     for i in range(n):
         Hdot += dH[i] * qd[i]
     dTdq = sp.Matrix([(qd_vec.T * dH[j] * qd_vec)[0, 0] / 2 for j in range(n)])
     h = Hdot * qd_vec - dTdq
-    g = sp.Matrix([sp.diff(model.V, qi) for qi in q])
-    Q = sp.Matrix([model.forces[j] - sp.diff(model.dissipation, qd[j]) for j in range(n)])
+    g = gradient(model.V, q)
+    Q = sp.Matrix(model.forces) - gradient(model.dissipation, qd)
     return dict(H=H, h=h, g=g, Q=Q, rhs=Q - h - g, dTdq=dTdq, momentum_rate=dTdq - g + Q,
                 E=model.T + model.V)
 
