@@ -69,3 +69,6 @@ def compile_all(module):
     module.constraints(q, qd, p, np.empty(m), np.empty((m, n)), np.empty(m))
     module.constraint_dq(q, w, lam, p, np.empty((m, n)), A)
     module.forward_dynamics(q, qd, 0.0, p, A, v)
+    ne = module.N_ELEMENTS
+    module.elements(q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 2)))
+    module.elements_hessian(q, np.zeros(ne), p, A)

@@ -18,7 +18,7 @@ import sympy as sp
 from .errors import ModelError
 
 __all__ = [
-    "Coordinate", "Velocity", "Parameter", "PointForce", "Model",
+    "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Model",
     "coordinates", "parameters", "t", "load_model",
 ]
 
@@ -78,6 +78,46 @@ class PointForce:
         object.__setattr__(self, "force", force)
 
 
+class SaintVenant:
+    """A Saint-Venant element: a spring of stiffness k in series with a slider of threshold eta,
+    acting on the strain s(q).
+
+    Its internal variable u (the elastic part of s) obeys u' + dpsi_[-eta, eta](u) ∋ s', and it
+    exerts the generalized force -k u grad s(q). Give ``threshold`` (eta) or ``yield_force``
+    (alpha = k eta). Several elements form the generalized Prandtl model; a parallel spring in V
+    gives linear hardening, a dashpot in ``dissipation`` the viscoelastoplastic model.
+    """
+
+    kind = "saint_venant"
+
+    def __init__(self, strain, stiffness, threshold=None, yield_force=None, name=None):
+        if (threshold is None) == (yield_force is None):
+            raise ModelError("SaintVenant: give exactly one of threshold (eta) or yield_force (alpha = k eta)")
+        self.strain = sp.sympify(strain)
+        self.stiffness = sp.sympify(stiffness)
+        self.threshold = (sp.sympify(threshold) if threshold is not None
+                          else sp.sympify(yield_force) / self.stiffness)
+        self.name = name
+
+    def coefficients(self):
+        return (self.stiffness, self.threshold)
+
+
+class DryFriction:
+    """Coulomb friction on the rate of s(q): force -F_d sign(d s/dt) grad s(q), set-valued
+    (anywhere in [-F_d, F_d]) when d s/dt = 0. Needs a velocity-level implicit solve."""
+
+    kind = "dry_friction"
+
+    def __init__(self, rate_of, bound, name=None):
+        self.strain = sp.sympify(rate_of)
+        self.bound = sp.sympify(bound)
+        self.name = name
+
+    def coefficients(self):
+        return (self.bound, sp.S.Zero)
+
+
 def _split_names(names):
     if isinstance(names, str):
         names = names.replace(",", " ").split()
@@ -134,12 +174,13 @@ class Model:
         ones belong in V.
     dissipation : Rayleigh function D(q, qdot); contributes Q = -dD/dqdot.
     constraints : list of holonomic constraints Phi(q) = 0.
+    elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
     params : optional explicit parameter order; default: order of declaration.
     description : one line shown in the generated module's docstring.
     """
 
     def __init__(self, name, coords, T, V=0, forces=None, dissipation=0, constraints=(),
-                 params=None, description=""):
+                 elements=(), params=None, description=""):
         _check_name("model", str(name))
         self.name = str(name)
         self.description = description
@@ -153,6 +194,7 @@ class Model:
         self.dissipation = _sympify(dissipation, "dissipation", replace)
         self.forces = self._generalized_forces(forces, replace)
         self.constraints = [_sympify(c, f"constraint {i}", replace) for i, c in enumerate(constraints)]
+        self.elements = self._elements(elements, replace)
         self.params = self._collect_params(params)
         self.source_path = None      # set by load_model
         self.source_text = ""
@@ -197,6 +239,21 @@ class Model:
                              "(give one per coordinate, a dict, or a list of PointForce)")
         return [_sympify(f, f"force {i}", replace) for i, f in enumerate(forces)]
 
+    def _elements(self, elements, replace):
+        out = []
+        for i, e in enumerate(elements):
+            if not isinstance(e, (SaintVenant, DryFriction)):
+                raise ModelError(f"model {self.name}: element {i} is {type(e).__name__}, not SaintVenant or DryFriction")
+            e.name = e.name or f"{e.kind}_{i}"
+            _check_name("element", e.name)
+            e.strain = _sympify(e.strain, f"strain of element {e.name}", replace)
+            out.append(e)
+        return out
+
+    @property
+    def n_elements(self):
+        return len(self.elements)
+
     def _all_expressions(self):
         yield "T", self.T
         yield "V", self.V
@@ -205,6 +262,10 @@ class Model:
             yield f"force on {c}", f
         for i, c in enumerate(self.constraints):
             yield f"constraint {i}", c
+        for e in self.elements:
+            yield f"strain of element {e.name}", e.strain
+            for c in e.coefficients():
+                yield f"coefficient of element {e.name}", c
 
     def _collect_params(self, explicit):
         found = {}
@@ -254,8 +315,25 @@ class Model:
             if bad:
                 raise ModelError(f"model {self.name}: constraint {i} ({c}) depends on {', '.join(bad)}; "
                                  "only holonomic scleronomic constraints Phi(q) = 0 are supported")
+        self._validate_elements(qd)
         if not (self.T.free_symbols & qd):
             raise ModelError(f"model {self.name}: T does not depend on any velocity")
+
+    def _validate_elements(self, qd):
+        for e in self.elements:
+            bad = sorted(str(s) for s in e.strain.free_symbols & (qd | {t}))
+            if bad:
+                raise ModelError(f"model {self.name}: element {e.name}: the strain {e.strain} depends on "
+                                 f"{', '.join(bad)}; a strain must be a function s(q) of the coordinates")
+            for label, c in zip(("stiffness/bound", "threshold"), e.coefficients()):
+                if c.free_symbols - set(self.params):
+                    raise ModelError(f"model {self.name}: element {e.name}: {label} {c} must depend on parameters only")
+                value = c.xreplace({p: sp.Float(_declared[p.name]) for p in c.free_symbols
+                                    if _declared.get(p.name) is not None})
+                if e.kind == "dry_friction" and label == "threshold":
+                    continue
+                if value.is_number and not float(value) > 0:
+                    raise ModelError(f"model {self.name}: element {e.name}: {label} must be > 0, got {c} = {float(value):g}")
 
     def defaults(self):
         """Default parameter values in PARAMS order (None where a value is required)."""

@@ -57,5 +57,7 @@ def symbol_table(dyn):
         names[s] = f"w[{i}]"
     for i, s in enumerate(dyn.aux["lam"]):
         names[s] = f"lam[{i}]"
+    for i, s in enumerate(dyn.aux.get("we", [])):
+        names[s] = f"we[{i}]"
     names[dyn.t] = "t"
     return names

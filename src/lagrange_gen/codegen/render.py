@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ..derive.elements import KIND_CODES
 from .printer import KernelPrinter, symbol_table
 from .spec import KernelSpec
 
@@ -73,6 +74,10 @@ def module_docstring(dyn, source_rel, methods) -> str:
     if dyn.m:
         lines.append("Constraints Phi(q) = 0 (index in phi / rows of J):")
         lines += [f"    {i}: {sp.sstr(c)}" for i, c in enumerate(dyn.Phi)]
+    if dyn.n_elements:
+        lines.append("Nonsmooth elements (index in s / rows of G and coef):")
+        lines += [f"    {i}: {e.name} ({e.kind}) on s = {sp.sstr(e.strain)}, coef = "
+                  f"({', '.join(sp.sstr(c) for c in e.coefficients())})" for i, e in enumerate(m.elements)]
     lines.append("Structure:")
     lines.append(f"    mass matrix constant: {dyn.mass_is_constant}")
     lines.append(f"    forces velocity-free: {dyn.forces_velocity_free}")
@@ -147,6 +152,9 @@ def render_module(dyn, kernels, *, key, model_sha, gen_sha, options, source_rel,
         f"N_CONSTRAINTS = {dyn.m}",
         f"N_PARAMS = {len(dyn.params)}",
         f"CONSTRAINTS = {tuple(sp.sstr(c) for c in dyn.Phi)!r}",
+        f"N_ELEMENTS = {dyn.n_elements}",
+        f"ELEMENTS = {tuple(e.name for e in dyn.model.elements)!r}",
+        f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in dyn.model.elements)!r}  # 0 Saint-Venant, 1 dry friction",
         f"MASS_IS_CONSTANT = {dyn.mass_is_constant}",
         f"FORCES_VELOCITY_FREE = {dyn.forces_velocity_free}",
         f"METHODS = {tuple(methods)!r}",

@@ -28,7 +28,7 @@ class Output:
         return (self.matrix.shape[0],) if self.is_vector else tuple(self.matrix.shape)
 
 
-_ALWAYS_2D = {"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat"}
+_ALWAYS_2D = {"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef"}
 
 
 @dataclass
@@ -71,5 +71,11 @@ def make_kernels(dyn) -> list[KernelSpec]:
         KernelSpec("constraint_dq", ["q", "w", "lam", "p"],
                    [Output("dJw", jac["dJw_dq"]), Output("dJTlam", jac["dJTlam_dq"], symmetric=True)],
                    doc="d(J w)/dq (m, n) and d(J^T lam)/dq (n, n)"),
+        KernelSpec("elements", ["q", "p"],
+                   [Output("s", dyn.elem_s), Output("G", dyn.elem_grad), Output("coef", dyn.elem_coef)],
+                   doc="nonsmooth elements: strains s (ne,), gradients G = ds/dq (ne, n), "
+                       "coef (ne, 2) = (stiffness, threshold) or (friction bound, 0)"),
+        KernelSpec("elements_hessian", ["q", "we", "p"], [Output("out_mat", dyn.elem_hess_w, symmetric=True)],
+                   doc="sum_e we[e] d2 s_e/dq2 (n, n) for weights we (ne,)"),
     ]
     return kernels

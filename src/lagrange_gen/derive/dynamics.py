@@ -8,6 +8,7 @@ import sympy as sp
 
 from ..model import Model, t as time_symbol
 from .constraints import derive_constraints
+from .elements import derive_elements
 from .jacobians import derive_jacobians
 from .lagrangian import derive_lagrangian
 
@@ -19,7 +20,9 @@ class Dynamics:
     Shapes (n coordinates, m constraints): H (n, n); h, g, Q, rhs, dTdq, momentum_rate (n, 1);
     Phi (m, 1); J (m, n); gamma (m, 1); E scalar. Jacobian matrices are (n, n) unless noted.
     The equations of motion are H qddot + h + g = Q + J^T lambda with Phi(q) = 0, and
-    rhs = Q - h - g. ``momentum_rate`` = dT/dq - dV/dq + Q is dp/dt for p = H qdot.
+    rhs = Q - h - g (smooth forces only: nonsmooth element forces are the steppers' business).
+    Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 2),
+    elem_hess_w (n, n). ``momentum_rate`` = dT/dq - dV/dq + Q is dp/dt for p = H qdot.
     """
 
     model: Model
@@ -38,6 +41,10 @@ class Dynamics:
     Phi: sp.Matrix
     J: sp.Matrix
     gamma: sp.Matrix
+    elem_s: sp.Matrix = None
+    elem_grad: sp.Matrix = None
+    elem_coef: sp.Matrix = None
+    elem_hess_w: sp.Matrix = None
     jac: dict = field(default_factory=dict)
     aux: dict = field(default_factory=dict)   # auxiliary input vectors (w, lam) by name
 
@@ -48,6 +55,10 @@ class Dynamics:
     @property
     def m(self):
         return self.Phi.shape[0]
+
+    @property
+    def n_elements(self):
+        return self.elem_s.shape[0]
 
     @property
     def mass_is_constant(self):
@@ -69,4 +80,7 @@ def derive(model: Model, check_samples: int = 8) -> Dynamics:
     dyn = Dynamics(model=model, q=list(model.coords), qd=list(model.velocities),
                    params=list(model.params), t=time_symbol, **parts, **cons)
     dyn.jac, dyn.aux = derive_jacobians(dyn)
+    dyn.aux["we"] = list(sp.symbols(f"we_0:{len(model.elements)}", real=True))
+    for key, value in derive_elements(model, dyn.aux["we"]).items():
+        setattr(dyn, key, value)
     return dyn

@@ -1,0 +1,29 @@
+"""Nonsmooth elements: strains s_e(q), their gradients and curvature, and coefficients."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .backend import jacobian
+
+KIND_CODES = {"saint_venant": 0, "dry_friction": 1}
+
+
+def derive_elements(model, aux_we):
+    """Return dict(elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 2), elem_hess_w (n, n)).
+
+    elem_coef rows are (stiffness, threshold) for a Saint-Venant element and (bound, 0) for dry
+    friction. elem_hess_w = sum_e we_e d2 s_e/dq2 for an input vector we (ne,): the curvature
+    term of the Newton tangent of the element forces -k u grad s (zero for linear strains).
+    """
+    q = list(model.coords)
+    n, ne = len(q), len(model.elements)
+    if not ne:
+        return dict(elem_s=sp.zeros(0, 1), elem_grad=sp.zeros(0, n), elem_coef=sp.zeros(0, 2),
+                    elem_hess_w=sp.zeros(n, n))
+    s = sp.Matrix([e.strain for e in model.elements])
+    grad = jacobian(s, q)
+    weighted = sp.Matrix([sum((aux_we[e] * grad[e, j] for e in range(ne)), sp.S.Zero) for j in range(n)])
+    hess_w = jacobian(weighted, q)
+    coef = sp.Matrix([list(e.coefficients()) for e in model.elements])
+    return dict(elem_s=s, elem_grad=grad, elem_coef=coef, elem_hess_w=hess_w)
