@@ -1,7 +1,87 @@
-"""Registry of stepper methods and the glue each one emits into a generated module."""
+"""Registry of stepper methods and the glue each one emits into a generated module.
 
-METHODS = ()
+Why glue: numba caches a compiled function on disk only when it takes no function arguments.
+The cores in ``steppers/<method>.py`` are generic over the kernels: they receive the generated
+module itself as their first argument (``kern``; see base.py for why a module and not the
+dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` lives in the
+generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
+and its compiled code, cores included, is loaded from numba's cache by the next process. The KEY of a
+generated module hashes ``steppers/``, so a change here regenerates the module and thereby
+invalidates that cache.
+
+Glue signature (identical for every method)::
+
+    run_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
+                 out_t, out_q, out_v, out_stats, out_extra, out_last) -> (status, steps_done)
+
+    q0, v0     (n,) float64      initial state at time t0
+    h          float             step (may be negative: steps backwards in time)
+    n_steps, save_every  int     saves after every save_every-th step, plus row 0
+    p          (n_params,)       parameter values in PARAMS order
+    settings   (N_SETTINGS,)     base.make_settings(newton_tol, max_iter, bound, mode)
+    out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_extra)
+               S = n_steps // save_every + 1; n_extra = 0 for unconstrained methods (room for
+               multipliers and constraint residuals of the constrained methods)
+    out_last   (2 n + 2,)        [t, q, v, Newton residual] at the end or at the failure
+    status     lagrange_gen.status code; steps_done = index of the failing step on failure
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
+           "composition")
+
+GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
+             "out_t, out_q, out_v, out_stats, out_extra, out_last")
+
+
+@dataclass(frozen=True)
+class MethodInfo:
+    """What the tests and reports may rely on for a method."""
+
+    order: int
+    symplectic: bool
+    symmetric: bool
+    implicit: bool
+    summary: str
+
+
+INFO = {
+    "explicit_euler": MethodInfo(1, False, False, False, "forward Euler (reference of what not to do)"),
+    "symplectic_euler": MethodInfo(1, True, False, True, "symplectic Euler A in (q, p = H v)"),
+    "verlet": MethodInfo(2, True, True, True, "velocity Verlet / generalized leapfrog"),
+    "midpoint": MethodInfo(2, True, True, True, "midpoint variational integrator (A-stable)"),
+    "implicit_euler": MethodInfo(1, False, False, True, "backward Euler (L-stable)"),
+    "rk4": MethodInfo(4, False, False, False, "classical Runge-Kutta 4"),
+    "composition": MethodInfo(4, True, True, True, "Yoshida 4th-order triple jump of verlet"),
+}
+
+# _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
+# cores call kernels through; assigning it in every glue block keeps each block self-contained.
+_GLUE = '''import sys as _sys
+
+from lagrange_gen.steppers import {method} as _stepper_{method}
+
+_THIS_MODULE = _sys.modules[__name__]
+
+
+@njit(cache=True)
+def run_{method}({wrapped}):
+    """Integrate with {method} ({summary}); returns (status, steps_done).
+
+    Argument shapes: see lagrange_gen.steppers.registry; lagrange_gen.simulate wraps this."""
+    return _stepper_{method}.run(_THIS_MODULE, {wrapped_call})'''
 
 
 def glue_source(method: str) -> str:
-    raise KeyError(method)
+    """Source text of ``run_<method>`` to append to a generated module (deterministic)."""
+    if method not in INFO:
+        raise KeyError(f"unknown stepper method {method!r}; known: {', '.join(METHODS)}")
+    indent = " " * (len(f"def run_{method}("))
+    wrapped = GLUE_ARGS.replace("settings, ", "settings,\n" + indent)
+    call_indent = " " * len(f"    return _stepper_{method}.run(")
+    wrapped_call = GLUE_ARGS.replace("settings, ", "settings,\n" + call_indent)
+    return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
+                        summary=INFO[method].summary)

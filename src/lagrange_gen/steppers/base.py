@@ -1,0 +1,230 @@
+"""Rules and shared machinery of the stepper library.
+
+The rules every method module (``steppers/<method>.py``) follows:
+
+* One integrator per module, with a module docstring stating the scheme, its order and the
+  properties the tests check.
+* Two jitted functions with the same signatures in every module::
+
+      prepare(kern, q, v, mom, t, p, settings, work, mats, piv) -> status
+      step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra)
+          -> (status, newton_iterations, newton_residual)
+
+  ``prepare`` fills whatever per-run state the method carries between steps (the momentum
+  ``mom = H(q) v`` or a cached acceleration); ``step`` advances (q, v, mom) from t to t + h in
+  place. On failure ``step`` leaves q, v and mom at the start of the step, so the driver reports
+  the state it could not step from.
+* ``run(kern, q0, v0, t0, h, n_steps, save_every, p, settings, out_t, out_q, out_v, out_stats,
+  out_extra, out_last)`` is ``run_loop`` over the module's prepare and step; the generated glue
+  ``run_<method>`` calls it (see registry.py for why the glue exists).
+* No allocation per step: work arrays are allocated once per ``run`` and passed to ``step``.
+* Failures are status codes (lagrange_gen.status), never garbage and never exceptions.
+
+How the kernels reach the cores: ``kern`` is the generated module itself. numba types a module
+as a compile-time constant with no runtime representation, so ``kern.dynamics(...)`` is a direct
+call and ``kern.MASS_IS_CONSTANT`` a constant; likewise ``run_loop`` receives the method's module
+and calls ``method.step``. Passing the dispatchers themselves as values would make numba embed
+process-specific addresses ("dynamic globals") and refuse to cache the glue. None of the
+functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
+generated module's glue.
+
+Shapes: n coordinates; q, v, mom (n,); p (n_params,); work (N_WORK, n); mats (N_MAT, n, n);
+piv (n,) int64; extra (n_extra,) per-step method output (empty for unconstrained methods).
+"""
+
+import numpy as np
+from numba import njit
+
+from ..linalg import cholesky_inplace, cholesky_solve_inplace, lu_inplace, lu_solve_inplace
+from ..status import NON_FINITE, OK, SINGULAR_MASS, UNSTABLE
+
+# Layout of the float64 ``settings`` array shared by every method.
+S_TOL = 0          # Newton: converged when max|dx| <= tol * max(1, max|x|)
+S_MAX_ITER = 1     # Newton iteration cap per solve
+S_BOUND = 2        # UNSTABLE when max(|q|, |v|) exceeds this
+S_MODE = 3         # 0: explicit path when the model allows it; 1: always the Newton path
+N_SETTINGS = 4
+DEFAULT_SETTINGS = (1e-12, 50.0, 1e150, 0.0)
+
+# Columns of ``out_stats`` (n_saves, N_STATS), one row per saved state.
+STAT_ENERGY = 0     # E = T + V at the saved state
+STAT_ITERS = 1      # Newton iterations summed over the steps since the previous save
+STAT_RESIDUAL = 2   # largest Newton residual (max norm, last iterate of a step) over those steps
+N_STATS = 3
+
+# Work array sizes (rows of ``work`` are n-vectors, entries of ``mats`` are n x n matrices).
+N_WORK = 12
+N_MAT = 6
+# Rows a method may keep across steps (all others are scratch within one step): the cached
+# acceleration of explicit Verlet, and composition's copy of the state at the start of a step.
+W_ACC = 11
+W_SAVE_Q, W_SAVE_V, W_SAVE_MOM = 8, 9, 10
+
+
+def make_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0):
+    """The float64 settings array (N_SETTINGS,) in the layout above."""
+    return np.array([newton_tol, max_iter, bound, mode], dtype=np.float64)
+
+
+@njit
+def explicit_path(kern, settings):
+    """True when a partitioned method may skip Newton: the model has constant H and
+    velocity-free forces (generated flags) and settings[S_MODE] allows it."""
+    return kern.MASS_IS_CONSTANT and kern.FORCES_VELOCITY_FREE and settings[S_MODE] == 0.0
+
+
+@njit(cache=True)
+def max_abs(x):
+    """max |x_i| of a vector (n,); NaN propagates (returns NaN)."""
+    m = 0.0
+    for i in range(x.shape[0]):
+        a = abs(x[i])
+        if a > m or a != a:
+            m = a
+    return m
+
+
+@njit(cache=True)
+def increment_small(dx, x, tol):
+    """Newton stopping test on the increment, relative to the size of the unknown."""
+    return max_abs(dx) <= tol * max(1.0, max_abs(x))
+
+
+@njit(cache=True)
+def copy_into(dst, src):
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@njit(cache=True)
+def matvec(A, x, out):
+    """out = A x for A (n, n), x (n,)."""
+    n = x.shape[0]
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += A[i, j] * x[j]
+        out[i] = s
+
+
+@njit(cache=True)
+def mass_solve(H, b):
+    """Overwrite b (n,) by H^-1 b with H (n, n) SPD, factored in place. False if singular."""
+    if not cholesky_inplace(H):
+        return False
+    cholesky_solve_inplace(H, b)
+    return True
+
+
+@njit(cache=True)
+def lu_solve(A, piv, b, scratch):
+    """Overwrite b by A^-1 b (general A, factored in place by LU). False if singular."""
+    if not lu_inplace(A, piv):
+        return False
+    lu_solve_inplace(A, piv, b, scratch)
+    return True
+
+
+@njit
+def velocity_from_momentum(kern, q, mom, p, H, v):
+    """v = H(q)^-1 mom (the inverse Legendre transform). Returns OK or SINGULAR_MASS."""
+    kern.mass_matrix(q, p, H)
+    copy_into(v, mom)
+    return OK if mass_solve(H, v) else SINGULAR_MASS
+
+
+@njit
+def momentum_from_velocity(kern, q, v, p, H, mom):
+    """mom = H(q) v (the Legendre transform)."""
+    kern.mass_matrix(q, p, H)
+    matvec(H, v, mom)
+
+
+@njit(cache=True)
+def check_state(q, v, bound):
+    """NON_FINITE if any entry is NaN/inf, UNSTABLE if one exceeds bound, else OK."""
+    big = max(max_abs(q), max_abs(v))
+    if big != big or big == np.inf:
+        return NON_FINITE
+    if big > bound:
+        return UNSTABLE
+    return OK
+
+
+@njit(cache=True)
+def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, extra, out_extra):
+    out_t[row] = t
+    for i in range(q.shape[0]):
+        out_q[row, i] = q[i]
+        out_v[row, i] = v[i]
+    out_stats[row, STAT_ENERGY] = energy
+    out_stats[row, STAT_ITERS] = iters
+    out_stats[row, STAT_RESIDUAL] = resid
+    for k in range(extra.shape[0]):
+        out_extra[row, k] = extra[k]
+
+
+@njit(cache=True)
+def _last(out_last, t, q, v, resid):
+    n = q.shape[0]
+    out_last[0] = t
+    for i in range(n):
+        out_last[1 + i] = q[i]
+        out_last[1 + n + i] = v[i]
+    out_last[1 + 2 * n] = resid
+
+
+@njit
+def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
+             out_t, out_q, out_v, out_stats, out_extra, out_last):
+    """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
+
+    ``method`` is a stepper module (its prepare and step are called), ``kern`` the generated
+    module.
+    Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
+    n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
+    (S, N_STATS), out_extra (S, n_extra). out_last (2n + 2,) receives [t, q, v, residual] of the
+    final state, or on failure: the state the failing step started from (Newton failure,
+    singular mass) or the offending state after it (NON_FINITE, UNSTABLE).
+    Returns (status, steps_done): steps_done = index of the failing step on failure.
+    """
+    n = q0.shape[0]
+    q = q0.copy()
+    v = v0.copy()
+    mom = np.zeros(n)
+    work = np.zeros((N_WORK, n))
+    mats = np.zeros((N_MAT, n, n))
+    piv = np.zeros(n, dtype=np.int64)
+    extra = np.zeros(out_extra.shape[1])
+    bound = settings[S_BOUND]
+    status = check_state(q, v, bound)
+    if status == OK:
+        status = method.prepare(kern, q, v, mom, t0, p, settings, work, mats, piv)
+    _last(out_last, t0, q, v, 0.0)
+    if status != OK:
+        return status, 0
+    _save(0, t0, q, v, kern.energy(q, v, t0, p), 0.0, 0.0, out_t, out_q, out_v, out_stats,
+          extra, out_extra)
+    iters_acc = 0.0
+    resid_max = 0.0
+    for i in range(n_steps):
+        t = t0 + i * h       # not accumulated: no drift of t over millions of steps
+        status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, work, mats,
+                                           piv, extra)
+        iters_acc += iters
+        resid_max = max(resid_max, resid)
+        if status != OK:
+            _last(out_last, t, q, v, resid)
+            return status, i
+        t_new = t0 + (i + 1) * h
+        status = check_state(q, v, bound)
+        if status != OK:
+            _last(out_last, t_new, q, v, resid)
+            return status, i
+        if (i + 1) % save_every == 0:
+            _save((i + 1) // save_every, t_new, q, v, kern.energy(q, v, t_new, p), iters_acc,
+                  resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
+            iters_acc = 0.0
+            resid_max = 0.0
+    _last(out_last, t0 + n_steps * h, q, v, resid_max)
+    return OK, n_steps

@@ -1,0 +1,81 @@
+"""Implicit (backward) Euler on the first-order system, without forming H^-1.
+
+With rhs = Q - h - g (generated ``dynamics``), one step solves for v+ (Newton):
+
+    R(v+) = H(q+) (v+ - v) - h rhs(q+, v+, t + h) = 0,    q+ = q + h v+
+
+Order 1, not symmetric, not symplectic; L-stable: on x'' = -omega^2 x the step matrix has
+eigenvalues 1/(1 +- i tau), spectral radius 1/sqrt(1 + tau^2) -> 0 as tau -> inf, so stiff modes
+are damped out. This is the stepper of the nonsmooth elements (exact for the play operator).
+
+Newton uses the exact Jacobian
+    dR/dv+ = H(q+) + h d(H w)/dq |_{w = v+ - v} - h^2 d rhs/dq - h d rhs/dv
+from ``mass_matvec_dq`` and ``rhs_jacobian``.
+"""
+
+import sys
+
+from numba import njit
+
+from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
+from .base import S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs, run_loop
+
+_V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
+_H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4           # mats
+
+
+@njit
+def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+    """Nothing is carried between steps."""
+    return OK
+
+
+@njit
+def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+    """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
+    n = q.shape[0]
+    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
+    v1, q1, dv, rhs, R, scratch = work[_V1], work[_Q1], work[_DV], work[_RHS], work[_R], work[_S]
+    H, A, Jq, Jqd, dHw = mats[_H], mats[_A], mats[_JQ], mats[_JQD], mats[_DHW]
+    t1 = t + h
+    for i in range(n):
+        v1[i] = v[i]
+    resid = 0.0
+    for it in range(1, max_iter + 1):
+        for i in range(n):
+            q1[i] = q[i] + h * v1[i]
+            dv[i] = v1[i] - v[i]
+        kern.dynamics(q1, v1, t1, p, H, rhs)
+        kern.rhs_jacobian(q1, v1, t1, p, Jq, Jqd)
+        kern.mass_matvec_dq(q1, dv, p, dHw)
+        for i in range(n):
+            s = -h * rhs[i]
+            for j in range(n):
+                s += H[i, j] * dv[j]
+                A[i, j] = H[i, j] + h * dHw[i, j] - h * h * Jq[i, j] - h * Jqd[i, j]
+            R[i] = -s
+        resid = max_abs(R)
+        if resid != resid:
+            return NEWTON_DIVERGED, it, resid
+        if not lu_solve(A, piv, R, scratch):
+            return SINGULAR_MASS, it, resid
+        for i in range(n):
+            v1[i] += R[i]
+        if increment_small(R, v1, tol):
+            for i in range(n):
+                q[i] += h * v1[i]
+                v[i] = v1[i]
+            return OK, it, resid
+    return NEWTON_DIVERGED, max_iter, resid
+
+
+@njit
+def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
+        out_t, out_q, out_v, out_stats, out_extra, out_last):
+    """See base.run_loop."""
+    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
+                    out_t, out_q, out_v, out_stats, out_extra, out_last)
+
+
+# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+_THIS = sys.modules[__name__]
