@@ -1,0 +1,304 @@
+"""Identification of the generalized Prandtl model with linear hardening from a loading half-cycle.
+
+Model (Lamarque's lecture, slides 19-26)::
+
+    m x'' + c x' + k0 x + sum_{i=1}^n k_i u_i = F(t),    u_i' + dpsi_[-eta_i, eta_i](u_i) ∋ x'.
+
+Method. In the plane (x, y) with y = F - m x'' - c x' = k0 x + sum k_i u_i, take a loading branch:
+x increasing from a turning point x_turn at which every element is saturated at u_i = -eta_i. Element
+i then follows u_i = -eta_i + (x - x_turn) until it saturates at +eta_i, at x - x_turn = 2 eta_i. With
+eta_1 < ... < eta_n the branch is continuous and piecewise linear with slopes
+p_j = k0 + sum_{l>=j} k_l (decreasing) and breakpoints at x_turn + 2 eta_j. Hence::
+
+    k0 = p_{n+1},   k_j = p_j - p_{j+1},   eta_j = (breakpoint_j - x_turn) / 2.
+
+The slopes and breakpoints come from a continuous piecewise-linear least-squares fit with free
+breakpoints (module piecewise: global dynamic-programming segmentation, then joint refinement), or
+from the lecture's wavelet localisation of the kinks (module wavelet) refined by the same least
+squares. The number of elements is given, or chosen by the Bayesian information criterion.
+
+Assumptions: the element thresholds are distinct; the damping c is known (pass it with velocities
+or times; c = 0 by default) and m x'' is already subtracted; the branch starts at a turning point
+reached after a monotone excursion of at least 2 max(eta) (true on a steady symmetric cycle that
+unlocks every element), otherwise the elements are not all saturated there and the breakpoints
+move; noise is additive on y. The turning point is the smallest x of the branch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import IdentificationError
+from .piecewise import fit_hinges, fit_piecewise
+
+MIN_POINTS = 3          # samples per linear piece: two fix a line, one more to see its residual
+SIGNIFICANCE = 4.0      # a slope change counts when it exceeds this many standard errors ...
+RELATIVE_CHANGE = 1e-6  # ... and this fraction of the largest slope (clean data: round-off level)
+REVERSAL = 0.01         # x must retreat by this fraction of its range to count as a turning point
+
+
+@dataclass
+class PrandtlFit:
+    """Identified parameters; n = number of elements, arrays sorted by increasing threshold.
+
+    k0: hardening stiffness; k: (n,) element stiffnesses; eta: (n,) thresholds (alpha = k eta is
+    the yield force); slopes: (n+1,) branch slopes p_j; breakpoints: (n,) abscissae of the kinks
+    (x_turn + 2 eta); *_stderr: standard errors of the estimates; noise: noise level of y used;
+    rms: residual root mean square; branches: [(start, stop)] index ranges of the runs used, the
+    widest rising run first. For a joint fit of several runs, x_turn is 0 and breakpoints are
+    measured from each run's turning point.
+    """
+
+    k0: float
+    k: np.ndarray
+    eta: np.ndarray
+    slopes: np.ndarray
+    breakpoints: np.ndarray
+    x_turn: float
+    k0_stderr: float
+    k_stderr: np.ndarray
+    eta_stderr: np.ndarray
+    noise: float
+    rms: float
+    n_samples: int
+    branches: list
+    method: str
+    warnings: list = field(default_factory=list)
+
+    @property
+    def n_elements(self):
+        return len(self.k)
+
+    @property
+    def alpha(self):
+        """(n,) yield forces k_i eta_i."""
+        return self.k * self.eta
+
+    def summary(self):
+        """Multi-line text table of the parameters (what the CLI prints)."""
+        lines = [f"generalized Prandtl model, {self.n_elements} element(s), from "
+                 f"{self.n_samples} samples of {len(self.branches)} branch(es) "
+                 f"({self.method} fit, residual rms {self.rms:.3g})",
+                 f"k0 = {self.k0:.6g} +- {self.k0_stderr:.2g}",
+                 f"{'i':>3} {'k_i':>12} {'+-':>8} {'eta_i':>12} {'+-':>8} {'alpha_i':>12}"]
+        for i, (k, dk, e, de, a) in enumerate(zip(self.k, self.k_stderr, self.eta,
+                                                  self.eta_stderr, self.alpha), 1):
+            lines.append(f"{i:>3} {k:>12.6g} {dk:>8.2g} {e:>12.6g} {de:>8.2g} {a:>12.6g}")
+        lines.append("slopes p_j: " + ", ".join(f"{p:.6g}" for p in self.slopes))
+        lines += [f"warning: {w}" for w in self.warnings]
+        return "\n".join(lines)
+
+
+def _samples(x, y):
+    """Validated float arrays of shape (N,)."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.ndim != 1 or x.shape != y.shape:
+        raise IdentificationError(f"x and F - m x'' must be 1-D of the same length, got shapes "
+                                  f"{x.shape} and {y.shape}")
+    if len(x) < 8:
+        raise IdentificationError(f"too few samples: {len(x)}, need at least 8")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+        raise IdentificationError("x or F - m x'' holds NaN or infinite samples; remove them first")
+    return x, y
+
+
+def _turning_points(x, delta):
+    """Indices of alternating extrema of x (N,); a reversal counts once x retreats by > delta."""
+    lo = hi = 0
+    direction, pivots, ext = 0, [], 0
+    for i in range(1, len(x)):
+        if direction == 0:
+            lo = i if x[i] < x[lo] else lo
+            hi = i if x[i] > x[hi] else hi
+            if x[hi] - x[lo] > delta:  # the first clear move sets the direction
+                direction = 1 if hi > lo else -1
+                pivots.append(min(lo, hi))
+                ext = max(lo, hi)
+        elif direction * (x[i] - x[ext]) >= 0:
+            ext = i
+        elif direction * (x[ext] - x[i]) > delta:
+            pivots.append(ext)
+            ext, direction = i, -direction
+    return pivots + [ext] if direction else pivots
+
+
+def loading_branch(x, reversal=REVERSAL):
+    """(start, stop) indices of the widest rising run of x (N,), from a minimum to the next maximum.
+
+    Runs are delimited by turning points: x must retreat by more than `reversal` times its range,
+    so noise on x does not split a run. Among runs of equal rise (a steady cycle) the last wins.
+    """
+    x = np.asarray(x, dtype=float)
+    span = float(np.ptp(x)) if len(x) else 0.0
+    if span == 0.0:
+        raise IdentificationError("no loading phase: x is constant, so it never increases")
+    pivots = _turning_points(x, reversal * span)
+    runs = [(p, q) for p, q in zip(pivots, pivots[1:]) if x[q] > x[p]]
+    if not runs:
+        raise IdentificationError(f"no loading phase: x never increases by more than "
+                                  f"{reversal:.0%} of its range; need x rising from a turning point")
+    rises = np.array([x[q] - x[p] for p, q in runs])
+    best = np.flatnonzero(rises >= rises.max() * (1 - 1e-6))[-1]
+    return runs[best]
+
+
+def _restoring_force(x, y, damping, velocity, t):
+    """y - c x' with x' given, or from times t by second-order differences; shapes (N,)."""
+    if not damping:
+        return y
+    if velocity is None and t is None:
+        raise IdentificationError("damping given but neither velocity nor t: cannot form c x'")
+    given = np.asarray(velocity if velocity is not None else t, dtype=float)
+    if given.shape != x.shape:
+        raise IdentificationError(f"velocity/t has shape {given.shape}, x has {x.shape}")
+    v = given if velocity is not None else np.gradient(x, given)
+    return y - damping * v
+
+
+def identify_prandtl(x, F_minus_mxdd, n_elements=None, noise=None, *, damping=0.0, velocity=None,
+                     t=None, method="pwl", branches="all", max_elements=7):
+    """Identify k0, k_i, eta_i from samples of the (x, F - m x'') curve.
+
+    x, F_minus_mxdd: (N,) samples of a loading half-cycle, or of longer records (full cycles).
+    The widest rising run of x (see loading_branch) is identified first; with branches="all" every
+    other monotone run (rising, or falling and mirrored) that starts after an excursion of at least
+    2 max(eta) is then fitted jointly with it (shared slopes and breakpoints), which averages the
+    noise over all recorded cycles; branches="widest" uses that run only. n_elements: number of
+    Saint-Venant elements, or None to choose it (BIC, at most max_elements). noise: standard
+    deviation of the noise on F - m x'' (None: estimated). damping: known viscous coefficient c,
+    subtracted as c x' with x' from velocity (N,) or from times t (N,). method: "pwl"
+    (dynamic-programming segmentation) or "wavelet" (kinks located by the Mexican-hat transform);
+    both end with the same least-squares refinement. Returns a PrandtlFit; raises
+    IdentificationError when the data do not determine the parameters.
+    """
+    x, y = _samples(x, F_minus_mxdd)
+    if method not in ("pwl", "wavelet") or branches not in ("all", "widest"):
+        raise IdentificationError(f"method must be 'pwl' or 'wavelet' and branches 'all' or "
+                                  f"'widest', got {method!r} and {branches!r}")
+    if n_elements is not None and int(n_elements) < 1:
+        raise IdentificationError(f"n_elements must be at least 1, got {n_elements}")
+    y = _restoring_force(x, y, damping, velocity, t)
+    start, stop = loading_branch(x)
+    fit = _fit_branch(x[start:stop + 1], y[start:stop + 1], n_elements, noise, method,
+                      max_elements)
+    notes = _warnings(x, start, fit)
+    runs = [(start, stop)]
+    if branches == "all":
+        fit, runs = _pool_branches(x, y, fit, runs[0], noise, notes)
+    return _prandtl_fit(fit, runs, method, notes)
+
+
+def _fit_branch(xb, yb, n_elements, noise, method, max_elements):
+    """Piecewise-linear fit of one rising branch (N,) whose every kink is a real slope drop."""
+    order = np.argsort(xb, kind="stable")
+    xb, yb = xb[order], yb[order]
+    need = max(8, MIN_POINTS * ((n_elements or 1) + 1))
+    if len(xb) < need:
+        raise IdentificationError(f"too few samples: the loading branch has {len(xb)}, need at "
+                                  f"least {need} ({MIN_POINTS} per linear piece)")
+    init = _wavelet_init(xb, yb) if method == "wavelet" else None
+    pieces = None if n_elements is None else int(n_elements) + 1
+    fit, _ = fit_piecewise(xb, yb, pieces, noise, init, max_segments=max_elements + 1,
+                           min_points=MIN_POINTS)
+    n_good = _count_kinks(fit)
+    if n_elements is None and 0 < n_good < len(fit.breakpoints):
+        # BIC kept a kink that fails the significance test: refit with the significant ones only.
+        fit, _ = fit_piecewise(xb, yb, n_good + 1, noise, init, min_points=MIN_POINTS)
+        n_good = _count_kinks(fit)
+    if n_good == 0 and n_elements is None:
+        raise IdentificationError("no slope change on the loading branch: no element slips "
+                                  "(purely elastic response, or forcing too weak)")
+    if n_good < len(fit.breakpoints):
+        raise IdentificationError(
+            f"fewer breakpoints than elements: {n_good} significant slope change(s) on the "
+            f"loading branch, {len(fit.breakpoints)} element(s) asked for (forcing too weak to "
+            f"unlock them all, or ask for fewer)")
+    return fit
+
+
+def _pool_branches(x, y, fit, widest, noise, notes):
+    """Joint refit over the widest run and every run that starts after a full excursion.
+
+    A falling run is mirrored (x_turn - x, -y): by the centre symmetry of the cycle it is then a
+    loading branch with the same slopes and breakpoints. Returns (fit, runs used).
+    """
+    need = (fit.breakpoints[-1] - fit.x_lo) * 1.02  # margin for the breakpoint's own error
+    pivots = _turning_points(x, REVERSAL * float(np.ptp(x)))
+    runs = [widest] + [(p, q) for prev, p, q in zip(pivots, pivots[1:], pivots[2:])
+                       if abs(x[p] - x[prev]) >= need and (p, q) != widest]
+    if len(runs) == 1:
+        return fit, runs
+    dx, dy, groups = [], [], []
+    for g, (p, q) in enumerate(runs):
+        sign = 1.0 if x[q] > x[p] else -1.0
+        dx.append(sign * (x[p:q + 1] - x[p]))
+        dy.append(sign * y[p:q + 1])
+        groups.append(np.full(q - p + 1, g))
+    joint = fit_hinges(np.concatenate(dx), np.concatenate(dy), fit.breakpoints - fit.x_lo, noise,
+                       np.concatenate(groups))
+    if _count_kinks(joint) < len(fit.breakpoints):
+        notes.append(f"the {len(runs)} branches disagree (a kink vanishes in their joint fit): "
+                     f"kept the widest branch alone")
+        return fit, [widest]
+    return joint, runs
+
+
+def _wavelet_init(xb, yb):
+    """Initial breakpoints for K pieces: the K-1 strongest wavelet kinks, sorted (None: too few)."""
+    from .wavelet import wavelet_breakpoints
+    locations, _ = wavelet_breakpoints(xb, yb)
+
+    def init(k):
+        return np.sort(locations[:k - 1]) if len(locations) >= k - 1 else None
+    return init
+
+
+def _count_kinks(fit):
+    """Number of slope changes that are decreases, significant, and flanked by enough samples.
+
+    Raises IdentificationError on a significant slope increase or a negative last slope: neither
+    can occur on a loading branch of the model (k_i > 0, k0 >= 0).
+    """
+    change = fit.slope_changes
+    real = (np.abs(change) > SIGNIFICANCE * fit.change_stderr()) & (
+        np.abs(change) > RELATIVE_CHANGE * np.abs(fit.slopes).max())
+    flanked = (fit.counts[:-1] >= MIN_POINTS) & (fit.counts[1:] >= MIN_POINTS)
+    rising = real & flanked & (change > 0)
+    if rising.any():
+        j = int(np.flatnonzero(rising)[0])
+        raise IdentificationError(
+            f"slope increases by {change[j]:.3g} at x = {fit.breakpoints[j]:.6g}: not a loading "
+            f"branch of a generalized Prandtl model (slopes must decrease, k_i > 0)")
+    if fit.slopes[-1] < -SIGNIFICANCE * fit.last_slope_stderr():
+        raise IdentificationError(f"last slope {fit.slopes[-1]:.3g} is negative: k0 >= 0 fails, "
+                                  f"not a loading branch of a generalized Prandtl model")
+    return int(np.count_nonzero(real & flanked))
+
+
+def _prandtl_fit(fit, runs, method, warnings):
+    """PrandtlFit from a HingeFit whose every kink is a significant slope decrease."""
+    return PrandtlFit(
+        k0=float(fit.slopes[-1]), k=-fit.slope_changes, eta=(fit.breakpoints - fit.x_lo) / 2,
+        slopes=fit.slopes, breakpoints=fit.breakpoints, x_turn=fit.x_lo,
+        k0_stderr=fit.last_slope_stderr(), k_stderr=fit.change_stderr(),
+        eta_stderr=fit.breakpoint_stderr() / 2, noise=fit.sigma,
+        rms=float(np.sqrt(fit.sse / fit.n_samples)), n_samples=fit.n_samples,
+        branches=[(int(p), int(q)) for p, q in runs], method=method, warnings=warnings)
+
+
+def _warnings(x, start, fit):
+    """Checks of the saturation assumption that the data can support (list of messages)."""
+    if not len(fit.breakpoints):
+        return []
+    need = fit.breakpoints[-1] - fit.x_lo
+    pivots = _turning_points(x[:start + 1], REVERSAL * float(np.ptp(x)))
+    if start == 0 or len(pivots) < 2:
+        return [f"no fall recorded before the turning point: assumed it was at least "
+                f"2 max(eta) = {need:.4g}, so that every element starts saturated"]
+    fall = x[pivots[-2]] - x[start]
+    if fall < need:
+        return [f"x fell by only {fall:.4g} before the turning point, less than 2 max(eta) = "
+                f"{need:.4g}: the largest elements may not be saturated there"]
+    return []
