@@ -97,9 +97,11 @@ def _spectral_period(x, dt):
     spectrum = np.abs(np.fft.rfft(x * np.hanning(len(x)), n))
     spectrum[0] = 0.0  # the mean is not an oscillation
     i = int(np.argmax(spectrum))
-    if i == 0 or i >= len(spectrum) - 1:
-        raise IdentificationError("no oscillation in x: a free decay of an under-damped "
-                                  "oscillator is needed")
+    if i < 4 * MIN_PERIODS or i >= len(spectrum) - 1:
+        # The padded spectrum has 4 bins per cycle over the record: fewer than MIN_PERIODS cycles.
+        raise IdentificationError(
+            f"no oscillation: the spectrum of x peaks at {i / 4:.1f} cycles over the record, need "
+            f"at least {MIN_PERIODS:g} (a free decay of an under-damped oscillator, or pass period)")
     a, b, c = np.log(spectrum[i - 1:i + 2] + np.finfo(float).tiny)
     shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
     return n * dt / (i + shift)
