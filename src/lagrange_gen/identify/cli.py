@@ -40,8 +40,9 @@ def add_parser(subparsers):
                    help="prandtl: noise standard deviation of F (default: estimated)")
     p.add_argument("--method", choices=["pwl", "wavelet"], default="pwl",
                    help="prandtl: breakpoint search (default: pwl)")
-    p.add_argument("--branches", choices=["all", "widest"], default="all",
-                   help="prandtl: pool every full branch (default) or use the widest rising one")
+    p.add_argument("--branches", choices=["all", "one"], default="all",
+                   help="prandtl: pool every branch that starts from a full excursion (default) "
+                        "or use the loading branch only")
     p.add_argument("--period", type=float, metavar="T",
                    help="damping: damped period (default: from the spectrum)")
     p.add_argument("--scale", type=float, metavar="A",

@@ -47,7 +47,7 @@ class PrandtlFit:
     the yield force); slopes: (n+1,) branch slopes p_j; breakpoints: (n,) abscissae of the kinks
     (x_turn + 2 eta); *_stderr: standard errors of the estimates; noise: noise level of y used;
     rms: residual root mean square; branches: [(start, stop)] index ranges of the runs used, the
-    widest rising run first. For a joint fit of several runs, x_turn is 0 and breakpoints are
+    loading branch first. For a joint fit of several runs, x_turn is 0 and breakpoints are
     measured from each run's turning point.
     """
 
@@ -124,24 +124,40 @@ def _turning_points(x, delta):
     return pivots + [ext] if direction else pivots
 
 
-def loading_branch(x, reversal=REVERSAL):
-    """(start, stop) indices of the widest rising run of x (N,), from a minimum to the next maximum.
+def monotone_runs(x, reversal=REVERSAL):
+    """Monotone runs of x (N,) between turning points: list of (start, stop, preceding excursion).
 
-    Runs are delimited by turning points: x must retreat by more than `reversal` times its range,
-    so noise on x does not split a run. Among runs of equal rise (a steady cycle) the last wins.
+    A reversal counts once x retreats by more than `reversal` times its range, so noise on x does
+    not split a run. The preceding excursion is |x[start] - x at the turning point before start|;
+    it is 0 for the first run, which starts from the initial state rather than a turning point.
     """
     x = np.asarray(x, dtype=float)
     span = float(np.ptp(x)) if len(x) else 0.0
     if span == 0.0:
         raise IdentificationError("no loading phase: x is constant, so it never increases")
     pivots = _turning_points(x, reversal * span)
-    runs = [(p, q) for p, q in zip(pivots, pivots[1:]) if x[q] > x[p]]
+    before = [0.0] + [abs(x[p] - x[o]) for o, p in zip(pivots, pivots[1:])]
+    return [(p, q, e) for p, q, e in zip(pivots, pivots[1:], before)]
+
+
+def loading_branch(x, reversal=REVERSAL):
+    """(start, stop) indices of the loading branch of x (N,): a rise from a minimum to a maximum.
+
+    The rising run chosen maximizes min(rise, preceding fall): the branch must show every kink and
+    start where every element is saturated, which needs both to exceed 2 max(eta). So a steady
+    cycle wins over a first loading from the initial state, and over a rise after a minor loop; a
+    lone rising half-cycle is taken as it is. Among equal scores (a steady cycle) the last wins.
+    """
+    x = np.asarray(x, dtype=float)
+    runs = [(p, q, min(x[q] - x[p], e)) for p, q, e in monotone_runs(x, reversal) if x[q] > x[p]]
     if not runs:
         raise IdentificationError(f"no loading phase: x never increases by more than "
                                   f"{reversal:.0%} of its range; need x rising from a turning point")
-    rises = np.array([x[q] - x[p] for p, q in runs])
-    best = np.flatnonzero(rises >= rises.max() * (1 - 1e-6))[-1]
-    return runs[best]
+    score = np.array([max(s, 0.0) for _, _, s in runs])
+    if score.max() == 0.0:  # no rise follows a recorded fall: take the widest rise
+        score = np.array([x[q] - x[p] for p, q, _ in runs])
+    best = np.flatnonzero(score >= score.max() * (1 - 1e-6))[-1]
+    return runs[best][:2]
 
 
 def _restoring_force(x, y, damping, velocity, t):
@@ -162,10 +178,10 @@ def identify_prandtl(x, F_minus_mxdd, n_elements=None, noise=None, *, damping=0.
     """Identify k0, k_i, eta_i from samples of the (x, F - m x'') curve.
 
     x, F_minus_mxdd: (N,) samples of a loading half-cycle, or of longer records (full cycles).
-    The widest rising run of x (see loading_branch) is identified first; with branches="all" every
+    The loading branch of x (see loading_branch) is identified first; with branches="all" every
     other monotone run (rising, or falling and mirrored) that starts after an excursion of at least
     2 max(eta) is then fitted jointly with it (shared slopes and breakpoints), which averages the
-    noise over all recorded cycles; branches="widest" uses that run only. n_elements: number of
+    noise over all recorded cycles; branches="one" uses the loading branch only. n_elements: number of
     Saint-Venant elements, or None to choose it (BIC, at most max_elements). noise: standard
     deviation of the noise on F - m x'' (None: estimated). damping: known viscous coefficient c,
     subtracted as c x' with x' from velocity (N,) or from times t (N,). method: "pwl"
@@ -174,20 +190,39 @@ def identify_prandtl(x, F_minus_mxdd, n_elements=None, noise=None, *, damping=0.
     IdentificationError when the data do not determine the parameters.
     """
     x, y = _samples(x, F_minus_mxdd)
-    if method not in ("pwl", "wavelet") or branches not in ("all", "widest"):
+    if method not in ("pwl", "wavelet") or branches not in ("all", "one"):
         raise IdentificationError(f"method must be 'pwl' or 'wavelet' and branches 'all' or "
-                                  f"'widest', got {method!r} and {branches!r}")
+                                  f"'one', got {method!r} and {branches!r}")
     if n_elements is not None and int(n_elements) < 1:
         raise IdentificationError(f"n_elements must be at least 1, got {n_elements}")
     y = _restoring_force(x, y, damping, velocity, t)
     start, stop = loading_branch(x)
-    fit = _fit_branch(x[start:stop + 1], y[start:stop + 1], n_elements, noise, method,
-                      max_elements)
-    notes = _warnings(x, start, fit)
+    notes = []
+    keep = _advancing(x, start, stop, notes)
+    fit = _fit_branch(x[keep], y[keep], n_elements, noise, method, max_elements)
+    notes += _warnings(x, start, fit)
     runs = [(start, stop)]
     if branches == "all":
         fit, runs = _pool_branches(x, y, fit, runs[0], noise, notes)
     return _prandtl_fit(fit, runs, method, notes)
+
+
+def _advancing(x, p, q, notes):
+    """Indices in [p, q] where x reaches a new extreme in the direction of the run (p to q).
+
+    Inside a run x may retreat by less than the reversal threshold (a minor loop). The minor loop
+    leaves the branch, but by return-point memory of the play operator the state is back on it
+    when x passes its previous extreme, so only the advancing samples lie on the branch. Assumes
+    the noise on x is small against its advance per sample; a large loss is reported in notes.
+    """
+    sign = 1.0 if x[q] >= x[p] else -1.0
+    run = sign * x[p:q + 1]
+    ahead = np.r_[True, run[1:] > np.maximum.accumulate(run)[:-1]]
+    dropped = len(run) - int(ahead.sum())
+    if dropped > 0.1 * len(run):
+        notes.append(f"x is not monotone on the branch x[{p}:{q + 1}]: kept the {len(run) - dropped} "
+                     f"samples where it advances, dropped {dropped} (minor loops or noise on x)")
+    return np.flatnonzero(ahead) + p
 
 
 def _fit_branch(xb, yb, n_elements, noise, method, max_elements):
@@ -218,30 +253,30 @@ def _fit_branch(xb, yb, n_elements, noise, method, max_elements):
     return fit
 
 
-def _pool_branches(x, y, fit, widest, noise, notes):
-    """Joint refit over the widest run and every run that starts after a full excursion.
+def _pool_branches(x, y, fit, branch, noise, notes):
+    """Joint refit over the loading branch and every run that starts after a full excursion.
 
     A falling run is mirrored (x_turn - x, -y): by the centre symmetry of the cycle it is then a
     loading branch with the same slopes and breakpoints. Returns (fit, runs used).
     """
     need = (fit.breakpoints[-1] - fit.x_lo) * 1.02  # margin for the breakpoint's own error
-    pivots = _turning_points(x, REVERSAL * float(np.ptp(x)))
-    runs = [widest] + [(p, q) for prev, p, q in zip(pivots, pivots[1:], pivots[2:])
-                       if abs(x[p] - x[prev]) >= need and (p, q) != widest]
+    runs = [branch] + [(p, q) for p, q, before in monotone_runs(x)
+                       if before >= need and (p, q) != branch]
     if len(runs) == 1:
         return fit, runs
     dx, dy, groups = [], [], []
     for g, (p, q) in enumerate(runs):
         sign = 1.0 if x[q] > x[p] else -1.0
-        dx.append(sign * (x[p:q + 1] - x[p]))
-        dy.append(sign * y[p:q + 1])
-        groups.append(np.full(q - p + 1, g))
+        keep = _advancing(x, p, q, notes if g else [])  # the loading branch was reported already
+        dx.append(sign * (x[keep] - x[p]))
+        dy.append(sign * y[keep])
+        groups.append(np.full(len(keep), g))
     joint = fit_hinges(np.concatenate(dx), np.concatenate(dy), fit.breakpoints - fit.x_lo, noise,
                        np.concatenate(groups))
     if _count_kinks(joint) < len(fit.breakpoints):
         notes.append(f"the {len(runs)} branches disagree (a kink vanishes in their joint fit): "
-                     f"kept the widest branch alone")
-        return fit, [widest]
+                     f"kept the loading branch alone")
+        return fit, [branch]
     return joint, runs
 
 
@@ -293,11 +328,10 @@ def _warnings(x, start, fit):
     if not len(fit.breakpoints):
         return []
     need = fit.breakpoints[-1] - fit.x_lo
-    pivots = _turning_points(x[:start + 1], REVERSAL * float(np.ptp(x)))
-    if start == 0 or len(pivots) < 2:
+    fall = next(before for p, _, before in monotone_runs(x) if p == start)
+    if fall == 0.0:
         return [f"no fall recorded before the turning point: assumed it was at least "
                 f"2 max(eta) = {need:.4g}, so that every element starts saturated"]
-    fall = x[pivots[-2]] - x[start]
     if fall < need:
         return [f"x fell by only {fall:.4g} before the turning point, less than 2 max(eta) = "
                 f"{need:.4g}: the largest elements may not be saturated there"]
