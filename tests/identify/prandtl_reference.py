@@ -1,6 +1,6 @@
 """Exact reference simulator for the generalized Prandtl model with linear hardening (test helper).
 
-Model (one degree of freedom, n Saint-Venant elements in parallel with a spring k0 and a dashpot c)::
+Model (one degree of freedom; n Saint-Venant elements in parallel with a spring k0, a dashpot c)::
 
     m x'' + c x' + k0 x + sum_i k_i u_i = F(t),      u_i' + dpsi_[-eta_i, eta_i](u_i) ∋ x'.
 
@@ -50,7 +50,7 @@ def _clamp(value, bound):
 
 
 def _solve_increment(u, k, eta, stiff, rhs):
-    """Root of stiff * d + sum k_i clamp(u_i + d, -eta_i, eta_i) = rhs (piecewise linear, increasing)."""
+    """Root d of stiff * d + sum k_i clamp(u_i + d, -eta_i, eta_i) = rhs (increasing in d)."""
     def g(d):
         return stiff * d + sum(ki * _clamp(ui + d, ei) for ui, ki, ei in zip(u, k, eta))
 

@@ -19,7 +19,7 @@ def _invoke(argv):
 
 
 def test_prandtl_from_csv_with_header(tmp_path, steady_cycle, capsys):
-    """One steady cycle, every 5th sample, columns x,F,v: the printed table holds 1/3 and 1, 2, 3."""
+    """One steady cycle, every 5th sample, columns x,F,v: the table shows k_i = 1/3, eta_i = i."""
     _, x, f, v = steady_cycle
     path = tmp_path / "cycle.csv"
     np.savetxt(path, np.column_stack([x, f, v])[::5], delimiter=",", header="x,F,v",

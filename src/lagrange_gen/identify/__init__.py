@@ -2,9 +2,9 @@
 
 Two identifications, each from one sampled signal:
 
-- :func:`identify_prandtl`: stiffnesses k0, k_i and thresholds eta_i of the generalized Prandtl model
-  with linear hardening, from a loading half-cycle in the (x, F - m x'') plane, whose slope changes
-  sit at 2 eta_j from the turning point (module :mod:`.prandtl`);
+- :func:`identify_prandtl`: stiffnesses k0, k_i and thresholds eta_i of the generalized Prandtl
+  model with linear hardening, from a loading half-cycle (or full cycles) in the (x, F - m x'')
+  plane, whose slope changes sit at 2 eta_j from the turning point (module :mod:`.prandtl`);
 - :func:`identify_damping`: viscous damping from a free decay by the wavelet logarithmic decrement
   (module :mod:`.damping`, needs PyWavelets).
 

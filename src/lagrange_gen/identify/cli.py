@@ -72,7 +72,8 @@ def read_columns(path):
         try:
             values = [float(cell) for cell in row]
         except ValueError:
-            raise IdentificationError(f"{path}: line {number}: non-numeric value in {row}") from None
+            raise IdentificationError(
+                f"{path}: line {number}: non-numeric value in {row}") from None
         if len(values) != width:
             raise IdentificationError(f"{path}: line {number}: {len(values)} columns, "
                                       f"expected {width}")

@@ -101,7 +101,7 @@ def _spectral_period(x, dt):
         # The padded spectrum has 4 bins per cycle over the record: fewer than MIN_PERIODS cycles.
         raise IdentificationError(
             f"no oscillation: the spectrum of x peaks at {i / 4:.1f} cycles over the record, need "
-            f"at least {MIN_PERIODS:g} (a free decay of an under-damped oscillator, or pass period)")
+            f"at least {MIN_PERIODS:g} (a free decay of an under-damped oscillator)")
     a, b, c = np.log(spectrum[i - 1:i + 2] + np.finfo(float).tiny)
     shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
     return n * dt / (i + shift)

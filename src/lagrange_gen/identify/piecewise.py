@@ -207,8 +207,9 @@ def fit_piecewise(x, y, n_segments=None, sigma=None, init=None, max_segments=8, 
     """Best continuous piecewise-linear fit of (x, y), shapes (N,), x sorted.
 
     n_segments: K, or None to choose K in 1..max_segments by BIC (the search stops two K past the
-    best). sigma: noise level of y (None: estimated by noise_level). init: optional callable K -> initial breakpoints (K-1,), replacing
-    the dynamic-programming search. Returns (HingeFit, {K: BIC}).
+    best). sigma: noise level of y (None: estimated by noise_level). init: optional callable
+    K -> initial breakpoints (K-1,) or None, tried before the dynamic-programming search.
+    Returns (HingeFit, {K: BIC}); the fit is None when no K is feasible.
     """
     n = len(x)
     noise = noise_level(x, y) if sigma is None else float(sigma)
@@ -218,8 +219,10 @@ def fit_piecewise(x, y, n_segments=None, sigma=None, init=None, max_segments=8, 
     for k in candidates:
         if best is not None and k > len(best.slopes) + 2:
             break  # BIC rose twice after the best K: more pieces only fit noise, at growing cost
-        start = np.empty(0) if k == 1 else (init(k) if init else dp_breakpoints(x, y, k, min_points))
-        if start is None or len(start) != k - 1:
+        start = np.empty(0) if k == 1 else (init(k) if init else None)
+        if start is None:  # no initializer, or it found too few kinks: global DP search
+            start = dp_breakpoints(x, y, k, min_points)
+        if start is None:  # K pieces of min_points samples do not fit in the data
             continue
         fit = fit_hinges(x, y, start, sigma)
         scores[k] = fit.sse / noise**2 + 2 * k * np.log(n)

@@ -4,11 +4,11 @@ Model (Lamarque's lecture, slides 19-26)::
 
     m x'' + c x' + k0 x + sum_{i=1}^n k_i u_i = F(t),    u_i' + dpsi_[-eta_i, eta_i](u_i) ∋ x'.
 
-Method. In the plane (x, y) with y = F - m x'' - c x' = k0 x + sum k_i u_i, take a loading branch:
-x increasing from a turning point x_turn at which every element is saturated at u_i = -eta_i. Element
-i then follows u_i = -eta_i + (x - x_turn) until it saturates at +eta_i, at x - x_turn = 2 eta_i. With
-eta_1 < ... < eta_n the branch is continuous and piecewise linear with slopes
-p_j = k0 + sum_{l>=j} k_l (decreasing) and breakpoints at x_turn + 2 eta_j. Hence::
+Method. In the plane (x, y) with y = F - m x'' - c x' = k0 x + sum k_i u_i, take a loading
+branch: x increasing from a turning point x_turn at which every element is saturated at
+u_i = -eta_i. Element i then follows u_i = -eta_i + (x - x_turn) until it saturates at +eta_i, at
+x - x_turn = 2 eta_i. With eta_1 < ... < eta_n the branch is continuous and piecewise linear
+with slopes p_j = k0 + sum_{l>=j} k_l (decreasing) and breakpoints at x_turn + 2 eta_j. Hence::
 
     k0 = p_{n+1},   k_j = p_j - p_{j+1},   eta_j = (breakpoint_j - x_turn) / 2.
 
@@ -17,11 +17,21 @@ breakpoints (module piecewise: global dynamic-programming segmentation, then joi
 from the lecture's wavelet localisation of the kinks (module wavelet) refined by the same least
 squares. The number of elements is given, or chosen by the Bayesian information criterion.
 
+Records longer than a half-cycle are cut into monotone runs at the turning points of x. The
+loading branch is the rise that best satisfies the saturation assumption below; every other run
+(falling ones mirrored, by the centre symmetry of the cycle) that starts after an excursion of
+at least 2 max(eta) obeys the same law, so all of them are refitted jointly (shared slopes and
+breakpoints, an offset each), which averages the noise over the recorded cycles. Inside a run,
+samples of minor loops (x retreating less than the turning-point threshold) are dropped: by the
+return-point memory of the play operator the state is back on the branch once x passes its
+previous extreme.
+
 Assumptions: the element thresholds are distinct; the damping c is known (pass it with velocities
-or times; c = 0 by default) and m x'' is already subtracted; the branch starts at a turning point
+or times; c = 0 by default) and m x'' is already subtracted; a branch starts at a turning point
 reached after a monotone excursion of at least 2 max(eta) (true on a steady symmetric cycle that
 unlocks every element), otherwise the elements are not all saturated there and the breakpoints
-move; noise is additive on y. The turning point is the smallest x of the branch.
+move (checked when the record shows the excursion, a warning otherwise); noise is additive on
+y, and x is much less noisy than its advance per sample.
 """
 
 from __future__ import annotations
@@ -47,8 +57,8 @@ class PrandtlFit:
     the yield force); slopes: (n+1,) branch slopes p_j; breakpoints: (n,) abscissae of the kinks
     (x_turn + 2 eta); *_stderr: standard errors of the estimates; noise: noise level of y used;
     rms: residual root mean square; branches: [(start, stop)] index ranges of the runs used, the
-    loading branch first. For a joint fit of several runs, x_turn is 0 and breakpoints are
-    measured from each run's turning point.
+    loading branch first (x_turn and breakpoints refer to it); warnings: checks of the
+    assumptions that could not be confirmed, one sentence each.
     """
 
     k0: float
@@ -151,8 +161,9 @@ def loading_branch(x, reversal=REVERSAL):
     x = np.asarray(x, dtype=float)
     runs = [(p, q, min(x[q] - x[p], e)) for p, q, e in monotone_runs(x, reversal) if x[q] > x[p]]
     if not runs:
-        raise IdentificationError(f"no loading phase: x never increases by more than "
-                                  f"{reversal:.0%} of its range; need x rising from a turning point")
+        raise IdentificationError(
+            f"no loading phase: x never increases by more than {reversal:.0%} of its range; "
+            f"need x rising from a turning point")
     score = np.array([max(s, 0.0) for _, _, s in runs])
     if score.max() == 0.0:  # no rise follows a recorded fall: take the widest rise
         score = np.array([x[q] - x[p] for p, q, _ in runs])
@@ -181,12 +192,12 @@ def identify_prandtl(x, F_minus_mxdd, n_elements=None, noise=None, *, damping=0.
     The loading branch of x (see loading_branch) is identified first; with branches="all" every
     other monotone run (rising, or falling and mirrored) that starts after an excursion of at least
     2 max(eta) is then fitted jointly with it (shared slopes and breakpoints), which averages the
-    noise over all recorded cycles; branches="one" uses the loading branch only. n_elements: number of
-    Saint-Venant elements, or None to choose it (BIC, at most max_elements). noise: standard
-    deviation of the noise on F - m x'' (None: estimated). damping: known viscous coefficient c,
-    subtracted as c x' with x' from velocity (N,) or from times t (N,). method: "pwl"
-    (dynamic-programming segmentation) or "wavelet" (kinks located by the Mexican-hat transform);
-    both end with the same least-squares refinement. Returns a PrandtlFit; raises
+    noise over all recorded cycles; branches="one" uses the loading branch only. n_elements:
+    number of Saint-Venant elements, or None to choose it (BIC, at most max_elements). noise:
+    standard deviation of the noise on F - m x'' (None: estimated). damping: known viscous
+    coefficient c, subtracted as c x' with x' from velocity (N,) or from times t (N,). method:
+    "pwl" (dynamic-programming segmentation) or "wavelet" (kinks located by the Mexican-hat
+    transform); both end with the same least-squares refinement. Returns a PrandtlFit; raises
     IdentificationError when the data do not determine the parameters.
     """
     x, y = _samples(x, F_minus_mxdd)
@@ -204,7 +215,7 @@ def identify_prandtl(x, F_minus_mxdd, n_elements=None, noise=None, *, damping=0.
     runs = [(start, stop)]
     if branches == "all":
         fit, runs = _pool_branches(x, y, fit, runs[0], noise, notes)
-    return _prandtl_fit(fit, runs, method, notes)
+    return _prandtl_fit(fit, runs, method, notes, x[start])
 
 
 def _advancing(x, p, q, notes):
@@ -220,8 +231,9 @@ def _advancing(x, p, q, notes):
     ahead = np.r_[True, run[1:] > np.maximum.accumulate(run)[:-1]]
     dropped = len(run) - int(ahead.sum())
     if dropped > 0.1 * len(run):
-        notes.append(f"x is not monotone on the branch x[{p}:{q + 1}]: kept the {len(run) - dropped} "
-                     f"samples where it advances, dropped {dropped} (minor loops or noise on x)")
+        notes.append(f"x is not monotone on the branch x[{p}:{q + 1}]: kept the "
+                     f"{len(run) - dropped} samples where it advances, dropped {dropped} "
+                     f"(minor loops or noise on x)")
     return np.flatnonzero(ahead) + p
 
 
@@ -237,6 +249,9 @@ def _fit_branch(xb, yb, n_elements, noise, method, max_elements):
     pieces = None if n_elements is None else int(n_elements) + 1
     fit, _ = fit_piecewise(xb, yb, pieces, noise, init, max_segments=max_elements + 1,
                            min_points=MIN_POINTS)
+    if fit is None:  # the samples pile up on too few distinct x for the pieces asked
+        raise IdentificationError(f"too few samples: the loading branch cannot hold {pieces} "
+                                  f"pieces of {MIN_POINTS} samples")
     n_good = _count_kinks(fit)
     if n_elements is None and 0 < n_good < len(fit.breakpoints):
         # BIC kept a kink that fails the significance test: refit with the significant ones only.
@@ -312,11 +327,16 @@ def _count_kinks(fit):
     return int(np.count_nonzero(real & flanked))
 
 
-def _prandtl_fit(fit, runs, method, warnings):
-    """PrandtlFit from a HingeFit whose every kink is a significant slope decrease."""
+def _prandtl_fit(fit, runs, method, warnings, x_turn):
+    """PrandtlFit from a HingeFit whose every kink is a significant slope decrease.
+
+    fit.x_lo is the turning point of the fitted abscissae (0 for a joint fit, whose abscissae are
+    distances from each run's turning point); x_turn is that of the loading branch.
+    """
+    eta = (fit.breakpoints - fit.x_lo) / 2
     return PrandtlFit(
-        k0=float(fit.slopes[-1]), k=-fit.slope_changes, eta=(fit.breakpoints - fit.x_lo) / 2,
-        slopes=fit.slopes, breakpoints=fit.breakpoints, x_turn=fit.x_lo,
+        k0=float(fit.slopes[-1]), k=-fit.slope_changes, eta=eta, slopes=fit.slopes,
+        breakpoints=x_turn + 2 * eta, x_turn=float(x_turn),
         k0_stderr=fit.last_slope_stderr(), k_stderr=fit.change_stderr(),
         eta_stderr=fit.breakpoint_stderr() / 2, noise=fit.sigma,
         rms=float(np.sqrt(fit.sse / fit.n_samples)), n_samples=fit.n_samples,
