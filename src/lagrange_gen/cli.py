@@ -12,7 +12,7 @@ import time
 
 from .errors import LagrangeGenError
 
-SUBCOMMANDS = ("simulate", "bench")
+SUBCOMMANDS = ("simulate", "bench", "identify")
 
 _EPILOG = """\
 examples:
@@ -23,6 +23,7 @@ examples:
   lagrange-gen --methods verlet,midpoint models/double_pendulum.py
   lagrange-gen simulate models/cart_pendulum.py --method midpoint --h 1e-3 --t-end 10
   lagrange-gen bench --help
+  lagrange-gen identify cycle.csv --kind prandtl --elements 3
 
 A model file builds a lagrange_gen.Model from SymPy expressions and assigns it to `model`
 (see models/cart_pendulum.py). The generated module holds numba kernels (dynamics, energy,
@@ -51,7 +52,7 @@ def generate_parser():
     p = argparse.ArgumentParser(
         prog="lagrange-gen",
         description="Derive equations of motion from SymPy model files and write numba kernels "
-                    "into generated/. Subcommands: simulate, bench (lagrange-gen SUBCOMMAND --help).",
+                    "into generated/. Subcommands: simulate, bench, identify (lagrange-gen SUBCOMMAND --help).",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
     p.add_argument("-o", "--out-dir", default="generated", metavar="DIR",
@@ -94,6 +95,8 @@ def _subcommand_parser(name):
     sub = p.add_subparsers(dest="command", required=True)
     if name == "simulate":
         from .cli_simulate import add_parser
+    elif name == "identify":
+        from .identify.cli import add_parser
     else:
         from .bench.cli import add_parser
     add_parser(sub)
@@ -103,6 +106,8 @@ def _subcommand_parser(name):
 def _run_subcommand(args) -> int:
     if args.command == "simulate":
         from .cli_simulate import run
+    elif args.command == "identify":
+        from .identify.cli import run
     else:
         from .bench.cli import run
     return run(args)
