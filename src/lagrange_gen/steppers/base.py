@@ -26,7 +26,10 @@ call and ``kern.MASS_IS_CONSTANT`` a constant; likewise ``run_loop`` receives th
 and calls ``method.step``. Passing the dispatchers themselves as values would make numba embed
 process-specific addresses ("dynamic globals") and refuse to cache the glue. None of the
 functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
-generated module's glue.
+generated module's glue. The thin layers (``run``, ``run_loop`` and the small helpers taking
+``kern``) are ``inline="always"`` (inlined at numba-IR level into the glue): every separately
+compiled layer re-optimizes everything below it, about 0.5 s of compile time per layer, per
+method and per model.
 
 Shapes: n coordinates; q, v, mom (n,); p (n_params,); work (N_WORK, n); mats (N_MAT, n, n);
 piv (n,) int64; extra (n_extra,) per-step method output (empty for unconstrained methods).
@@ -66,7 +69,7 @@ def make_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0):
     return np.array([newton_tol, max_iter, bound, mode], dtype=np.float64)
 
 
-@njit
+@njit(inline="always")
 def explicit_path(kern, settings):
     """True when a partitioned method may skip Newton: the model has constant H and
     velocity-free forces (generated flags) and settings[S_MODE] allows it."""
@@ -125,7 +128,7 @@ def lu_solve(A, piv, b, scratch):
     return True
 
 
-@njit
+@njit(inline="always")
 def velocity_from_momentum(kern, q, mom, p, H, v):
     """v = H(q)^-1 mom (the inverse Legendre transform). Returns OK or SINGULAR_MASS."""
     kern.mass_matrix(q, p, H)
@@ -133,7 +136,7 @@ def velocity_from_momentum(kern, q, mom, p, H, v):
     return OK if mass_solve(H, v) else SINGULAR_MASS
 
 
-@njit
+@njit(inline="always")
 def momentum_from_velocity(kern, q, v, p, H, mom):
     """mom = H(q) v (the Legendre transform)."""
     kern.mass_matrix(q, p, H)
@@ -165,16 +168,17 @@ def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, ex
 
 
 @njit(cache=True)
-def _last(out_last, t, q, v, resid):
+def _last(out_last, t, q, v, iters, resid):
     n = q.shape[0]
     out_last[0] = t
     for i in range(n):
         out_last[1 + i] = q[i]
         out_last[1 + n + i] = v[i]
-    out_last[1 + 2 * n] = resid
+    out_last[1 + 2 * n] = iters
+    out_last[2 + 2 * n] = resid
 
 
-@njit
+@njit(inline="always")
 def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
              out_t, out_q, out_v, out_stats, out_extra, out_last):
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
@@ -183,9 +187,10 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     module.
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
-    (S, N_STATS), out_extra (S, n_extra). out_last (2n + 2,) receives [t, q, v, residual] of the
-    final state, or on failure: the state the failing step started from (Newton failure,
-    singular mass) or the offending state after it (NON_FINITE, UNSTABLE).
+    (S, N_STATS), out_extra (S, n_extra). out_last (2n + 3,) receives [t, q, v, Newton
+    iterations since the last save, Newton residual] of the final state, or on failure: of the
+    state the failing step started from (Newton failure, singular mass) or of the offending state
+    after it (NON_FINITE, UNSTABLE).
     Returns (status, steps_done): steps_done = index of the failing step on failure.
     """
     n = q0.shape[0]
@@ -200,13 +205,14 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     status = check_state(q, v, bound)
     if status == OK:
         status = method.prepare(kern, q, v, mom, t0, p, settings, work, mats, piv)
-    _last(out_last, t0, q, v, 0.0)
+    _last(out_last, t0, q, v, 0.0, 0.0)
     if status != OK:
         return status, 0
     _save(0, t0, q, v, kern.energy(q, v, t0, p), 0.0, 0.0, out_t, out_q, out_v, out_stats,
           extra, out_extra)
     iters_acc = 0.0
     resid_max = 0.0
+    since = 0
     for i in range(n_steps):
         t = t0 + i * h       # not accumulated: no drift of t over millions of steps
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, work, mats,
@@ -214,17 +220,19 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
         iters_acc += iters
         resid_max = max(resid_max, resid)
         if status != OK:
-            _last(out_last, t, q, v, resid)
+            _last(out_last, t, q, v, iters_acc, resid)
             return status, i
         t_new = t0 + (i + 1) * h
         status = check_state(q, v, bound)
         if status != OK:
-            _last(out_last, t_new, q, v, resid)
+            _last(out_last, t_new, q, v, iters_acc, resid)
             return status, i
-        if (i + 1) % save_every == 0:
+        since += 1
+        if since == save_every:
+            since = 0
             _save((i + 1) // save_every, t_new, q, v, kern.energy(q, v, t_new, p), iters_acc,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
             iters_acc = 0.0
             resid_max = 0.0
-    _last(out_last, t0 + n_steps * h, q, v, resid_max)
+    _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max)
     return OK, n_steps

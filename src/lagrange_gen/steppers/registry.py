@@ -22,7 +22,8 @@ Glue signature (identical for every method)::
     out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_extra)
                S = n_steps // save_every + 1; n_extra = 0 for unconstrained methods (room for
                multipliers and constraint residuals of the constrained methods)
-    out_last   (2 n + 2,)        [t, q, v, Newton residual] at the end or at the failure
+    out_last   (2 n + 3,)        [t, q, v, Newton iterations since the last save, Newton
+                                 residual] at the end, or at the failure
     status     lagrange_gen.status code; steps_done = index of the failing step on failure
 """
 

@@ -63,7 +63,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     return OK, 0, 0.0
 
 
-@njit
+@njit(inline="always")
 def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
         out_t, out_q, out_v, out_stats, out_extra, out_last):
     """See base.run_loop."""

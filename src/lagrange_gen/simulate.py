@@ -1,0 +1,290 @@
+"""Python driver: integrate a generated module with a stepper, get a Trajectory.
+
+    from lagrange_gen.simulate import simulate
+    traj = simulate("models/cart_pendulum.py", method="midpoint", q0=[0.1, 0.5], t_end=10, h=1e-3)
+    traj.plot("traj.png"); traj.to_npz("traj.npz")
+
+The integration itself runs inside the generated module's jitted ``run_<method>`` (see
+steppers/registry.py), in chunks of steps so that a progress bar can be shown; this driver only
+checks inputs, allocates outputs and turns status codes into exceptions that name the step, the
+time, the state and (for Newton) the residual.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+import types
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import status as st
+from .errors import BlowUp, NewtonDivergence, SimulationError, SingularMass
+from .params import resolve_params
+from .steppers import registry
+from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, make_settings
+
+__all__ = ["simulate", "Trajectory", "load_module"]
+
+#: Steps per call into the jitted loop (a multiple of save_every is used): large enough that the
+#: Python overhead per chunk (a few microseconds) is negligible, small enough for a progress bar.
+CHUNK_STEPS = 200_000
+
+
+@dataclass
+class Trajectory:
+    """Saved states of one simulation.
+
+    t (S,), q (S, n), v (S, n), energy (S,) E = T + V, newton_iters (S,) Newton iterations summed
+    over the steps since the previous saved row, newton_residual (S,) the largest final Newton
+    residual over those steps. S = n_steps // save_every + 1 (+1 when the final state does not
+    fall on a save).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    energy: np.ndarray
+    newton_iters: np.ndarray
+    newton_residual: np.ndarray
+    method: str
+    h: float
+    model: str
+    params: dict
+    coords: tuple
+    n_steps: int
+    wall_time: float = 0.0
+    extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+
+    @property
+    def energy_error(self) -> np.ndarray:
+        """E - E0 (S,)."""
+        return self.energy - self.energy[0]
+
+    @property
+    def max_energy_error(self) -> float:
+        return float(np.max(np.abs(self.energy_error)))
+
+    def to_npz(self, path):
+        """Write every array and the metadata to a .npz file."""
+        np.savez(path, t=self.t, q=self.q, v=self.v, energy=self.energy,
+                 newton_iters=self.newton_iters, newton_residual=self.newton_residual,
+                 method=self.method, h=self.h, model=self.model, coords=np.array(self.coords),
+                 param_names=np.array(list(self.params)),
+                 param_values=np.array(list(self.params.values()), dtype=float),
+                 n_steps=self.n_steps)
+
+    def to_csv(self, path):
+        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters."""
+        header = ["t", *self.coords, *(f"{c}_dot" for c in self.coords), "energy", "newton_iters"]
+        data = np.column_stack([self.t, self.q, self.v, self.energy, self.newton_iters])
+        np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+
+    def plot(self, path):
+        """PNG (matplotlib Agg): coordinates vs t, and the energy error E - E0 vs t."""
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, (ax_q, ax_e) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+        for i, name in enumerate(self.coords):
+            ax_q.plot(self.t, self.q[:, i], label=name)
+        ax_q.set_ylabel("q")
+        ax_q.legend(loc="upper right")
+        ax_q.set_title(f"{self.model}: {self.method}, h = {self.h:g}")
+        ax_e.plot(self.t, self.energy_error)
+        ax_e.set_ylabel("E - E0")
+        ax_e.set_xlabel("t")
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+
+    def __repr__(self):
+        return (f"Trajectory({self.model}, {self.method}, h={self.h:g}, steps={self.n_steps}, "
+                f"saved={len(self.t)}, t=[{self.t[0]:g}, {self.t[-1]:g}])")
+
+
+def load_module(module_or_path, out_dir="generated"):
+    """A generated module from: the module itself, a generated .py, or a model file (generated
+    into ``out_dir`` first when missing or stale)."""
+    if isinstance(module_or_path, types.ModuleType):
+        return module_or_path
+    from .loader import load
+    return load(Path(module_or_path), out_dir=out_dir)
+
+
+def _vector(name, value, n, coords):
+    if value is None:
+        return np.zeros(n)
+    try:
+        arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise SimulationError(f"{name} must be a sequence of {n} numbers, got {value!r}") from None
+    if arr.shape[0] != n:
+        raise SimulationError(f"{name} has {arr.shape[0]} entries but the model has {n} "
+                              f"coordinates ({', '.join(coords)})")
+    if not np.all(np.isfinite(arr)):
+        raise SimulationError(f"{name} contains a non-finite value: {arr.tolist()}")
+    return np.ascontiguousarray(arr)
+
+
+def _n_steps(t0, t_end, h):
+    """Whole steps to reach t_end; rounded up when (t_end - t0) / h is not an integer."""
+    ratio = (t_end - t0) / h
+    nearest = round(ratio)
+    if abs(ratio - nearest) <= 1e-9 * max(1.0, abs(ratio)):
+        return int(nearest)
+    return int(math.ceil(ratio))
+
+
+def _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter):
+    for name, value in (("h", h), ("t0", t0), ("t_end", t_end), ("newton_tol", newton_tol)):
+        if not isinstance(value, (int, float, np.floating, np.integer)) or not math.isfinite(value):
+            raise SimulationError(f"{name} must be a finite number, got {value!r}")
+    if h <= 0:
+        raise SimulationError(f"step size h must be > 0, got {h}")
+    if t_end < t0:
+        raise SimulationError(f"t_end = {t_end} is before t0 = {t0}")
+    if int(save_every) != save_every or save_every < 1:
+        raise SimulationError(f"save_every must be a positive integer, got {save_every!r}")
+    if newton_tol <= 0:
+        raise SimulationError(f"newton_tol must be > 0, got {newton_tol}")
+    if int(max_iter) != max_iter or max_iter < 1:
+        raise SimulationError(f"max_iter must be a positive integer, got {max_iter!r}")
+
+
+def _runner(module, method):
+    if method not in registry.METHODS:
+        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+    run = getattr(module, f"run_{method}", None)
+    if run is None:
+        have = ", ".join(getattr(module, "METHODS", ())) or "none"
+        model = getattr(module, "MODEL_PATH", None)
+        where = Path(module.__file__).parent / model if model else Path("<model file>")
+        raise SimulationError(
+            f"{module.NAME}: module {module.__file__} was generated without method {method!r} "
+            f"(it has: {have}); run `lagrange-gen --methods "
+            f"{','.join(sorted(set(getattr(module, 'METHODS', ())) | {method}))} {where}`")
+    return run
+
+
+def _format_state(coords, q, v):
+    parts = [f"{c}={x:.6g}" for c, x in zip(coords, q)]
+    parts += [f"{c}_dot={x:.6g}" for c, x in zip(coords, v)]
+    return ", ".join(parts)
+
+
+def _raise_for_status(code, module, method, step, n_steps, last, max_iter, h):
+    """Turn a stepper status into the matching exception (step is 1-based)."""
+    n = module.N_COORDS
+    t, q, v, resid = last[0], last[1:1 + n], last[1 + n:1 + 2 * n], last[2 + 2 * n]
+    state = _format_state(module.COORDS, q, v)
+    where = f"{module.NAME}, {method}: step {step} of {n_steps} (t = {t:.9g}, h = {h:g})"
+    kwargs = dict(step=step, time=float(t), state=np.concatenate([q, v]), residual=float(resid))
+    if code == st.NEWTON_DIVERGED:
+        raise NewtonDivergence(f"{where}: Newton did not converge in {max_iter} iterations "
+                               f"(residual {resid:.3g}) from {state}; reduce h or raise max_iter",
+                               **kwargs)
+    if code == st.SINGULAR_MASS:
+        raise SingularMass(f"{where}: singular mass matrix (or Newton matrix) at {state}", **kwargs)
+    if code == st.NON_FINITE:
+        raise BlowUp(f"{where}: the state became non-finite: {state}", **kwargs)
+    if code == st.UNSTABLE:
+        raise BlowUp(f"{where}: the state grew past the blow-up bound (unstable at this h?): "
+                     f"{state}", **kwargs)
+    raise SimulationError(f"{where}: stepper returned unknown status {code}", **kwargs)
+
+
+def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, params=None,
+             save_every=1, newton_tol=1e-12, max_iter=50, t0=0.0, progress=False,
+             blowup_bound=1e150, newton_always=False, out_dir="generated") -> Trajectory:
+    """Integrate a generated model from t0 to t_end with fixed step h.
+
+    module_or_path: a generated module, the path of a generated .py, or a model file (generated
+        into out_dir when missing or stale).
+    method: one of steppers.registry.METHODS.
+    q0, v0: initial coordinates and velocities (n,), default zeros.
+    params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
+        parameter without default must be given.
+    save_every: keep every save_every-th state (the initial and the final state are always kept).
+    newton_tol, max_iter: Newton stopping test (increment relative to max(1, |unknown|)) and cap.
+    blowup_bound: BlowUp when |q| or |v| exceeds it.
+    newton_always: use the Newton path of symplectic_euler / verlet / composition even when the
+        model allows the explicit one (constant H, velocity-free forces).
+    The final time is t0 + n_steps h with n_steps = (t_end - t0) / h rounded up to a whole step.
+    Raises SimulationError (bad input), NewtonDivergence, SingularMass, BlowUp.
+    """
+    module = load_module(module_or_path, out_dir)
+    run = _runner(module, method)
+    n = module.N_COORDS
+    _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter)
+    q = _vector("q0", q0, n, module.COORDS)
+    v = _vector("v0", v0, n, module.COORDS)
+    p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME)
+    h, t0, save_every, max_iter = float(h), float(t0), int(save_every), int(max_iter)
+    settings = make_settings(newton_tol, max_iter, blowup_bound, 1 if newton_always else 0)
+    n_steps = _n_steps(t0, float(t_end), h)
+    rows = n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
+    out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
+    out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, 0))
+    last = np.empty(2 * n + 3)
+    chunk = max(1, CHUNK_STEPS // save_every) * save_every
+    bar = _ProgressBar(n_steps) if progress else None
+    start = time.perf_counter()
+    done, row = 0, 0
+    while True:
+        k = min(chunk, n_steps - done)
+        saves = k // save_every
+        # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
+        # Newton statistics, which belong to the steps before it.
+        kept = out_stats[row].copy()
+        code, steps = run(q, v, t0 + done * h, h, k, save_every, p, settings,
+                          out_t[row:row + saves + 1], out_q[row:row + saves + 1],
+                          out_v[row:row + saves + 1], out_stats[row:row + saves + 1],
+                          out_extra[row:row + saves + 1], last)
+        if row > 0:
+            out_stats[row, STAT_ITERS:] = kept[STAT_ITERS:]
+        if code != st.OK:
+            _raise_for_status(code, module, method, done + steps + 1, n_steps, last, max_iter, h)
+        q, v = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy()
+        done += k
+        row += saves
+        if bar:
+            bar.update(done)
+        if done >= n_steps:
+            break
+    if n_steps % save_every:
+        row += 1
+        out_t[row], out_q[row], out_v[row] = last[0], q, v
+        out_stats[row] = (module.energy(q, v, last[0], p), last[1 + 2 * n], last[2 + 2 * n])
+    wall = time.perf_counter() - start
+    if bar:
+        bar.close()
+    return Trajectory(t=out_t, q=out_q, v=out_v, energy=out_stats[:, STAT_ENERGY].copy(),
+                      newton_iters=out_stats[:, STAT_ITERS].copy(),
+                      newton_residual=out_stats[:, STAT_RESIDUAL].copy(), method=method, h=h,
+                      model=module.NAME, params=dict(zip(module.PARAMS, p.tolist())),
+                      coords=tuple(module.COORDS), n_steps=n_steps, wall_time=wall)
+
+
+class _ProgressBar:
+    """A one-line text bar on stderr, redrawn only when the percentage changes."""
+
+    def __init__(self, total, width=40, stream=None):
+        self.total, self.width, self.stream = max(total, 1), width, stream or sys.stderr
+        self.shown = -1
+        self.update(0)
+
+    def update(self, done):
+        pct = int(100 * done / self.total)
+        if pct != self.shown:
+            self.shown = pct
+            filled = self.width * pct // 100
+            self.stream.write(f"\r[{'#' * filled}{' ' * (self.width - filled)}] {pct:3d}%")
+            self.stream.flush()
+
+    def close(self):
+        self.stream.write("\n")
+        self.stream.flush()

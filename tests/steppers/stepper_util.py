@@ -1,0 +1,55 @@
+"""Helpers of the stepper tests: call the generated run_<method> glue directly."""
+
+import numpy as np
+
+from lagrange_gen.status import OK
+from lagrange_gen.steppers.base import N_STATS, make_settings
+
+
+def params(mod, **given):
+    """Parameter vector in PARAMS order: defaults overridden by ``given``."""
+    values = dict(zip(mod.PARAMS, mod.DEFAULTS))
+    values.update(given)
+    return np.array([values[name] for name in mod.PARAMS], dtype=np.float64)
+
+
+def run(mod, method, q0, v0, h, n_steps, p, t0=0.0, save_every=1, settings=None):
+    """Integrate with run_<method>; returns (t (S,), q (S, n), v (S, n), stats (S, N_STATS))."""
+    n = mod.N_COORDS
+    rows = n_steps // save_every + 1
+    out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
+    out_stats, out_extra, last = np.empty((rows, N_STATS)), np.empty((rows, 0)), np.empty(2 * n + 3)
+    settings = make_settings() if settings is None else settings
+    status, done = getattr(mod, f"run_{method}")(
+        np.asarray(q0, dtype=np.float64), np.asarray(v0, dtype=np.float64), float(t0), float(h),
+        n_steps, save_every, p, settings, out_t, out_q, out_v, out_stats, out_extra, last)
+    assert status == OK, f"{method}: status {status} at step {done}"
+    return out_t, out_q, out_v, out_stats
+
+
+def one_step(mod, method, q, v, h, p, t0=0.0, settings=None):
+    """(q+, v+) after one step of size h (h may be negative)."""
+    _, qs, vs, _ = run(mod, method, q, v, h, 1, p, t0=t0, settings=settings)
+    return qs[1].copy(), vs[1].copy()
+
+
+def mass_matrix(mod, q, p):
+    H = np.empty((mod.N_COORDS, mod.N_COORDS))
+    mod.mass_matrix(np.asarray(q, dtype=np.float64), p, H)
+    return H
+
+
+def reference_solution(mod, q0, v0, t_end, p, rtol=1e-13, atol=1e-13):
+    """(q, v) at t_end from scipy's DOP853 on the generated forward_dynamics."""
+    from scipy.integrate import solve_ivp
+    n = mod.N_COORDS
+    H, qdd = np.empty((n, n)), np.empty(n)
+
+    def rhs(t, y):
+        assert mod.forward_dynamics(y[:n], y[n:], t, p, H, qdd) == OK
+        return np.concatenate([y[n:], qdd])
+
+    sol = solve_ivp(rhs, (0.0, t_end), np.concatenate([q0, v0]), method="DOP853",
+                    rtol=rtol, atol=atol)
+    assert sol.success
+    return sol.y[:n, -1], sol.y[n:, -1]

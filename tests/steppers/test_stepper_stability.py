@@ -1,0 +1,91 @@
+"""Linear stability measured from the real steppers (HARD_CASES case 3, DESIGN.md section 6).
+
+One step of each method is applied to the basis vectors (q, v) = (1, 0), (0, 1) of the
+oscillator x'' = -omega^2 x; the columns form the step matrix, whose eigenvalues are compared
+with the closed forms at tau = h omega.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from stepper_util import one_step, params
+from lagrange_gen.steppers.base import make_settings
+
+TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)
+OMEGA = 3.0        # not 1, so that h and tau differ and a wrong scaling shows
+
+
+def step_matrix(mod, method, tau, settings=None):
+    p = params(mod, m=1.0, k=OMEGA**2)
+    h = tau / OMEGA
+    cols = [np.concatenate(one_step(mod, method, [q], [v], h, p, settings=settings))
+            for q, v in ((1.0, 0.0), (0.0, 1.0))]
+    return np.column_stack(cols)
+
+
+def spectral_radius(A):
+    return float(np.max(np.abs(np.linalg.eigvals(A))))
+
+
+def verlet_radius(tau):
+    """Closed form: trace 2 - tau^2, determinant 1."""
+    half_trace = 1.0 - tau**2 / 2
+    if abs(half_trace) <= 1.0:
+        return 1.0
+    return abs(half_trace) + math.sqrt(half_trace**2 - 1.0)
+
+
+def rk4_radius(tau):
+    z = 1j * tau
+    return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+
+CLOSED_FORMS = {
+    "explicit_euler": lambda tau: math.sqrt(1 + tau**2),
+    "implicit_euler": lambda tau: 1 / math.sqrt(1 + tau**2),
+    "midpoint": lambda tau: 1.0,
+    "verlet": verlet_radius,
+    "symplectic_euler": verlet_radius,   # same trace and determinant as Verlet
+    "rk4": rk4_radius,
+}
+
+
+@pytest.mark.parametrize("method", sorted(CLOSED_FORMS))
+def test_spectral_radius_matches_closed_form(model, method):
+    mod = model("oscillator")
+    for tau in TAUS:
+        rho = spectral_radius(step_matrix(mod, method, tau))
+        expected = CLOSED_FORMS[method](tau)
+        assert rho == pytest.approx(expected, rel=1e-10, abs=1e-12), (method, tau)
+
+
+def test_verlet_stable_below_two_unstable_above(model):
+    mod = model("oscillator")
+    for tau in TAUS:
+        rho = spectral_radius(step_matrix(mod, "verlet", tau))
+        if tau < 2:
+            assert abs(rho - 1.0) < 1e-10, tau
+        else:
+            assert rho > 1.0 + 1e-3, tau
+
+
+def test_midpoint_phase_is_two_atan_half_tau(model):
+    mod = model("oscillator")
+    for tau in TAUS:
+        eig = np.linalg.eigvals(step_matrix(mod, "midpoint", tau))
+        assert np.max(np.abs(np.abs(eig) - 1.0)) < 1e-10, tau
+        assert np.max(np.abs(np.angle(eig))) == pytest.approx(2 * math.atan(tau / 2), rel=1e-10)
+
+
+@pytest.mark.parametrize("method", ["verlet", "symplectic_euler"])
+def test_newton_path_equals_explicit_path_on_linear_system(model, method):
+    """Constant H and velocity-free forces: the explicit path and the Newton path are the same
+    scheme (the implicit equations are linear), so their step matrices agree."""
+    mod = model("oscillator")
+    assert mod.MASS_IS_CONSTANT and mod.FORCES_VELOCITY_FREE
+    for tau in (0.1, 1.0, 1.9):
+        explicit = step_matrix(mod, method, tau)
+        newton = step_matrix(mod, method, tau, settings=make_settings(mode=1))
+        np.testing.assert_allclose(newton, explicit, rtol=1e-12, atol=1e-14)
