@@ -56,7 +56,8 @@ class Trajectory:
     params: dict
     coords: tuple
     n_steps: int
-    wall_time: float = 0.0
+    wall_time: float = 0.0       # integration only, seconds
+    compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
     extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
 
     @property
@@ -70,6 +71,7 @@ class Trajectory:
 
     def to_npz(self, path):
         """Write every array and the metadata to a .npz file."""
+        _parent(path)
         np.savez(path, t=self.t, q=self.q, v=self.v, energy=self.energy,
                  newton_iters=self.newton_iters, newton_residual=self.newton_residual,
                  method=self.method, h=self.h, model=self.model, coords=np.array(self.coords),
@@ -81,6 +83,7 @@ class Trajectory:
         """Write one row per saved state: t, coordinates, velocities, energy, newton_iters."""
         header = ["t", *self.coords, *(f"{c}_dot" for c in self.coords), "energy", "newton_iters"]
         data = np.column_stack([self.t, self.q, self.v, self.energy, self.newton_iters])
+        _parent(path)
         np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
 
     def plot(self, path):
@@ -98,12 +101,17 @@ class Trajectory:
         ax_e.set_ylabel("E - E0")
         ax_e.set_xlabel("t")
         fig.tight_layout()
+        _parent(path)
         fig.savefig(path, dpi=110)
         plt.close(fig)
 
     def __repr__(self):
         return (f"Trajectory({self.model}, {self.method}, h={self.h:g}, steps={self.n_steps}, "
                 f"saved={len(self.t)}, t=[{self.t[0]:g}, {self.t[-1]:g}])")
+
+
+def _parent(path):
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
 
 
 def load_module(module_or_path, out_dir="generated"):
@@ -231,6 +239,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, 0))
     last = np.empty(2 * n + 3)
     chunk = max(1, CHUNK_STEPS // save_every) * save_every
+    compile_time = _warm_up(run, q, v, t0, h, p, settings, n)
     bar = _ProgressBar(n_steps) if progress else None
     start = time.perf_counter()
     done, row = 0, 0
@@ -255,10 +264,12 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
             bar.update(done)
         if done >= n_steps:
             break
+    # Times as t0 + k h, independent of how the run was chunked (each chunk adds its own i h).
+    out_t[:row + 1] = t0 + h * save_every * np.arange(row + 1)
     if n_steps % save_every:
         row += 1
-        out_t[row], out_q[row], out_v[row] = last[0], q, v
-        out_stats[row] = (module.energy(q, v, last[0], p), last[1 + 2 * n], last[2 + 2 * n])
+        out_t[row], out_q[row], out_v[row] = t0 + n_steps * h, q, v
+        out_stats[row] = (module.energy(q, v, out_t[row], p), last[1 + 2 * n], last[2 + 2 * n])
     wall = time.perf_counter() - start
     if bar:
         bar.close()
@@ -266,7 +277,17 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
                       newton_iters=out_stats[:, STAT_ITERS].copy(),
                       newton_residual=out_stats[:, STAT_RESIDUAL].copy(), method=method, h=h,
                       model=module.NAME, params=dict(zip(module.PARAMS, p.tolist())),
-                      coords=tuple(module.COORDS), n_steps=n_steps, wall_time=wall)
+                      coords=tuple(module.COORDS), n_steps=n_steps, wall_time=wall,
+                      compile_time=compile_time)
+
+
+def _warm_up(run, q, v, t0, h, p, settings, n):
+    """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
+    measured wall time is integration only. Returns the seconds it took."""
+    start = time.perf_counter()
+    run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
+        np.empty((1, N_STATS)), np.empty((1, 0)), np.empty(2 * n + 3))
+    return time.perf_counter() - start
 
 
 class _ProgressBar:

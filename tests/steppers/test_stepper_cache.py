@@ -1,0 +1,44 @@
+"""The run_<method> glue is cached on disk: a second process loads it instead of recompiling
+(DESIGN.md section 5; the reason the glue exists, see steppers/registry.py)."""
+
+import json
+import subprocess
+import sys
+
+from lagrange_gen.codegen import generate_model
+
+from conftest import MODEL_FILES
+
+SCRIPT = """
+import json, sys
+import numpy as np
+from lagrange_gen.loader import import_generated
+from lagrange_gen.steppers.base import N_STATS, make_settings
+mod = import_generated(sys.argv[1])
+out = dict()
+for method in ("rk4", "verlet"):
+    run = getattr(mod, "run_" + method)
+    rows = 11
+    status, done = run(np.array([0.1, 0.5]), np.zeros(2), 0.0, 1e-3, 10, 1, mod.DEFAULT_PARAMS,
+                       make_settings(), np.empty(rows), np.empty((rows, 2)), np.empty((rows, 2)),
+                       np.empty((rows, N_STATS)), np.empty((rows, 0)), np.empty(7))
+    out[method] = dict(status=int(status), hits=sum(run.stats.cache_hits.values()),
+                       misses=sum(run.stats.cache_misses.values()))
+print(json.dumps(out))
+"""
+
+
+def run_in_new_process(path):
+    proc = subprocess.run([sys.executable, "-c", SCRIPT, str(path)], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_second_process_loads_the_glue_from_numba_cache(tmp_path):
+    path = generate_model(MODEL_FILES["cart_pendulum"], tmp_path).path
+    first = run_in_new_process(path)
+    second = run_in_new_process(path)
+    for method in ("rk4", "verlet"):
+        assert first[method] == dict(status=0, hits=0, misses=1), first
+        assert second[method] == dict(status=0, hits=1, misses=0), second
