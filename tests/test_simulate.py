@@ -1,6 +1,7 @@
 """The simulate() driver, its Trajectory and the `lagrange-gen simulate` subcommand."""
 
 import argparse
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,8 +11,8 @@ from lagrange_gen.cli import main
 from lagrange_gen.cli_simulate import add_parser, run as run_cli
 from lagrange_gen.simulate import simulate
 
-from conftest import MODELS_DIR
 
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
 Q0, V0 = [0.1, 0.5], [0.0, 0.2]
 
 

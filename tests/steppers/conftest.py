@@ -1,22 +1,11 @@
 """Fixtures of the stepper tests: each model is generated once per session into a temp dir."""
 
-from pathlib import Path
-
 import pytest
 
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.loader import import_generated
 
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent.parent
-MODEL_FILES = {
-    "oscillator": HERE / "models" / "oscillator.py",
-    "pendulum": HERE / "models" / "pendulum.py",
-    "double_pendulum": HERE / "models" / "double_pendulum.py",
-    "driven_oscillator": HERE / "models" / "driven_oscillator.py",
-    "spherical": HERE / "models" / "spherical.py",
-    "cart_pendulum": ROOT / "models" / "cart_pendulum.py",
-}
+from stepper_util import MODEL_FILES
 
 
 @pytest.fixture(scope="session")

@@ -1,9 +1,21 @@
 """Helpers of the stepper tests: call the generated run_<method> glue directly."""
 
+from pathlib import Path
+
 import numpy as np
 
 from lagrange_gen.status import OK
 from lagrange_gen.steppers.base import N_STATS, make_settings
+
+HERE = Path(__file__).resolve().parent
+MODEL_FILES = {
+    "oscillator": HERE / "models" / "oscillator.py",
+    "pendulum": HERE / "models" / "pendulum.py",
+    "double_pendulum": HERE / "models" / "double_pendulum.py",
+    "driven_oscillator": HERE / "models" / "driven_oscillator.py",
+    "spherical": HERE / "models" / "spherical.py",
+    "cart_pendulum": HERE.parent.parent / "models" / "cart_pendulum.py",
+}
 
 
 def params(mod, **given):

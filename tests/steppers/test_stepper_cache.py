@@ -7,7 +7,7 @@ import sys
 
 from lagrange_gen.codegen import generate_model
 
-from conftest import MODEL_FILES
+from stepper_util import MODEL_FILES
 
 SCRIPT = """
 import json, sys
