@@ -26,10 +26,17 @@ call and ``kern.MASS_IS_CONSTANT`` a constant; likewise ``run_loop`` receives th
 and calls ``method.step``. Passing the dispatchers themselves as values would make numba embed
 process-specific addresses ("dynamic globals") and refuse to cache the glue. None of the
 functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
-generated module's glue. The thin layers (``run``, ``run_loop`` and the small helpers taking
-``kern``) are ``inline="always"`` (inlined at numba-IR level into the glue): every separately
-compiled layer re-optimizes everything below it, about 0.5 s of compile time per layer, per
-method and per model.
+generated module's glue. The two thin layers ``run`` and ``run_loop`` are ``inline="always"``
+(inlined at numba-IR level into the glue): every separately compiled layer re-optimizes
+everything below it, about 0.5 s of compile time per layer, per method and per model.
+
+Speed: everything called once or more per step is compiled with ``_nrt=False`` (numba's switch
+for "no reference counting"; none of these functions allocates). With reference counting on,
+numba increments and decrements an atomic counter for every array argument of every call and
+every array view that its pruning pass cannot prove redundant, which is most of them in
+functions with loops and early returns: on the cart pendulum that was half of the run time of
+the Newton methods (perf: NRT_incref/NRT_decref), and a 2 x 2 LU solve through calls cost 85 ns
+against 29 ns without. Only ``run_loop`` allocates (once per run) and keeps reference counting.
 
 Shapes: n coordinates; q, v, mom (n,); p (n_params,); work (N_WORK, n); mats (N_MAT, n, n);
 piv (n,) int64; extra (n_extra,) per-step method output (empty for unconstrained methods).
@@ -38,8 +45,12 @@ piv (n,) int64; extra (n_extra,) per-step method output (empty for unconstrained
 import numpy as np
 from numba import njit
 
-from ..linalg import cholesky_inplace, cholesky_solve_inplace, lu_inplace, lu_solve_inplace
+from .. import linalg
+
 from ..status import NON_FINITE, OK, SINGULAR_MASS, UNSTABLE
+
+#: numba options of every function on the per-step path (see the module docstring).
+FAST = dict(_nrt=False)
 
 # Layout of the float64 ``settings`` array shared by every method.
 S_TOL = 0          # Newton: converged when max|dx| <= tol * max(1, max|x|)
@@ -69,14 +80,14 @@ def make_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0):
     return np.array([newton_tol, max_iter, bound, mode], dtype=np.float64)
 
 
-@njit(inline="always")
+@njit(**FAST)
 def explicit_path(kern, settings):
     """True when a partitioned method may skip Newton: the model has constant H and
     velocity-free forces (generated flags) and settings[S_MODE] allows it."""
     return kern.MASS_IS_CONSTANT and kern.FORCES_VELOCITY_FREE and settings[S_MODE] == 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def max_abs(x):
     """max |x_i| of a vector (n,); NaN propagates (returns NaN)."""
     m = 0.0
@@ -87,19 +98,19 @@ def max_abs(x):
     return m
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def increment_small(dx, x, tol):
     """Newton stopping test on the increment, relative to the size of the unknown."""
     return max_abs(dx) <= tol * max(1.0, max_abs(x))
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def copy_into(dst, src):
     for i in range(src.shape[0]):
         dst[i] = src[i]
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def matvec(A, x, out):
     """out = A x for A (n, n), x (n,)."""
     n = x.shape[0]
@@ -110,25 +121,44 @@ def matvec(A, x, out):
         out[i] = s
 
 
-@njit(cache=True)
+# Twins of lagrange_gen.linalg without reference counting: the same code and singularity
+# thresholds (compiled from the same Python functions), callable from the FAST functions at the
+# cost of a plain call.
+_cholesky = njit(**FAST)(linalg.cholesky_inplace.py_func)
+_cholesky_solve = njit(**FAST)(linalg.cholesky_solve_inplace.py_func)
+_lu = njit(**FAST)(linalg.lu_inplace.py_func)
+_lu_solve = njit(**FAST)(linalg.lu_solve_inplace.py_func)
+
+
+@njit(**FAST)
 def mass_solve(H, b):
     """Overwrite b (n,) by H^-1 b with H (n, n) SPD, factored in place. False if singular."""
-    if not cholesky_inplace(H):
+    if not _cholesky(H):
         return False
-    cholesky_solve_inplace(H, b)
+    _cholesky_solve(H, b)
     return True
 
 
-@njit(cache=True)
+@njit(**FAST)
 def lu_solve(A, piv, b, scratch):
     """Overwrite b by A^-1 b (general A, factored in place by LU). False if singular."""
-    if not lu_inplace(A, piv):
+    if not _lu(A, piv):
         return False
-    lu_solve_inplace(A, piv, b, scratch)
+    _lu_solve(A, piv, b, scratch)
     return True
 
 
-@njit(inline="always")
+@njit(**FAST)
+def accel(kern, q, v, t, p, H, a):
+    """a = H(q)^-1 rhs(q, v, t) (n,), H (n, n) workspace; OK or SINGULAR_MASS.
+
+    The generated forward_dynamics computes the same; this one runs without reference counting
+    (the cached forward_dynamics pays for it on every call, about 20 ns)."""
+    kern.dynamics(q, v, t, p, H, a)
+    return OK if mass_solve(H, a) else SINGULAR_MASS
+
+
+@njit(**FAST)
 def velocity_from_momentum(kern, q, mom, p, H, v):
     """v = H(q)^-1 mom (the inverse Legendre transform). Returns OK or SINGULAR_MASS."""
     kern.mass_matrix(q, p, H)
@@ -136,14 +166,14 @@ def velocity_from_momentum(kern, q, mom, p, H, v):
     return OK if mass_solve(H, v) else SINGULAR_MASS
 
 
-@njit(inline="always")
+@njit(**FAST)
 def momentum_from_velocity(kern, q, v, p, H, mom):
     """mom = H(q) v (the Legendre transform)."""
     kern.mass_matrix(q, p, H)
     matvec(H, v, mom)
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def check_state(q, v, bound):
     """NON_FINITE if any entry is NaN/inf, UNSTABLE if one exceeds bound, else OK."""
     big = max(max_abs(q), max_abs(v))

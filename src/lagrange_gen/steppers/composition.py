@@ -15,21 +15,21 @@ import sys
 from numba import njit
 
 from ..status import OK
-from .base import W_SAVE_MOM, W_SAVE_Q, W_SAVE_V, copy_into, run_loop
 from . import verlet
+from .base import FAST, W_SAVE_MOM, W_SAVE_Q, W_SAVE_V, copy_into, run_loop
 
 _CBRT2 = 2.0 ** (1.0 / 3.0)
 G1 = 1.0 / (2.0 - _CBRT2)
 G2 = 1.0 - 2.0 * G1
 
 
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """The same per-run state as verlet."""
     return verlet.prepare(kern, q, v, mom, t, p, settings, work, mats, piv)
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual).
 

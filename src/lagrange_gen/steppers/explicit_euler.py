@@ -1,6 +1,6 @@
 """Explicit (forward) Euler: the reference of what not to do.
 
-    q+ = q + h v,   v+ = v + h a(q, v, t),   a = H(q)^-1 (Q - h - g)  (generated forward_dynamics)
+    q+ = q + h v,   v+ = v + h a(q, v, t),   a = H(q)^-1 (Q - h - g)  (dynamics + Cholesky)
 
 Order 1, neither symmetric nor symplectic. On the linear oscillator x'' = -omega^2 x the step
 matrix [[1, h], [-h omega^2, 1]] has eigenvalues 1 +- i tau (tau = h omega), so its spectral
@@ -13,24 +13,24 @@ import sys
 from numba import njit
 
 from ..status import OK
-from .base import run_loop
+from .base import FAST, accel, run_loop
 
 _A = 0     # work row: acceleration
 
 
 # No cache=True on functions that receive kernels: they are compiled (and cached) as part of
 # the generated module's run_<method> glue, see registry.py.
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Nothing is carried between steps."""
     return OK
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     a = work[_A]
-    status = kern.forward_dynamics(q, v, t, p, mats[0], a)
+    status = accel(kern, q, v, t, p, mats[0], a)
     if status != OK:
         return status, 0, 0.0
     for i in range(q.shape[0]):

@@ -18,19 +18,19 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs, run_loop
+from .base import FAST, S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs, run_loop
 
 _V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4           # mats
 
 
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Nothing is carried between steps."""
     return OK
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]

@@ -23,21 +23,21 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import (S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs, momentum_from_velocity,
-                   run_loop, velocity_from_momentum)
+from .base import (FAST, S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs,
+                   momentum_from_velocity, run_loop, velocity_from_momentum)
 
 _VB, _QB, _R, _F, _S, _QN, _VN, _PN = 0, 1, 2, 3, 4, 5, 6, 7    # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4                         # mats
 
 
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Carry the momentum p = H(q) v between steps."""
     momentum_from_velocity(kern, q, v, p, mats[_H], mom)
     return OK
 
 
-@njit
+@njit(**FAST)
 def _solve(kern, q, mom, tm, h, p, tol, max_iter, vb, qb, R, f, scratch, H, A, Jq, Jqd, dHw, piv):
     """Newton on R(vb) = 0; vb (n,) holds the initial guess. Returns (status, iters, residual)."""
     n = q.shape[0]
@@ -68,7 +68,7 @@ def _solve(kern, q, mom, tm, h, p, tol, max_iter, vb, qb, R, f, scratch, H, A, J
     return NEWTON_DIVERGED, max_iter, resid
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]

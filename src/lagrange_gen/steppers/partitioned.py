@@ -20,10 +20,10 @@ Newton uses exact Jacobians: d f/d v from ``momentum_rate_jacobian`` and d(H(q) 
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import increment_small, lu_solve, max_abs
+from .base import FAST, increment_small, lu_solve, max_abs
 
 
-@njit
+@njit(**FAST)
 def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, f, scratch):
     """Solve H(q) u = mom + hk f(q, u, t) for u (n,); u holds the initial guess on entry.
 
@@ -54,7 +54,7 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
     return NEWTON_DIVERGED, max_iter, resid
 
 
-@njit
+@njit(**FAST)
 def solve_drift(kern, q, u, mom, hd, p, tol, max_iter, H, A, dHw, piv, w, R, q_new, scratch):
     """Solve H(q + hd (u + w)) w = mom for w (n,); w holds the initial guess on entry.
 

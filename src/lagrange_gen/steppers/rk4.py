@@ -6,7 +6,7 @@
     a4 = a(q + h v3,   v + h a3,   t + h)             (v4 = v + h a3)
     q+ = q + h/6 (v + 2 v2 + 2 v3 + v4),   v+ = v + h/6 (a1 + 2 a2 + 2 a3 + a4)
 
-with a = H(q)^-1 (Q - h - g) from the generated forward_dynamics. Order 4, explicit (four force
+with a = H(q)^-1 (Q - h - g) (generated dynamics, Cholesky). Order 4, explicit (four force
 evaluations), neither symmetric nor symplectic: energy drifts slowly over long runs. On
 x'' = -omega^2 x the stability polynomial is 1 + z + z^2/2 + z^3/6 + z^4/24 at z = i tau,
 stable for tau <= 2 sqrt(2).
@@ -17,43 +17,43 @@ import sys
 from numba import njit
 
 from ..status import OK
-from .base import run_loop
+from .base import FAST, accel, run_loop
 
 _A1, _A2, _A3, _A4, _QS, _V2, _V3, _V4 = 0, 1, 2, 3, 4, 5, 6, 7     # work rows
 
 
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Nothing is carried between steps."""
     return OK
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     n = q.shape[0]
     a1, a2, a3, a4 = work[_A1], work[_A2], work[_A3], work[_A4]
     qs, v2, v3, v4 = work[_QS], work[_V2], work[_V3], work[_V4]
     H = mats[0]
-    status = kern.forward_dynamics(q, v, t, p, H, a1)
+    status = accel(kern, q, v, t, p, H, a1)
     if status != OK:
         return status, 0, 0.0
     for i in range(n):
         qs[i] = q[i] + 0.5 * h * v[i]
         v2[i] = v[i] + 0.5 * h * a1[i]
-    status = kern.forward_dynamics(qs, v2, t + 0.5 * h, p, H, a2)
+    status = accel(kern, qs, v2, t + 0.5 * h, p, H, a2)
     if status != OK:
         return status, 0, 0.0
     for i in range(n):
         qs[i] = q[i] + 0.5 * h * v2[i]
         v3[i] = v[i] + 0.5 * h * a2[i]
-    status = kern.forward_dynamics(qs, v3, t + 0.5 * h, p, H, a3)
+    status = accel(kern, qs, v3, t + 0.5 * h, p, H, a3)
     if status != OK:
         return status, 0, 0.0
     for i in range(n):
         qs[i] = q[i] + h * v3[i]
         v4[i] = v[i] + h * a3[i]
-    status = kern.forward_dynamics(qs, v4, t + h, p, H, a4)
+    status = accel(kern, qs, v4, t + h, p, H, a4)
     if status != OK:
         return status, 0, 0.0
     c = h / 6.0

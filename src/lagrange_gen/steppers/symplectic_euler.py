@@ -19,15 +19,15 @@ import sys
 from numba import njit
 
 from ..status import OK
-from .base import (S_MAX_ITER, S_TOL, explicit_path, momentum_from_velocity, run_loop,
-                   velocity_from_momentum)
+from .base import (FAST, S_MAX_ITER, S_TOL, accel, explicit_path, momentum_from_velocity,
+                   run_loop, velocity_from_momentum)
 from .partitioned import solve_kick
 
 _U, _R, _F, _S, _QN, _VN, _PN = 0, 1, 2, 3, 4, 5, 6     # work rows
 _H, _A, _JQ, _JQD = 0, 1, 2, 3                          # mats
 
 
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Carry the momentum p = H(q) v between steps (Newton path only)."""
     if not explicit_path(kern, settings):
@@ -35,13 +35,13 @@ def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     return OK
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]
     if explicit_path(kern, settings):
         a = work[_F]
-        status = kern.forward_dynamics(q, v, t, p, mats[_H], a)
+        status = accel(kern, q, v, t, p, mats[_H], a)
         if status != OK:
             return status, 0, 0.0
         for i in range(n):

@@ -26,24 +26,24 @@ import sys
 from numba import njit
 
 from ..status import OK
-from .base import (S_MAX_ITER, S_TOL, W_ACC, explicit_path, momentum_from_velocity, run_loop,
-                   velocity_from_momentum)
+from .base import (FAST, S_MAX_ITER, S_TOL, W_ACC, accel, explicit_path, momentum_from_velocity,
+                   run_loop, velocity_from_momentum)
 from .partitioned import solve_drift, solve_kick
 
 _U, _W, _R, _F, _S, _QN, _VN, _PH = 0, 1, 2, 3, 4, 5, 6, 7    # work rows (W_ACC is kept)
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4                       # mats
 
 
-@njit
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Explicit path: cache a(q, t) in work[W_ACC]. Newton path: carry p = H(q) v."""
     if explicit_path(kern, settings):
-        return kern.forward_dynamics(q, v, t, p, mats[_H], work[W_ACC])
+        return accel(kern, q, v, t, p, mats[_H], work[W_ACC])
     momentum_from_velocity(kern, q, v, p, mats[_H], mom)
     return OK
 
 
-@njit
+@njit(**FAST)
 def _step_explicit(kern, q, v, t, h, p, work, mats):
     n = q.shape[0]
     acc, v_half, q_new, acc_new = work[W_ACC], work[_U], work[_QN], work[_F]
@@ -51,7 +51,7 @@ def _step_explicit(kern, q, v, t, h, p, work, mats):
         v_half[i] = v[i] + 0.5 * h * acc[i]
         q_new[i] = q[i] + h * v_half[i]
     # Forces are velocity-free here, so a(q+) does not depend on the velocity passed.
-    status = kern.forward_dynamics(q_new, v_half, t + h, p, mats[_H], acc_new)
+    status = accel(kern, q_new, v_half, t + h, p, mats[_H], acc_new)
     if status != OK:
         return status
     for i in range(n):
@@ -61,7 +61,7 @@ def _step_explicit(kern, q, v, t, h, p, work, mats):
     return OK
 
 
-@njit
+@njit(**FAST)
 def _step_newton(kern, q, v, mom, t, h, p, settings, work, mats, piv):
     n = q.shape[0]
     tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
@@ -95,7 +95,7 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, work, mats, piv):
     return OK, iters, resid
 
 
-@njit
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
