@@ -217,7 +217,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
         parameter without default must be given.
     save_every: keep every save_every-th state (the initial and the final state are always kept).
-    newton_tol, max_iter: Newton stopping test (increment relative to max(1, |unknown|)) and cap.
+    newton_tol, max_iter: Newton tolerance, relative to max(1, |unknown|) (see
+        steppers.base.newton_converged), and the iteration cap per solve.
     blowup_bound: BlowUp when |q| or |v| exceeds it.
     newton_always: use the Newton path of symplectic_euler / verlet / composition even when the
         model allows the explicit one (constant H, velocity-free forces).

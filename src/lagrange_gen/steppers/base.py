@@ -53,7 +53,7 @@ from ..status import NON_FINITE, OK, SINGULAR_MASS, UNSTABLE
 FAST = dict(_nrt=False)
 
 # Layout of the float64 ``settings`` array shared by every method.
-S_TOL = 0          # Newton: converged when max|dx| <= tol * max(1, max|x|)
+S_TOL = 0          # Newton tolerance, relative to max(1, |unknown|) (see newton_converged)
 S_MAX_ITER = 1     # Newton iteration cap per solve
 S_BOUND = 2        # UNSTABLE when max(|q|, |v|) exceeds this
 S_MODE = 3         # 0: explicit path when the model allows it; 1: always the Newton path
@@ -102,6 +102,26 @@ def max_abs(x):
 def increment_small(dx, x, tol):
     """Newton stopping test on the increment, relative to the size of the unknown."""
     return max_abs(dx) <= tol * max(1.0, max_abs(x))
+
+
+@njit(cache=True, **FAST)
+def newton_converged(dx, x, prev, tol):
+    """Newton stopping test after the update x += dx; returns (converged, max|dx|).
+
+    ``prev`` is max|dx| of the previous iteration (0 on the first). Converged when the increment
+    is small relative to the unknown, max|dx| <= tol max(1, max|x|), or when the observed
+    contraction theta = |dx| / |prev| < 1 bounds the error left in x by theta / (1 - theta) |dx|
+    below that (Hairer-Wanner, Solving ODEs II, sec. IV.8): in the quadratic regime this saves
+    the last iteration, which would only confirm convergence."""
+    size = tol * max(1.0, max_abs(x))
+    d = max_abs(dx)
+    if d <= size:
+        return True, d
+    if prev > 0.0:
+        theta = d / prev
+        if theta < 1.0 and theta / (1.0 - theta) * d <= size:
+            return True, d
+    return False, d
 
 
 @njit(cache=True, **FAST)

@@ -18,7 +18,7 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs, run_loop
+from .base import FAST, S_MAX_ITER, S_TOL, lu_solve, max_abs, newton_converged, run_loop
 
 _V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4           # mats
@@ -40,7 +40,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     t1 = t + h
     for i in range(n):
         v1[i] = v[i]
-    resid = 0.0
+    resid = prev = 0.0
     for it in range(1, max_iter + 1):
         for i in range(n):
             q1[i] = q[i] + h * v1[i]
@@ -61,7 +61,8 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
             return SINGULAR_MASS, it, resid
         for i in range(n):
             v1[i] += R[i]
-        if increment_small(R, v1, tol):
+        done, prev = newton_converged(R, v1, prev, tol)
+        if done:
             for i in range(n):
                 q[i] += h * v1[i]
                 v[i] = v1[i]

@@ -23,8 +23,8 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import (FAST, S_MAX_ITER, S_TOL, increment_small, lu_solve, max_abs,
-                   momentum_from_velocity, run_loop, velocity_from_momentum)
+from .base import (FAST, S_MAX_ITER, S_TOL, lu_solve, max_abs, momentum_from_velocity,
+                   newton_converged, run_loop, velocity_from_momentum)
 
 _VB, _QB, _R, _F, _S, _QN, _VN, _PN = 0, 1, 2, 3, 4, 5, 6, 7    # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4                         # mats
@@ -42,7 +42,7 @@ def _solve(kern, q, mom, tm, h, p, tol, max_iter, vb, qb, R, f, scratch, H, A, J
     """Newton on R(vb) = 0; vb (n,) holds the initial guess. Returns (status, iters, residual)."""
     n = q.shape[0]
     hh = 0.5 * h
-    resid = 0.0
+    resid = prev = 0.0
     for it in range(1, max_iter + 1):
         for i in range(n):
             qb[i] = q[i] + hh * vb[i]
@@ -63,7 +63,8 @@ def _solve(kern, q, mom, tm, h, p, tol, max_iter, vb, qb, R, f, scratch, H, A, J
             return SINGULAR_MASS, it, resid
         for i in range(n):
             vb[i] += R[i]
-        if increment_small(R, vb, tol):
+        done, prev = newton_converged(R, vb, prev, tol)
+        if done:
             return OK, it, resid
     return NEWTON_DIVERGED, max_iter, resid
 

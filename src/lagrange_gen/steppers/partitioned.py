@@ -20,7 +20,7 @@ Newton uses exact Jacobians: d f/d v from ``momentum_rate_jacobian`` and d(H(q) 
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, increment_small, lu_solve, max_abs
+from .base import FAST, lu_solve, max_abs, newton_converged
 
 
 @njit(**FAST)
@@ -32,7 +32,7 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
     """
     n = q.shape[0]
     kern.mass_matrix(q, p, H)
-    resid = 0.0
+    resid = prev = 0.0
     for it in range(1, max_iter + 1):
         kern.momentum_rate(q, u, t, p, f)
         kern.momentum_rate_jacobian(q, u, t, p, Jq, Jqd)
@@ -49,7 +49,8 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
             return SINGULAR_MASS, it, resid
         for i in range(n):
             u[i] += R[i]
-        if increment_small(R, u, tol):
+        done, prev = newton_converged(R, u, prev, tol)
+        if done:
             return OK, it, resid
     return NEWTON_DIVERGED, max_iter, resid
 
@@ -62,7 +63,7 @@ def solve_drift(kern, q, u, mom, hd, p, tol, max_iter, H, A, dHw, piv, w, R, q_n
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
     n = q.shape[0]
-    resid = 0.0
+    resid = prev = 0.0
     for it in range(1, max_iter + 1):
         for i in range(n):
             q_new[i] = q[i] + hd * (u[i] + w[i])
@@ -82,7 +83,8 @@ def solve_drift(kern, q, u, mom, hd, p, tol, max_iter, H, A, dHw, piv, w, R, q_n
             return SINGULAR_MASS, it, resid
         for i in range(n):
             w[i] += R[i]
-        if increment_small(R, w, tol):
+        done, prev = newton_converged(R, w, prev, tol)
+        if done:
             for i in range(n):
                 q_new[i] = q[i] + hd * (u[i] + w[i])
             kern.mass_matrix(q_new, p, H)
