@@ -25,16 +25,20 @@ def add_parser(subparsers):
                     "trajectory (.npz or .csv) and a plot (.png).",
         epilog="methods:\n" + methods, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("model", metavar="MODEL.py", help="model file or generated module")
-    p.add_argument("--method", default="midpoint", choices=METHODS, help="stepper (default: midpoint)")
+    p.add_argument("--method", default="midpoint", choices=METHODS,
+                   help="stepper (default: midpoint)")
     p.add_argument("--h", type=float, required=True, help="step size")
     p.add_argument("--t-end", type=float, required=True, help="final time")
     p.add_argument("--t0", type=float, default=0.0, help="initial time (default 0)")
-    p.add_argument("--q0", type=float, nargs="+", metavar="Q", help="initial coordinates (default 0)")
-    p.add_argument("--v0", type=float, nargs="+", metavar="V", help="initial velocities (default 0)")
+    p.add_argument("--q0", type=float, nargs="+", metavar="Q",
+                   help="initial coordinates (default 0)")
+    p.add_argument("--v0", type=float, nargs="+", metavar="V",
+                   help="initial velocities (default 0)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="parameter value, repeatable (default: the model's defaults)")
     p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
-    p.add_argument("--newton-tol", type=float, default=1e-12, help="Newton tolerance (default 1e-12)")
+    p.add_argument("--newton-tol", type=float, default=1e-12,
+                   help="Newton tolerance (default 1e-12)")
     p.add_argument("--max-iter", type=int, default=50, help="Newton iteration cap (default 50)")
     p.add_argument("--out", metavar="FILE", help="write the trajectory (.npz or .csv)")
     p.add_argument("--plot", metavar="FILE.png", help="plot coordinates and energy error")

@@ -66,10 +66,10 @@ def hand_rk4(q0, v0, h, n, p):
     x, th, xd, thd = q0[0], q0[1], v0[0], v0[1]
     for _ in range(n):
         a0, a1 = _accel(x, th, xd, thd, p)
-        b0, b1 = _accel(x + 0.5 * h * xd, th + 0.5 * h * thd, xd + 0.5 * h * a0, thd + 0.5 * h * a1, p)
         xd2, thd2 = xd + 0.5 * h * a0, thd + 0.5 * h * a1
-        c0, c1 = _accel(x + 0.5 * h * xd2, th + 0.5 * h * thd2, xd + 0.5 * h * b0, thd + 0.5 * h * b1, p)
+        b0, b1 = _accel(x + 0.5 * h * xd, th + 0.5 * h * thd, xd2, thd2, p)
         xd3, thd3 = xd + 0.5 * h * b0, thd + 0.5 * h * b1
+        c0, c1 = _accel(x + 0.5 * h * xd2, th + 0.5 * h * thd2, xd3, thd3, p)
         d0, d1 = _accel(x + h * xd3, th + h * thd3, xd + h * c0, thd + h * c1, p)
         xd4, thd4 = xd + h * c0, thd + h * c1
         x += h / 6 * (xd + 2 * xd2 + 2 * xd3 + xd4)
@@ -184,8 +184,8 @@ def hand_verlet(q0, v0, h, n, p, tol):
     return np.array([x, th, xd, thd])
 
 
-HAND_CLOSED_FORM = {"explicit_euler": hand_explicit_euler, "symplectic_euler": hand_symplectic_euler,
-                    "verlet": hand_verlet, "rk4": hand_rk4}
+HAND_CLOSED_FORM = {"explicit_euler": hand_explicit_euler, "rk4": hand_rk4,
+                    "symplectic_euler": hand_symplectic_euler, "verlet": hand_verlet}
 _NEWTON_HAND = ("symplectic_euler", "verlet")
 
 
@@ -373,7 +373,8 @@ def _markdown(rows, startup, n_steps, name):
         "# Stepper speed", "",
         f"`python -m lagrange_gen.bench.steppers`: {name}, h = {H_STEP:g}, {n_steps} steps from "
         f"q0 = {Q0}, v0 = {V0}; best of several runs, one process, ns per step.", "",
-        "| method | library | Newton it./step | hand, closed form | ratio | hand, generated kernels | ratio |",
+        "| method | library | Newton it./step | hand, closed form | ratio "
+        "| hand, generated kernels | ratio |",
         "|---|---|---|---|---|---|---|",
     ]
     for r in rows:
@@ -383,11 +384,13 @@ def _markdown(rows, startup, n_steps, name):
                      f"{_fmt(kern and r['ours_ns'] / kern, '.2f')} |")
     lines += ["", "Every reference ends in the library's final state to round-off (checked).", "",
               "## New process to its first step (warm numba cache)", "",
-              "| method | total wall | interpreter + numpy/numba imports | generated module import | "
-              "run_<method> load + first step | cold cache total wall |", "|---|---|---|---|---|---|"]
+              "| method | total wall | interpreter + numpy/numba imports "
+              "| generated module import | run_<method> load + first step "
+              "| cold cache total wall |", "|---|---|---|---|---|---|"]
     for method, s in startup.items():
         lines.append(f"| {method} | {s['wall']:.2f} s | {s['imports']:.2f} s | "
-                     f"{s['module_import']:.2f} s | {s['first_step']:.3f} s | {s['cold_wall']:.2f} s |")
+                     f"{s['module_import']:.2f} s | {s['first_step']:.3f} s | "
+                     f"{s['cold_wall']:.2f} s |")
     return "\n".join(lines) + "\n"
 
 

@@ -5,9 +5,9 @@ The cores in ``steppers/<method>.py`` are generic over the kernels: they receive
 module itself as their first argument (``kern``; see base.py for why a module and not the
 dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` lives in the
 generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
-and its compiled code, cores included, is loaded from numba's cache by the next process. The KEY of a
-generated module hashes ``steppers/``, so a change here regenerates the module and thereby
-invalidates that cache.
+and its compiled code, cores included, is loaded from numba's cache by the next process. The
+KEY of a generated module hashes ``steppers/``, so a change here regenerates the module and
+thereby invalidates that cache.
 
 Glue signature (identical for every method)::
 
@@ -50,7 +50,7 @@ class MethodInfo:
 
 
 INFO = {
-    "explicit_euler": MethodInfo(1, False, False, False, "forward Euler (reference of what not to do)"),
+    "explicit_euler": MethodInfo(1, False, False, False, "forward Euler (what not to do)"),
     "symplectic_euler": MethodInfo(1, True, False, True, "symplectic Euler A in (q, p = H v)"),
     "verlet": MethodInfo(2, True, True, True, "velocity Verlet / generalized leapfrog"),
     "midpoint": MethodInfo(2, True, True, True, "midpoint variational integrator (A-stable)"),
