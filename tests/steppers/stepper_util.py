@@ -1,8 +1,20 @@
-"""Helpers of the stepper tests: call the generated run_<method> glue directly."""
+"""Helpers of the stepper tests: generated test models, calls of the run_<method> glue.
 
+There is deliberately no conftest.py in this directory: test modules of other directories import
+names from the top-level conftest, and a second conftest module would shadow it. Test modules
+import the ``model`` fixture from here instead.
+"""
+
+import atexit
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
+import pytest
+
+from lagrange_gen.codegen import generate_model
+from lagrange_gen.loader import import_generated
 
 from lagrange_gen.status import OK
 from lagrange_gen.steppers.base import N_STATS, make_settings
@@ -16,6 +28,27 @@ MODEL_FILES = {
     "spherical": HERE / "models" / "spherical.py",
     "cart_pendulum": HERE.parent.parent / "models" / "cart_pendulum.py",
 }
+
+_GEN_DIR = []
+_MODULES = {}
+
+
+def generated_model(name):
+    """Model name (see MODEL_FILES) -> imported generated module, generated once per process
+    into a temporary directory. Modules carry the glue of every method; numba compiles a
+    run_<method> on its first call only."""
+    if name not in _MODULES:
+        if not _GEN_DIR:
+            _GEN_DIR.append(Path(tempfile.mkdtemp(prefix="lagrange_gen_stepper_models_")))
+            atexit.register(shutil.rmtree, _GEN_DIR[0], True)
+        _MODULES[name] = import_generated(generate_model(MODEL_FILES[name], _GEN_DIR[0]).path)
+    return _MODULES[name]
+
+
+@pytest.fixture(scope="session")
+def model():
+    """The generated_model function (a fixture, so tests read ``model("pendulum")``)."""
+    return generated_model
 
 
 def params(mod, **given):

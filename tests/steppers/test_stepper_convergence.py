@@ -5,7 +5,7 @@ every scheme correctly (through momentum_rate or rhs)."""
 import numpy as np
 import pytest
 
-from stepper_util import params, reference_solution, run
+from stepper_util import model, params, reference_solution, run  # model is a fixture
 from lagrange_gen.steppers.registry import INFO, METHODS
 
 T_END = 1.0

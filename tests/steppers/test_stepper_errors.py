@@ -11,7 +11,7 @@ from lagrange_gen.errors import BlowUp, NewtonDivergence, SimulationError, Singu
 from lagrange_gen.loader import import_generated
 from lagrange_gen.simulate import simulate
 
-from stepper_util import MODEL_FILES
+from stepper_util import MODEL_FILES, model  # model is a fixture
 
 
 def test_newton_divergence_names_the_failing_step(model):

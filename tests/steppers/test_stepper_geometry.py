@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from stepper_util import mass_matrix, one_step, params
+from stepper_util import mass_matrix, model, one_step, params  # model is a fixture
 
 SYMMETRIC = ("verlet", "midpoint", "composition")
 STATE = ([0.7, -0.4], [0.9, 1.3])          # generic state of the two-coordinate models

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.special import ellipj, ellipk
 
-from stepper_util import params, run
+from stepper_util import model, params, run  # model is a fixture
 
 
 def energy_error_tenths(mod, method, q0, v0, h, n_steps):

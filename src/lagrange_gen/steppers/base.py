@@ -46,7 +46,6 @@ import numpy as np
 from numba import njit
 
 from .. import linalg
-
 from ..status import NON_FINITE, OK, SINGULAR_MASS, UNSTABLE
 
 #: numba options of every function on the per-step path (see the module docstring).
@@ -58,7 +57,6 @@ S_MAX_ITER = 1     # Newton iteration cap per solve
 S_BOUND = 2        # UNSTABLE when max(|q|, |v|) exceeds this
 S_MODE = 3         # 0: explicit path when the model allows it; 1: always the Newton path
 N_SETTINGS = 4
-DEFAULT_SETTINGS = (1e-12, 50.0, 1e150, 0.0)
 
 # Columns of ``out_stats`` (n_saves, N_STATS), one row per saved state.
 STAT_ENERGY = 0     # E = T + V at the saved state
