@@ -37,6 +37,19 @@ def verlet_radius(tau):
     return abs(half_trace) + math.sqrt(half_trace**2 - 1.0)
 
 
+def verlet_matrix(tau):
+    """Velocity Verlet on x'' = -x in (x, v) with h = tau (omega = 1)."""
+    return np.array([[1 - tau**2 / 2, tau], [-tau * (1 - tau**2 / 4), 1 - tau**2 / 2]])
+
+
+def composition_radius(tau):
+    """Yoshida's triple jump: the product of three Verlet matrices."""
+    g1 = 1 / (2 - 2 ** (1 / 3))
+    g2 = 1 - 2 * g1
+    outer, inner = verlet_matrix(g1 * tau), verlet_matrix(g2 * tau)
+    return spectral_radius(outer @ inner @ outer)
+
+
 def rk4_radius(tau):
     z = 1j * tau
     return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
@@ -49,6 +62,7 @@ CLOSED_FORMS = {
     "verlet": verlet_radius,
     "symplectic_euler": verlet_radius,   # same trace and determinant as Verlet
     "rk4": rk4_radius,
+    "composition": composition_radius,
 }
 
 
@@ -77,6 +91,15 @@ def test_midpoint_phase_is_two_atan_half_tau(model):
         eig = np.linalg.eigvals(step_matrix(mod, "midpoint", tau))
         assert np.max(np.abs(np.abs(eig) - 1.0)) < 1e-10, tau
         assert np.max(np.abs(np.angle(eig))) == pytest.approx(2 * math.atan(tau / 2), rel=1e-10)
+
+
+def test_composition_stability_interval_is_shorter_than_verlets(model):
+    """Yoshida 4 is stable (rho = 1) only for tau < 1.573: the substeps g1 h, g2 h are longer
+    than h."""
+    mod = model("oscillator")
+    for tau, stable in ((1.0, True), (1.57, True), (1.58, False), (1.9, False)):
+        rho = spectral_radius(step_matrix(mod, "composition", tau))
+        assert (abs(rho - 1.0) < 1e-10) == stable, (tau, rho)
 
 
 @pytest.mark.parametrize("method", ["verlet", "symplectic_euler"])

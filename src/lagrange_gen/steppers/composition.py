@@ -6,8 +6,8 @@ with V the verlet step (velocity Verlet or the generalized leapfrog, see verlet.
 composition of symmetric symplectic maps with symmetric coefficients is symmetric and symplectic;
 the coefficients cancel the h^3 error term, so the order is 4 (Yoshida, Phys. Lett. A 150, 1990;
 Hairer-Lubich-Wanner, GNI, sec. II.4). Cost: three verlet steps per step. The middle substep
-runs backwards in time (g2 ~ -1.70); the substeps are longer than h, so the linear stability
-interval in tau = h omega is shorter than Verlet's.
+runs backwards in time (g2 ~ -1.70); the substeps are longer than h, so on x'' = -omega^2 x the
+step is stable (rho = 1) only for tau = h omega < 1.573, against 2 for Verlet.
 """
 
 import sys
