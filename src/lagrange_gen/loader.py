@@ -70,5 +70,5 @@ def compile_all(module):
     module.constraint_dq(q, w, lam, p, np.empty((m, n)), A)
     module.forward_dynamics(q, qd, 0.0, p, A, v)
     ne = module.N_ELEMENTS
-    module.elements(q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 2)))
+    module.elements(q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 3)))
     module.elements_hessian(q, np.zeros(ne), p, A)

@@ -74,7 +74,7 @@ def make_kernels(dyn) -> list[KernelSpec]:
         KernelSpec("elements", ["q", "p"],
                    [Output("s", dyn.elem_s), Output("G", dyn.elem_grad), Output("coef", dyn.elem_coef)],
                    doc="nonsmooth elements: strains s (ne,), gradients G = ds/dq (ne, n), "
-                       "coef (ne, 2) = (stiffness, threshold) or (friction bound, 0)"),
+                       "coef (ne, 3) = (stiffness, threshold, 0) or (friction bound, 0, 1)"),
         KernelSpec("elements_hessian", ["q", "we", "p"], [Output("out_mat", dyn.elem_hess_w, symmetric=True)],
                    doc="sum_e we[e] d2 s_e/dq2 (n, n) for weights we (ne,)"),
     ]

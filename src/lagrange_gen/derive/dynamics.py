@@ -21,7 +21,7 @@ class Dynamics:
     Phi (m, 1); J (m, n); gamma (m, 1); E scalar. Jacobian matrices are (n, n) unless noted.
     The equations of motion are H qddot + h + g = Q + J^T lambda with Phi(q) = 0, and
     rhs = Q - h - g (smooth forces only: nonsmooth element forces are the steppers' business).
-    Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 2),
+    Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 3),
     elem_hess_w (n, n). ``momentum_rate`` = dT/dq - dV/dq + Q is dp/dt for p = H qdot.
     """
 
