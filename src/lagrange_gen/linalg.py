@@ -1,4 +1,8 @@
-"""Small dense linear algebra in numba, in place, no allocation (used by kernels and steppers)."""
+"""Small dense linear algebra in numba, in place, no allocation (used by kernels and steppers).
+
+Compiled without numba's reference counting (``_nrt=False``): none of these functions allocates,
+and with it every call pays atomic increments per array argument (see steppers/base.py).
+"""
 
 import math
 
@@ -9,7 +13,7 @@ from numba import njit
 SINGULAR_RTOL = 1e-13
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def cholesky_inplace(A):
     """Overwrite the lower triangle of the SPD matrix A (n, n) with its Cholesky factor L.
 
@@ -37,7 +41,7 @@ def cholesky_inplace(A):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def cholesky_solve_inplace(L, b):
     """Solve (L L^T) x = b with L from cholesky_inplace; b (n,) is overwritten by x."""
     n = L.shape[0]
@@ -53,7 +57,7 @@ def cholesky_solve_inplace(L, b):
         b[i] = s / L[i, i]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def lu_inplace(A, piv):
     """LU factorization with partial pivoting of A (n, n) in place; piv (n,) int64 receives the
     row permutation. Returns False when a pivot is zero relative to the largest entry."""
@@ -91,7 +95,7 @@ def lu_inplace(A, piv):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def lu_solve_inplace(LU, piv, b, work):
     """Solve A x = b from lu_inplace's output; b (n,) is overwritten by x, work (n,) is scratch."""
     n = LU.shape[0]

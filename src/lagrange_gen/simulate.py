@@ -59,6 +59,13 @@ class Trajectory:
     wall_time: float = 0.0       # integration only, seconds
     compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
     extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    element_names: tuple = ()
+
+    @property
+    def element_state(self) -> np.ndarray:
+        """(S, ne): per nonsmooth element, u (elastic strain of a Saint-Venant element) or r (the
+        dry-friction force) at each saved state."""
+        return self.extra[:, :len(self.element_names)]
 
     @property
     def energy_error(self) -> np.ndarray:
@@ -77,7 +84,8 @@ class Trajectory:
                  method=self.method, h=self.h, model=self.model, coords=np.array(self.coords),
                  param_names=np.array(list(self.params)),
                  param_values=np.array(list(self.params.values()), dtype=float),
-                 n_steps=self.n_steps)
+                 n_steps=self.n_steps, element_names=np.array(self.element_names, dtype=str),
+                 element_state=self.element_state)
 
     def to_csv(self, path):
         """Write one row per saved state: t, coordinates, velocities, energy, newton_iters."""
@@ -205,9 +213,43 @@ def _raise_for_status(code, module, method, step, n_steps, last, max_iter, h):
     raise SimulationError(f"{where}: stepper returned unknown status {code}", **kwargs)
 
 
+def _element_method(module, method):
+    """The method that actually runs: implicit_euler becomes nonsmooth_euler on a model with
+    nonsmooth elements; a method that cannot treat them is refused, naming them."""
+    names = tuple(getattr(module, "ELEMENTS", ()))
+    if not names or method in registry.NONSMOOTH_METHODS:
+        return method
+    if method == "implicit_euler":
+        return "nonsmooth_euler"
+    raise SimulationError(
+        f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) {', '.join(names)} "
+        f"(no silent regularization); use method='implicit_euler' (exact Saint-Venant return map, "
+        f"Moreau-Jean dry friction)")
+
+
+def _extra_layout(module, method):
+    """(saved, total) columns of out_extra for a method on a module."""
+    if method == "nonsmooth_euler":
+        from .steppers.nonsmooth_euler import extra_size
+        return extra_size(module.N_COORDS, module.N_ELEMENTS)
+    return 0, 0
+
+
+def _element_energy(module, p, state):
+    """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
+    ne, n = module.N_ELEMENTS, module.N_COORDS
+    if not ne:
+        return 0.0
+    s, G, coef = np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))
+    module.elements(np.zeros(n), p, s, G, coef)    # coefficients depend on parameters only
+    k = np.where(coef[:, 2] == 0.0, coef[:, 0], 0.0)
+    return 0.5 * (state**2 * k).sum(axis=1)
+
+
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, params=None,
              save_every=1, newton_tol=1e-12, max_iter=50, t0=0.0, progress=False,
-             blowup_bound=1e150, newton_always=False, out_dir="generated") -> Trajectory:
+             blowup_bound=1e150, newton_always=False, out_dir="generated",
+             element_state0=None) -> Trajectory:
     """Integrate a generated model from t0 to t_end with fixed step h.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -222,10 +264,14 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     blowup_bound: BlowUp when |q| or |v| exceeds it.
     newton_always: use the Newton path of symplectic_euler / verlet / composition even when the
         model allows the explicit one (constant H, velocity-free forces).
+    element_state0: initial states of the nonsmooth elements (ne,), default 0 (virgin material).
+        On models with elements, method implicit_euler runs nonsmooth_euler; the trajectory's
+        energy then includes the elastic energy k u^2 / 2 stored in Saint-Venant elements.
     The final time is t0 + n_steps h with n_steps = (t_end - t0) / h rounded up to a whole step.
     Raises SimulationError (bad input), NewtonDivergence, SingularMass, BlowUp.
     """
     module = load_module(module_or_path, out_dir)
+    method = _element_method(module, method)
     run = _runner(module, method)
     n = module.N_COORDS
     _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter)
@@ -237,8 +283,11 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     n_steps = _n_steps(t0, float(t_end), h)
     rows = n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
     out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
-    out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, 0))
-    last = np.empty(2 * n + 3)
+    n_saved, n_extra = _extra_layout(module, method)
+    out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, n_extra))
+    if n_saved:
+        out_extra[0, :n_saved] = _vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    last = np.empty(2 * n + 3 + n_extra)
     chunk = max(1, CHUNK_STEPS // save_every) * save_every
     compile_time = _warm_up(run, q, v, t0, h, p, settings, n)
     bar = _ProgressBar(n_steps) if progress else None
@@ -271,15 +320,19 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
         row += 1
         out_t[row], out_q[row], out_v[row] = t0 + n_steps * h, q, v
         out_stats[row] = (module.energy(q, v, out_t[row], p), last[1 + 2 * n], last[2 + 2 * n])
+        out_extra[row] = last[3 + 2 * n:]
     wall = time.perf_counter() - start
     if bar:
         bar.close()
-    return Trajectory(t=out_t, q=out_q, v=out_v, energy=out_stats[:, STAT_ENERGY].copy(),
+    elements = out_extra[:, :n_saved].copy()
+    energy = out_stats[:, STAT_ENERGY] + _element_energy(module, p, elements)
+    return Trajectory(t=out_t, q=out_q, v=out_v, energy=energy,
                       newton_iters=out_stats[:, STAT_ITERS].copy(),
                       newton_residual=out_stats[:, STAT_RESIDUAL].copy(), method=method, h=h,
                       model=module.NAME, params=dict(zip(module.PARAMS, p.tolist())),
                       coords=tuple(module.COORDS), n_steps=n_steps, wall_time=wall,
-                      compile_time=compile_time)
+                      compile_time=compile_time, extra=elements,
+                      element_names=tuple(getattr(module, "ELEMENTS", ())) if n_saved else ())
 
 
 def _warm_up(run, q, v, t0, h, p, settings, n):

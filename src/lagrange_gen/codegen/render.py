@@ -39,7 +39,8 @@ def render_kernel(spec: KernelSpec, names: dict) -> str:
                             order="canonical")
     value = dict(zip(live, reduced))
     args = ", ".join(spec.args + [o.name for o in spec.outputs])
-    lines = ["@njit(cache=True)", f"def {spec.name}({args}):", f'    """{spec.doc}."""']
+    # _nrt=False: kernels never allocate, and reference counting costs every call from a stepper.
+    lines = ["@njit(cache=True, _nrt=False)", f"def {spec.name}({args}):", f'    """{spec.doc}."""']
     lines += [f"    {sym} = {printer.doprint(e)}" for sym, e in temps]
     result = "0.0"
     for k, (out, i, j) in enumerate(slots):
@@ -86,7 +87,7 @@ def module_docstring(dyn, source_rel, methods) -> str:
     return "\n".join(lines)
 
 
-_FORWARD = '''@njit(cache=True)
+_FORWARD = '''@njit(cache=True, _nrt=False)
 def forward_dynamics(q, qd, t, p, H, qdd):
     """Solve H(q) qdd = rhs by Cholesky; H (n, n) is workspace, qdd (n,) the output.
     Returns OK, or SINGULAR_MASS when H is not numerically positive definite."""

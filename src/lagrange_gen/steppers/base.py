@@ -139,13 +139,11 @@ def matvec(A, x, out):
         out[i] = s
 
 
-# Twins of lagrange_gen.linalg without reference counting: the same code and singularity
-# thresholds (compiled from the same Python functions), callable from the FAST functions at the
-# cost of a plain call.
-_cholesky = njit(**FAST)(linalg.cholesky_inplace.py_func)
-_cholesky_solve = njit(**FAST)(linalg.cholesky_solve_inplace.py_func)
-_lu = njit(**FAST)(linalg.lu_inplace.py_func)
-_lu_solve = njit(**FAST)(linalg.lu_solve_inplace.py_func)
+# lagrange_gen.linalg is compiled without reference counting too: plain calls.
+_cholesky = linalg.cholesky_inplace
+_cholesky_solve = linalg.cholesky_solve_inplace
+_lu = linalg.lu_inplace
+_lu_solve = linalg.lu_solve_inplace
 
 
 @njit(**FAST)
@@ -216,7 +214,7 @@ def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, ex
 
 
 @njit(cache=True)
-def _last(out_last, t, q, v, iters, resid):
+def _last(out_last, t, q, v, iters, resid, extra):
     n = q.shape[0]
     out_last[0] = t
     for i in range(n):
@@ -224,6 +222,8 @@ def _last(out_last, t, q, v, iters, resid):
         out_last[1 + n + i] = v[i]
     out_last[1 + 2 * n] = iters
     out_last[2 + 2 * n] = resid
+    for k in range(min(extra.shape[0], out_last.shape[0] - 3 - 2 * n)):
+        out_last[3 + 2 * n + k] = extra[k]
 
 
 @njit(inline="always")
@@ -235,8 +235,9 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     module.
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
-    (S, N_STATS), out_extra (S, n_extra). out_last (2n + 3,) receives [t, q, v, Newton
-    iterations since the last save, Newton residual] of the final state, or on failure: of the
+    (S, N_STATS), out_extra (S, n_extra), whose row 0 also holds the initial extra data.
+    out_last (2n + 3 [+ n_extra],) receives [t, q, v, Newton
+    iterations since the last save, Newton residual, extra data] of the final state, or on failure: of the
     state the failing step started from (Newton failure, singular mass) or of the offending state
     after it (NON_FINITE, UNSTABLE).
     Returns (status, steps_done): steps_done = index of the failing step on failure.
@@ -248,12 +249,14 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     work = np.zeros((N_WORK, n))
     mats = np.zeros((N_MAT, n, n))
     piv = np.zeros(n, dtype=np.int64)
-    extra = np.zeros(out_extra.shape[1])
+    # The method's persistent per-run data (element states, multipliers) start from row 0 of
+    # out_extra, so a run continued in chunks carries them over.
+    extra = out_extra[0].copy()
     bound = settings[S_BOUND]
     status = check_state(q, v, bound)
     if status == OK:
         status = method.prepare(kern, q, v, mom, t0, p, settings, work, mats, piv)
-    _last(out_last, t0, q, v, 0.0, 0.0)
+    _last(out_last, t0, q, v, 0.0, 0.0, extra)
     if status != OK:
         return status, 0
     _save(0, t0, q, v, kern.energy(q, v, t0, p), 0.0, 0.0, out_t, out_q, out_v, out_stats,
@@ -268,12 +271,12 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
         iters_acc += iters
         resid_max = max(resid_max, resid)
         if status != OK:
-            _last(out_last, t, q, v, iters_acc, resid)
+            _last(out_last, t, q, v, iters_acc, resid, extra)
             return status, i
         t_new = t0 + (i + 1) * h
         status = check_state(q, v, bound)
         if status != OK:
-            _last(out_last, t_new, q, v, iters_acc, resid)
+            _last(out_last, t_new, q, v, iters_acc, resid, extra)
             return status, i
         since += 1
         if since == save_every:
@@ -282,5 +285,5 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
             iters_acc = 0.0
             resid_max = 0.0
-    _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max)
+    _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max, extra)
     return OK, n_steps

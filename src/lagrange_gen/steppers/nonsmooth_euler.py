@@ -19,7 +19,9 @@ the return map is exact. Newton's tangent is exact for linear strains; for nonli
 friction gradients are frozen within an iteration (a quasi-Newton that converges linearly).
 
 Element data live in ``extra`` (see ``extra_size``): per element its state (u for Saint-Venant,
-the friction force r for dry friction), saved with every output row, then scratch.
+the friction force r for dry friction), saved with every output row, then scratch. Row 0 of
+out_extra holds the initial states (u0 = 0: virgin material, unless the caller sets them).
+With no elements this is exactly ``implicit_euler``.
 """
 
 import sys
@@ -28,7 +30,7 @@ from numba import njit
 
 from ..linalg import lu_inplace, lu_solve_inplace
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import S_MAX_ITER, S_TOL, increment_small, max_abs, run_loop
+from .base import FAST, S_MAX_ITER, S_TOL, increment_small, max_abs, run_loop
 
 _V1, _Q1, _DV, _RHS, _R, _S, _X = 0, 1, 2, 3, 4, 5, 6     # work rows (n,)
 _H, _A, _JQ, _JQD, _DHW, _HW = 0, 1, 2, 3, 4, 5          # mats (n, n)
@@ -59,7 +61,7 @@ def _views(extra, n, ne):
     return state, s0, s1, we, u1, G, coef, Y, W
 
 
-@njit(inline="always")
+@njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     """Nothing is carried in mom; the element state starts at zero (virgin material)."""
     return OK
@@ -145,7 +147,7 @@ def _pgs(h, tol, v1, X, state, G, coef, Y, W):
     return change
 
 
-@njit(inline="always")
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v, element states) at t, in place. Returns (status, iterations, residual)."""
     n, ne = q.shape[0], kern.N_ELEMENTS

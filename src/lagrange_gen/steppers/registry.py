@@ -32,7 +32,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
-           "composition")
+           "composition", "nonsmooth_euler")
+
+#: Methods that treat nonsmooth elements (SaintVenant, DryFriction); simulate() routes
+#: implicit_euler to nonsmooth_euler on models that have elements.
+NONSMOOTH_METHODS = ("nonsmooth_euler",)
 
 GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
              "out_t, out_q, out_v, out_stats, out_extra, out_last")
@@ -57,6 +61,8 @@ INFO = {
     "implicit_euler": MethodInfo(1, False, False, True, "backward Euler (L-stable)"),
     "rk4": MethodInfo(4, False, False, False, "classical Runge-Kutta 4"),
     "composition": MethodInfo(4, True, True, True, "Yoshida 4th-order triple jump of verlet"),
+    "nonsmooth_euler": MethodInfo(1, False, False, True,
+                                  "implicit Euler with Saint-Venant return map and Moreau-Jean friction"),
 }
 
 # _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
