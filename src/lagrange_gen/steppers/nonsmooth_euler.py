@@ -29,6 +29,7 @@ import sys
 from numba import njit
 
 from ..linalg import lu_inplace, lu_solve_inplace
+from ..nonsmooth.play import return_map
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
 from .base import FAST, S_MAX_ITER, S_TOL, increment_small, max_abs, run_loop
 
@@ -83,8 +84,7 @@ def _assemble(kern, q, v, t1, h, p, v1, q1, dv, rhs, R, H, A, Jq, Jqd, dHw, Hw,
         we[e] = 0.0
         if coef[e, 2] == 0.0:                  # Saint-Venant: return map
             k, eta = coef[e, 0], coef[e, 1]
-            trial = state[e] + s1[e] - s0[e]
-            u1[e] = min(max(trial, -eta), eta)
+            u1[e] = return_map(state[e], s1[e] - s0[e], eta)
             we[e] = k * u1[e]
             for i in range(n):
                 rhs[i] -= k * u1[e] * G[e, i]
@@ -185,7 +185,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
             kern.elements(q, p, s1, G, coef)
             for e in range(ne):
                 if coef[e, 2] == 0.0:
-                    state[e] = min(max(state[e] + s1[e] - s0[e], -coef[e, 1]), coef[e, 1])
+                    state[e] = return_map(state[e], s1[e] - s0[e], coef[e, 1])
             return OK, it, resid
     return NEWTON_DIVERGED, max_iter, resid
 
