@@ -5,15 +5,13 @@ import numpy as np
 import pytest
 
 from lagrange_gen.identify import identify_prandtl
+from lagrange_gen.nonsmooth import experiments
 from lagrange_gen.simulate import simulate
 from nonsmooth_util import forcing, ns_model  # noqa: F401  (fixture)
 
 
 def restoring_force(traj, F, m, c):
-    """R_{n+1} = F_{n+1} - m (v_{n+1} - v_n)/h - c v_{n+1} (S-1,): what implicit Euler balances
-    against k0 x + sum k_i u_i."""
-    v = traj.v[:, 0]
-    return F[1:] - m * np.diff(v) / traj.h - c * v[1:]
+    return experiments.restoring_force(traj.t, traj.v[:, 0], traj.h, F, m, c)
 
 
 @pytest.fixture(scope="module")
@@ -34,31 +32,16 @@ def test_discrete_identity_of_implicit_euler(loop):
     assert np.all(np.abs(traj.element_state) <= eta * (1 + 1e-15))
 
 
-def last_loading_branch(traj):
-    """Indices of the last loading half-cycle (from the last minimum of x to the next maximum)."""
-    x = traj.q[:, 0]
-    v = traj.v[:, 0]
-    turns_up = np.where((v[:-1] < 0) & (v[1:] >= 0))[0]
-    start = turns_up[-2] + 1 if len(turns_up) > 1 else turns_up[-1] + 1
-    stop = start + np.argmax(v[start:] < 0)
-    return np.arange(start, stop), x[start]
-
-
 def test_generalized_prandtl_loop_slopes_and_breakpoints(loop):
     """HARD_CASES 10: slopes 4/3, 1, 2/3, 1/3 (to 1e-9); breakpoints at 2, 4, 6 from the turn."""
     mod, traj = loop
     m, c, f, omega = (traj.params[k] for k in ("m", "c", "f", "omega"))
     R = np.concatenate([[np.nan], restoring_force(traj, forcing(traj, f, omega), m, c)])
-    idx, x_turn = last_loading_branch(traj)
+    idx, x_turn = experiments.last_loading_branch(traj.q[:, 0], traj.v[:, 0])
     x, r = traj.q[idx, 0] - x_turn, R[idx]
     assert x.max() > 6.5, "the cycle must reach the last breakpoint"
-    lines = []
-    for lo, hi, slope in [(0.2, 1.8, 4 / 3), (2.2, 3.8, 1.0), (4.2, 5.8, 2 / 3), (6.2, x.max() - 0.1, 1 / 3)]:
-        sel = (x > lo) & (x < hi)
-        a, b = np.polyfit(x[sel], r[sel], 1)
-        assert a == pytest.approx(slope, abs=1e-9)
-        lines.append((a, b))
-    breaks = [(b2 - b1) / (a1 - a2) for (a1, b1), (a2, b2) in zip(lines, lines[1:])]
+    slopes, breaks = experiments.branch_slopes(x, r, [(0.2, 1.8), (2.2, 3.8), (4.2, 5.8), (6.2, x.max() - 0.1)])
+    np.testing.assert_allclose(slopes, [4 / 3, 1.0, 2 / 3, 1 / 3], atol=1e-9, rtol=0)
     np.testing.assert_allclose(breaks, [2.0, 4.0, 6.0], atol=5e-3)
 
 
