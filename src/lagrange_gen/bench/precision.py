@@ -1,0 +1,370 @@
+"""`lagrange-gen bench precision`: work-precision diagrams, our steppers against the peers.
+
+For each model of the suite and each stepper, h = h0 / 2^k (k = 0, 1, ...) until the final error
+reaches round-off, the run gets too long, or k_max; for each peer a sweep of tolerances. Every
+run is compared with a DOP853 reference at rtol 1e-13 that a second solver has confirmed
+(bench.reference). Errors (max norm over q and v): the final state, the maximum over S sample
+times, max |E - E0| over the samples and, for constrained models, max |Phi|. Time: integration
+wall time, minimum over repeats, after a warm-up (simulate compiles or loads the glue before its
+clock starts; the peers' right-hand sides are called once before timing).
+
+Failed runs (blow-up, Newton divergence, solver failure) stay in the table and are drawn as
+crosses at the top of the figure.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from . import common, peers
+from . import reference as ref
+
+TARGET = 1e-8          # the headline's final-state error
+
+
+@dataclass(frozen=True)
+class Case:
+    """One model of the suite: initial state, end time, n0 steps at k = 0 (h0 = t_end / n0) and
+    the number of sample times S (a divisor of n0)."""
+
+    stem: str
+    q0: tuple
+    v0: tuple
+    t_end: float
+    n0: int
+    samples: int
+    constrained: bool = False
+    note: str = ""
+
+
+def _fpu_start(omega=50.0):
+    """HARD_CASES case 5: q1 = (1 - 1/omega)/sqrt 2, q2 = (1 + 1/omega)/sqrt 2, p2 = sqrt 2."""
+    r = math.sqrt(2.0)
+    return ((1 - 1 / omega) / r, (1 + 1 / omega) / r, 0, 0, 0, 0), (0, r, 0, 0, 0, 0)
+
+
+CASES = (
+    Case("cart_pendulum", (0.1, 0.5), (0.0, 0.0), 10.0, 100, 100),
+    Case("double_pendulum", (0.5, 1.0), (0.0, 0.0), 10.0, 200, 100),
+    Case("fpu", *_fpu_start(), 5.0, 250, 50, note="h0 omega = 1"),
+    Case("cartesian_pendulum", (math.sin(0.5), -math.cos(0.5)), (0.0, 0.0), 10.0, 100, 100,
+         constrained=True),
+)
+
+
+@dataclass(frozen=True)
+class Settings:
+    k_max: int
+    repeats: int
+    budget: float                 # stop a method's sweep after a run slower than this (s)
+    dop_rtols: tuple
+    radau_rtols: tuple
+    second: str                   # second reference solver: "Radau" or "LSODA"
+    floor: float = 1e-12          # stop refining once the final error is below this
+    cases: tuple = field(default=CASES)
+
+
+FULL = Settings(k_max=12, repeats=3, budget=2.0, second="Radau",
+                dop_rtols=tuple(10.0 ** -k for k in range(3, 14)),
+                radau_rtols=tuple(10.0 ** -k for k in range(3, 11)))
+QUICK = Settings(k_max=6, repeats=2, budget=0.2, second="LSODA",
+                 dop_rtols=(1e-4, 1e-7, 1e-10), radau_rtols=(1e-4, 1e-7))
+
+
+@dataclass
+class Point:
+    """One run: ``param`` is h (ours) or rtol (peers); errors are max norms (NaN if failed)."""
+
+    method: str
+    kind: str                     # "ours" or "peer"
+    param: float
+    wall: float
+    final: float = math.nan
+    traj_max: float = math.nan
+    energy: float = math.nan
+    phi: float = math.nan
+    failed: str = ""
+
+
+def _errors(point, mod, p, reference, t_grid, y_grid, y_end):
+    """Fill the error fields of ``point`` from states y_grid (2n, S) at t_grid and y_end (2n,)."""
+    n = mod.N_COORDS
+    exact = reference.y_at(t_grid)
+    point.final = float(np.max(np.abs(y_end - reference.y_end)))
+    point.traj_max = float(np.max(np.abs(y_grid - exact)))
+    e = np.array([mod.energy(np.ascontiguousarray(y[:n]), np.ascontiguousarray(y[n:]), t, p)
+                  for t, y in zip(t_grid, y_grid.T)])
+    point.energy = float(np.max(np.abs(e - e[0])))
+    if mod.N_CONSTRAINTS:
+        point.phi = float(np.max(ref.constraint_residual(mod, p, y_grid[:n].T)))
+    return point
+
+
+def sweep_ours(mod, method, case, p, reference, settings, progress):
+    """h = h0 / 2^k for k = 0..k_max; stops once the final error is below settings.floor or a
+    run takes longer than settings.budget. Returns [Point]."""
+    points, t_grid = [], np.linspace(0.0, case.t_end, case.samples + 1)
+    q0, v0 = np.array(case.q0, float), np.array(case.v0, float)
+    for k in range(settings.k_max + 1):
+        n_steps = case.n0 * 2**k
+        h = case.t_end / n_steps
+        run = common.guarded_run(mod, method, q0, v0, h, case.t_end, p,
+                                 save_every=n_steps // case.samples, repeats=settings.repeats)
+        progress.step(f"{case.stem} {method} h={h:.2g}")
+        if not run.ok:
+            points.append(Point(method, "ours", h, run.wall, failed=run.error))
+            continue
+        tr = run.traj
+        y_grid = np.vstack((tr.q.T, tr.v.T))
+        points.append(_errors(Point(method, "ours", h, run.wall), mod, p, reference, t_grid,
+                              y_grid, y_grid[:, -1]))
+        if points[-1].final < settings.floor or run.wall > settings.budget:
+            break
+    return points
+
+
+def sweep_peer(name, f, jac, method, rtols, mod, case, p, reference, settings, progress):
+    """One solve_ivp method over rtols on the right-hand side f; stops after a run slower than
+    the budget. Returns [Point]."""
+    t_grid = np.linspace(0.0, case.t_end, case.samples + 1)
+    y0 = np.concatenate((case.q0, case.v0)).astype(float)
+    f(0.0, y0)                                  # warm-up: numba specialization, lambdify
+    points = []
+    for rtol in rtols:
+        wall, y_grid, y_end, _, msg = peers.solver_run(f, y0, case.t_end, t_grid, method, rtol,
+                                                       jac=jac, repeats=settings.repeats)
+        progress.step(f"{case.stem} {name} rtol={rtol:.0e}")
+        if y_grid is None:
+            points.append(Point(name, "peer", rtol, wall, failed=str(msg)))
+            continue
+        points.append(_errors(Point(name, "peer", rtol, wall), mod, p, reference, t_grid,
+                              y_grid, y_end))
+        if wall > settings.budget:
+            break
+    return points
+
+
+def time_at(points, target=TARGET, key="final"):
+    """Wall time at which a method's error (``key``) reaches ``target``, by log-log
+    interpolation between the two runs that bracket it (points in sweep order: coarse to fine).
+    None when no successful pair of consecutive runs brackets the target."""
+    ok = [pt for pt in points if not pt.failed and getattr(pt, key) > 0]
+    for a, b in zip(ok, ok[1:]):
+        ea, eb = getattr(a, key), getattr(b, key)
+        if ea >= target >= eb and ea > eb:
+            w = (math.log(ea) - math.log(target)) / (math.log(ea) - math.log(eb))
+            return math.exp((1 - w) * math.log(a.wall) + w * math.log(b.wall))
+    first = ok[0] if ok else None
+    if first is not None and getattr(first, key) <= target:
+        return first.wall          # already below target at the coarsest setting: an upper bound
+    return None
+
+
+def _peer_list(mod, case, p, model_file, settings):
+    """[(name, f, jac, scipy method, rtols)] for a case; the sympy.mechanics and PyDy peers only
+    for conservative unconstrained models (they derive their own equations)."""
+    dop, radau = settings.dop_rtols, settings.radau_rtols
+    if case.constrained:
+        return [("scipy DOP853 (index-1 KKT)", ref.kkt_rhs(mod, p), None, "DOP853", dop)]
+    f = ref.ode_rhs(mod, p)
+    out = [("scipy DOP853", f, None, "DOP853", dop),
+           ("scipy Radau + Jacobian", f, ref.ode_jacobian(mod, p), "Radau", radau)]
+    try:
+        fm, _ = peers.mechanics_rhs(model_file, mod.PARAMS, p)
+        out.append(("sympy.mechanics + DOP853", fm, None, "DOP853", dop))
+        pydy = peers.pydy_rhs(model_file, mod.PARAMS, p)
+        if pydy is not None:
+            out.append((f"PyDy ({pydy[2]}) + DOP853", pydy[0], None, "DOP853", dop))
+    except ValueError:
+        pass
+    return out
+
+
+def _reference(mod, case, p, settings):
+    t_check = np.linspace(0.0, case.t_end, case.samples + 1)
+    q0, v0 = np.array(case.q0, float), np.array(case.v0, float)
+    if case.constrained:
+        return ref.pendulum_angle_reference(mod, p, q0, v0, case.t_end, t_check)
+    return ref.ode_reference(mod, p, q0, v0, case.t_end, t_check, second=settings.second)
+
+
+def run_case(case, models_dir, gen_dir, settings, methods=None, progress=None):
+    """All runs of one case -> dict(case, reference, points, methods, missing)."""
+    progress = progress or common.Progress(1, "", enabled=False)
+    mod = common.load_module(models_dir, case.stem, gen_dir)
+    p = common.params_of(mod)
+    reference = _reference(mod, case, p, settings)
+    wanted = common.constrained_methods() if case.constrained else common.unconstrained_methods()
+    wanted = [m for m in wanted if methods is None or m in methods]
+    points = []
+    for method in wanted:
+        points += sweep_ours(mod, method, case, p, reference, settings, progress)
+    for name, f, jac, solver, rtols in _peer_list(mod, case, p,
+                                                  Path(models_dir) / f"{case.stem}.py", settings):
+        points += sweep_peer(name, f, jac, solver, rtols, mod, case, p, reference, settings,
+                             progress)
+    missing = common.NOT_AVAILABLE if case.constrained and not wanted else ""
+    return {"case": case, "reference": reference, "points": points, "methods": wanted,
+            "missing": missing, "model": mod.NAME}
+
+
+def _by_method(points):
+    groups = {}
+    for pt in points:
+        groups.setdefault(pt.method, []).append(pt)
+    return groups
+
+
+def _panel(ax, points, key, label):
+    """log error (key) vs log wall time, one curve per method; failed runs as crosses on a
+    'failed' line above the largest finite error."""
+    finite = [getattr(pt, key) for pt in points if not pt.failed and getattr(pt, key) > 0]
+    if not finite:
+        ax.set_visible(False)
+        return
+    ceiling = 10 * max(max(finite), 1e-16)
+    floor = min(finite)
+    for i, (method, pts) in enumerate(_by_method(points).items()):
+        ours = pts[0].kind == "ours"
+        good = [pt for pt in pts if not pt.failed and getattr(pt, key) > 0]
+        style = dict(color=f"C{i % 10}", marker="o" if ours else "s", ms=4,
+                     ls="-" if ours else "--")
+        if good:
+            ax.loglog([pt.wall for pt in good], [getattr(pt, key) for pt in good], label=method,
+                      **style)
+        bad = [pt for pt in pts if pt.failed]
+        if bad:
+            ax.loglog([max(pt.wall, 1e-6) for pt in bad], [ceiling] * len(bad), ls="none",
+                      marker="x", ms=7, color=style["color"],
+                      label=None if good else f"{method} (all failed)")
+    ax.axhline(ceiling, color="0.6", lw=0.5)
+    ax.text(0.01, ceiling, " failed", transform=ax.get_yaxis_transform(), va="bottom",
+            fontsize=7, color="0.4")
+    ax.set_ylim(floor / 3, ceiling * 5)
+    ax.set_xlabel("wall time [s] (integration only, min of repeats)")
+    ax.set_ylabel(label)
+    ax.grid(True, which="major", alpha=0.3)
+
+
+def figure(result, path):
+    """PNG: final-state error and max |E - E0| (max |Phi| for constrained models) vs time."""
+    fig, (a, b) = common.new_figure(1, 2, figsize=(13, 5.2))
+    _panel(a, result["points"], "final", "final-state error (max norm)")
+    if result["case"].constrained:
+        _panel(b, result["points"], "phi", "max |Phi| over the samples")
+    else:
+        _panel(b, result["points"], "energy", "max |E - E0| over the samples")
+    case = result["case"]
+    fig.suptitle(f"{result['model']}: work-precision to T = {case.t_end:g} "
+                 f"(h = {case.t_end / case.n0:g} / 2^k; peers over rtol)")
+    handles, labels = a.get_legend_handles_labels()
+    if handles:
+        b.legend(handles, labels, fontsize=7, loc="best")
+    return common.save_figure(fig, path)
+
+
+def _ms(x):
+    return "-" if x is None else f"{x * 1e3:.3g} ms"
+
+
+def summary_rows(result, targets=(1e-4, 1e-6, TARGET)):
+    """Per method: kind, interpolated times at the targets, smallest final error, failures."""
+    rows = []
+    for method, pts in _by_method(result["points"]).items():
+        good = [pt.final for pt in pts if not pt.failed]
+        rows.append([method, pts[0].kind, *(_ms(time_at(pts, t)) for t in targets),
+                     common.fmt(min(good)) if good else "-",
+                     f"{sum(1 for pt in pts if pt.failed)} / {len(pts)}"])
+    return rows
+
+
+def headline(result, target=TARGET):
+    """Best of ours at final error ``target`` against every peer: dict with 'best' (method,
+    seconds) and 'peers' {name: seconds or None}."""
+    times = {m: time_at(pts, target) for m, pts in _by_method(result["points"]).items()}
+    kinds = {pt.method: pt.kind for pt in result["points"]}
+    ours = {m: t for m, t in times.items() if kinds[m] == "ours" and t is not None}
+    best = min(ours.items(), key=lambda kv: kv[1]) if ours else (None, None)
+    return {"best": best, "peers": {m: t for m, t in times.items() if kinds[m] == "peer"},
+            "target": target}
+
+
+def _full_table(points):
+    rows = [[pt.method, f"{pt.param:.3g}", _ms(pt.wall), common.fmt(pt.final),
+             common.fmt(pt.traj_max), common.fmt(pt.energy), common.fmt(pt.phi),
+             pt.failed[:90] or "ok"] for pt in points]
+    return common.md_table(["method", "h or rtol", "wall", "final error", "max error",
+                            "max abs(E - E0)", "max abs(Phi)", "status"], rows)
+
+
+def case_markdown(result, figure_name):
+    case, refr = result["case"], result["reference"]
+    lines = [f"## {result['model']}", "",
+             f"q0 = {tuple(round(x, 6) for x in case.q0)}, v0 = {tuple(case.v0)}, "
+             f"T = {case.t_end:g}, h = {case.t_end / case.n0:g} / 2^k {case.note}; "
+             f"errors at {case.samples + 1} sample times. Reference: DOP853 at rtol 1e-13; "
+             f"second solver ({refr.second}) agrees to {refr.agreement:.1e}.", ""]
+    if result["missing"]:
+        lines += [f"Constrained steppers: **{result['missing']}** (only the peers ran).", ""]
+    lines += common.md_table(["method", "kind", "time to final error 1e-4", "1e-6", "1e-8",
+                              "smallest final error", "failed runs"], summary_rows(result))
+    lines += ["", f"![{result['model']}]({figure_name})", "", "<details><summary>every run"
+              "</summary>", "", *_full_table(result["points"]), "", "</details>", ""]
+    return lines
+
+
+def headline_lines(result):
+    """Markdown lines: the best of ours at final error 1e-8 against each peer, with ratios."""
+    hl = headline(result)
+    method, best = hl["best"]
+    if best is None:
+        return [f"No stepper reached final error {hl['target']:g} on {result['model']}."]
+    rows = [[f"**{method}** (ours, best)", _ms(best), "1"]]
+    for name, t in hl["peers"].items():
+        rows.append([name, _ms(t), "-" if t is None else f"{t / best:.0f}x slower"])
+    if not any(name.startswith("PyDy") for name in hl["peers"]):
+        rows.append(["PyDy + DOP853", "pydy not installed", "-"])
+    return [f"{result['model']} to T = {result['case'].t_end:g}, wall time to reach final-state "
+            f"error {hl['target']:g} (interpolated on the work-precision curves below):", "",
+            *common.md_table(["method", "time", "ratio"], rows), ""]
+
+
+def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports", quick=False,
+                  methods=None, cases=None, progress=True):
+    """Run the suite, write reports_dir/precision.md and precision_<model>.png; returns
+    {"results": [case result], "report": path}."""
+    settings = QUICK if quick else FULL
+    cases = [c for c in settings.cases if cases is None or c.stem in cases]
+    n_methods = len(common.registry.METHODS) + 4
+    bar = common.Progress(sum(n_methods * (settings.k_max + 1) for _ in cases), "precision",
+                          enabled=progress)
+    results, lines = [], _intro(settings, quick)
+    for case in cases:
+        if not common.model_available(models_dir, case.stem):
+            lines += [f"## {case.stem}", "", f"Model file missing: {common.NOT_AVAILABLE}.", ""]
+            continue
+        result = run_case(case, models_dir, gen_dir, settings, methods, bar)
+        results.append(result)
+        name = f"precision_{case.stem}.png"
+        figure(result, Path(reports_dir) / name)
+        if case.stem == "cart_pendulum":
+            lines += ["## Headline", "", *headline_lines(result)]
+        lines += case_markdown(result, name)
+    bar.finish()
+    path = common.write_report(Path(reports_dir) / "precision.md", lines)
+    return {"results": results, "report": path}
+
+
+def _intro(settings, quick):
+    return ["# Work-precision", "",
+            f"`lagrange-gen bench precision{' --quick' if quick else ''}`. Ours: every stepper "
+            f"through `simulate` at h = h0 / 2^k, k <= {settings.k_max}; peers: scipy solve_ivp "
+            f"on our generated right-hand side (DOP853; Radau with the generated Jacobian), and "
+            f"sympy.physics.mechanics LagrangesMethod lambdified + DOP853 on the model's own "
+            f"L = T - V. Wall time: integration only, min of {settings.repeats} repeats after a "
+            f"warm-up, all in one process on a shared 2-core machine (compare ratios, not "
+            f"absolute times). Failed runs are listed and drawn as crosses.", ""]

@@ -1,0 +1,143 @@
+"""Right-hand sides and reference solutions for scipy's solve_ivp, built on a generated module.
+
+The first-order state is y = (q, v) (2n,). ``ode_rhs`` is y' = (v, H^-1 rhs) through the generated
+forward_dynamics; ``ode_jacobian`` is its exact Jacobian from the generated rhs_jacobian and
+mass_matvec_dq (what Radau and BDF need to be fair); ``kkt_rhs`` is the acceleration-level
+(index-1) form of a constrained model, [[H, J^T], [J, 0]] (qdd, -lam) = (rhs, gamma), which is
+what a user of solve_ivp integrates and which drifts off Phi = 0.
+
+A reference is DOP853 at rtol = atol = 1e-13 and is only trusted after a second, different solver
+agrees with it (``check_reference``): Radau with the exact Jacobian, or for the Cartesian
+pendulum the same motion integrated in one angle.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..status import OK
+
+REF_TOL = 1e-13
+
+
+def ode_rhs(mod, p):
+    """f(t, y) -> y' (2n,) for solve_ivp; raises when H(q) is singular (never returns NaN)."""
+    n = mod.N_COORDS
+    H, qdd = np.empty((n, n)), np.empty(n)
+
+    def f(t, y):
+        if mod.forward_dynamics(y[:n], y[n:], t, p, H, qdd) != OK:
+            raise FloatingPointError(f"{mod.NAME}: singular mass matrix at q = {y[:n]}")
+        return np.concatenate((y[n:], qdd))
+    return f
+
+
+def ode_jacobian(mod, p):
+    """J(t, y) (2n, 2n) of ode_rhs: with H qdd = rhs(q, v),
+    d qdd/dq = H^-1 (d rhs/dq - d(H w)/dq |_{w = qdd}) and d qdd/dv = H^-1 d rhs/dv."""
+    n = mod.N_COORDS
+    H, qdd = np.empty((n, n)), np.empty(n)
+    Jq, Jv, dHw = np.empty((n, n)), np.empty((n, n)), np.empty((n, n))
+
+    def jac(t, y):
+        q, v = y[:n], y[n:]
+        mod.dynamics(q, v, t, p, H, qdd)
+        Hm = H.copy()
+        qdd_ = np.linalg.solve(Hm, qdd)
+        mod.rhs_jacobian(q, v, t, p, Jq, Jv)
+        mod.mass_matvec_dq(q, qdd_, p, dHw)
+        out = np.zeros((2 * n, 2 * n))
+        out[:n, n:] = np.eye(n)
+        out[n:, :n] = np.linalg.solve(Hm, Jq - dHw)
+        out[n:, n:] = np.linalg.solve(Hm, Jv)
+        return out
+    return jac
+
+
+def kkt_rhs(mod, p):
+    """Index-1 form of a constrained model: y' = (v, qdd) with qdd, lam from the KKT system
+    [[H, -J^T], [J, 0]] (qdd, lam) = (rhs, gamma) (m = N_CONSTRAINTS multipliers)."""
+    n, m = mod.N_COORDS, mod.N_CONSTRAINTS
+    H, rhs = np.empty((n, n)), np.empty(n)
+    phi, J, gamma = np.empty(m), np.empty((m, n)), np.empty(m)
+
+    def f(t, y):
+        q, v = y[:n], y[n:]
+        mod.dynamics(q, v, t, p, H, rhs)
+        mod.constraints(q, v, p, phi, J, gamma)
+        K = np.block([[H, -J.T], [J, np.zeros((m, m))]])
+        sol = np.linalg.solve(K, np.concatenate((rhs, gamma)))
+        return np.concatenate((v, sol[:n]))
+    return f
+
+
+def constraint_residual(mod, p, q):
+    """max |Phi(q)| over the rows of q (S, n) -> (S,)."""
+    m, n = mod.N_CONSTRAINTS, mod.N_COORDS
+    phi, J, gamma = np.empty(m), np.empty((m, n)), np.empty(m)
+    out = np.empty(len(q))
+    for i, qi in enumerate(q):
+        mod.constraints(np.ascontiguousarray(qi), np.zeros(n), p, phi, J, gamma)
+        out[i] = np.max(np.abs(phi)) if m else 0.0
+    return out
+
+
+@dataclass
+class Reference:
+    """A dense reference solution: ``y_at(t)`` (2n, len(t)); ``y_end`` (2n,) the state at t_end
+    (the solver's own end point, not an interpolant); ``agreement`` the max-norm difference to
+    the second solver over the sample times; ``second`` names it."""
+
+    sol: object
+    y_end: np.ndarray
+    agreement: float
+    second: str
+
+    def y_at(self, t):
+        return self.sol(np.asarray(t, dtype=float))
+
+
+def solve(f, y0, t_end, method="DOP853", rtol=REF_TOL, atol=REF_TOL, jac=None, t_eval=None):
+    """solve_ivp with dense output; raises RuntimeError when the solver fails."""
+    kwargs = {"jac": jac} if jac is not None else {}
+    sol = solve_ivp(f, (0.0, t_end), y0, method=method, rtol=rtol, atol=atol,
+                    dense_output=True, t_eval=t_eval, **kwargs)
+    if not sol.success:
+        raise RuntimeError(f"reference solver {method} failed: {sol.message}")
+    return sol
+
+
+def ode_reference(mod, p, q0, v0, t_end, t_check, second="Radau"):
+    """DOP853 reference of an unconstrained model, checked at t_check (and t_end) against
+    ``second``: "Radau" (implicit Runge-Kutta) or "LSODA" (multistep, much cheaper at 1e-13),
+    both with the exact Jacobian."""
+    y0 = np.concatenate((q0, v0))
+    f = ode_rhs(mod, p)
+    f(0.0, y0)                   # numba specializes forward_dynamics on the first call
+    main = solve(f, y0, t_end)
+    other = solve(f, y0, t_end, method=second, jac=ode_jacobian(mod, p))
+    diff = max(np.max(np.abs(main.sol(t_check) - other.sol(t_check))),
+               np.max(np.abs(main.y[:, -1] - other.y[:, -1])))
+    return Reference(main.sol, main.y[:, -1], float(diff), f"{second} at rtol {REF_TOL:g}")
+
+
+def pendulum_angle_reference(mod, p, q0, v0, t_end, t_check):
+    """Reference of the Cartesian pendulum (coords x, y; params m, l, g; |x| = l): DOP853 on the
+    same motion in the angle theta from the downward vertical, theta'' = -(g/l) sin(theta),
+    mapped to (x, y) = l (sin, -cos); checked against DOP853 on the index-1 Cartesian form."""
+    pv = dict(zip(mod.PARAMS, p))
+    l, g = pv["l"], pv["g"]
+    th0 = np.arctan2(q0[0], -q0[1])
+    w0 = (q0[0] * v0[1] - q0[1] * v0[0]) / l**2     # (r x v)_z / l^2
+    ang = solve(lambda t, y: np.array([y[1], -g / l * np.sin(y[0])]), np.array([th0, w0]), t_end)
+
+    def cart(t):
+        th, w = ang.sol(np.asarray(t, dtype=float))
+        return np.array([l * np.sin(th), -l * np.cos(th), l * np.cos(th) * w, l * np.sin(th) * w])
+    other = solve(kkt_rhs(mod, p), np.concatenate((q0, v0)), t_end)
+    diff = max(np.max(np.abs(cart(t_check) - other.sol(t_check))),
+               np.max(np.abs(cart(t_end) - other.y[:, -1])))
+    return Reference(cart, cart(t_end), float(diff), "index-1 Cartesian form, DOP853")

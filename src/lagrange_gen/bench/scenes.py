@@ -1,0 +1,113 @@
+"""The hard cases of HARD_CASES.md (4-8) as scenes: a model, a start, an end time, the fixed h of
+the hard suite, and what "stable" means for the scene (used by the stability suite's search for
+the largest stable h). Closed-form solutions and invariants the hard suite checks live here too.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.special import ellipj, ellipk
+
+FPU_OMEGA = 50.0
+#: HARD_CASES case 5 (Hairer-Lubich-Wanner, DOP853 at 1e-13): I_j at t = 50, 100, 200.
+FPU_REFERENCE = {50.0: (0.559, 0.367, 0.070), 100.0: (0.106, 0.421, 0.476),
+                 200.0: (0.010, 0.160, 0.835)}
+SEPARATRIX_K = 0.999
+
+
+@dataclass(frozen=True)
+class Scene:
+    """key, title; stem and build options of the model file; parameters; start (q0, v0); t_end;
+    h (the hard suite's fixed step); h_max (where the stable-h search starts); ``stable`` names
+    the predicate in STABLE."""
+
+    key: str
+    title: str
+    stem: str
+    params: dict
+    q0: tuple
+    v0: tuple
+    t_end: float
+    h: float
+    h_max: float
+    stable: str
+    options: dict = field(default_factory=dict)
+
+
+def oscillator_scene(compliance, b=0.1, h=0.01, t_end=10.0):
+    """Case 4: m x'' + b x' + x / c = 0, m = 1, x0 = 1; tau = h / sqrt(c)."""
+    return Scene(f"oscillator_c{compliance:.0e}", f"damped oscillator, c = {compliance:g}",
+                 "damped_oscillator", {"m": 1.0, "c": compliance, "b": b}, (1.0,), (0.0,),
+                 t_end, h, 1.0, "energy_not_growing")
+
+
+def fpu_scene(t_end=200.0, h=0.01):
+    r = math.sqrt(2.0)
+    w = FPU_OMEGA
+    q0 = ((1 - 1 / w) / r, (1 + 1 / w) / r, 0.0, 0.0, 0.0, 0.0)
+    return Scene("fpu", f"FPU chain, omega = {w:g}", "fpu", {"omega": w}, q0,
+                 (0.0, r, 0.0, 0.0, 0.0, 0.0), t_end, h, 0.2, "energy_not_growing")
+
+
+def separatrix_scene(periods=4, h=0.01):
+    """Case 6: theta'' = -sin(theta) (n_link_pendulum n = 1, m = l = g = 1), theta'(0) = 2k."""
+    period = 4 * ellipk(SEPARATRIX_K**2)
+    return Scene("separatrix", f"pendulum near the separatrix, k = {SEPARATRIX_K}",
+                 "n_link_pendulum", {"m": 1.0, "l": 1.0, "g": 1.0}, (0.0,),
+                 (2 * SEPARATRIX_K,), periods * period, h, 1.0, "libration",
+                 options={"n": 1})
+
+
+def separatrix_exact(t, k=SEPARATRIX_K):
+    """theta(t), theta'(t) (each (S,)): sin(theta/2) = k sn(t, k^2), theta' = 2 k cn(t, k^2)."""
+    sn, cn, _, _ = ellipj(np.asarray(t, dtype=float), k**2)
+    return 2 * np.arcsin(k * sn), 2 * k * cn
+
+
+def oscillator_exact(t, m, c, b, x0=1.0, v0=0.0):
+    """Underdamped m x'' + b x' + x / c = 0: x(t), v(t) (each (S,))."""
+    t = np.asarray(t, dtype=float)
+    beta = b / (2 * m)
+    wd = math.sqrt(1 / (m * c) - beta**2)
+    A, B = x0, (v0 + beta * x0) / wd
+    e = np.exp(-beta * t)
+    x = e * (A * np.cos(wd * t) + B * np.sin(wd * t))
+    v = -beta * x + e * wd * (-A * np.sin(wd * t) + B * np.cos(wd * t))
+    return x, v
+
+
+def fpu_oscillatory_energies(q, v, omega=FPU_OMEGA):
+    """I_j = (xdot_j^2 + omega^2 x_j^2) / 2 with x_j = (q_2j - q_2j-1) / sqrt 2 for q, v (S, 6):
+    returns (S, 3)."""
+    r = math.sqrt(2.0)
+    x = (q[:, 1::2] - q[:, 0::2]) / r
+    xd = (v[:, 1::2] - v[:, 0::2]) / r
+    return 0.5 * (xd**2 + omega**2 * x**2)
+
+
+# ---------------------------------------------------------------- what "stable" means per scene
+
+def _energy_not_growing(traj, scene):
+    """No growth: max E <= 1.5 E0 (E0 > 0). Damping, physical or numerical, passes: whether it
+    is acceptable is an accuracy question (the hard suite), not a stability one."""
+    return float(np.max(traj.energy)) <= 1.5 * traj.energy[0]
+
+
+def _libration(traj, scene):
+    """The pendulum stays inside the separatrix: |theta| < pi throughout."""
+    return float(np.max(np.abs(traj.q[:, 0]))) < math.pi
+
+
+STABLE = {"energy_not_growing": _energy_not_growing, "libration": _libration}
+
+
+def is_stable(traj, scene):
+    return STABLE[scene.stable](traj, scene)
+
+
+def constrained_scenes(quick):
+    """Cases 7 and 8 (stretchable pendulum, closed-loop linkage) once their models exist."""
+    return []
