@@ -24,10 +24,39 @@ def _nonsmooth(args):
     print(run_nonsmooth_report(args.reports, args.models))
 
 
+def _suite_kwargs(args):
+    return dict(models_dir=args.models, reports_dir=args.reports, quick=args.quick,
+                progress=not args.no_progress)
+
+
+def _precision(args):
+    from .precision import run_precision
+    print(run_precision(**_suite_kwargs(args))["report"])
+
+
+def _stability(args):
+    from .stability import run_stability
+    print(run_stability(**_suite_kwargs(args))["report"])
+
+
+def _hard(args):
+    from .hard import run_hard
+    print(run_hard(**_suite_kwargs(args))["report"])
+
+
+def _report(args):
+    from .report import run_report
+    print(run_report(**_suite_kwargs(args))["report"])
+
+
 SUITES = {
     "pipeline": ("derive/emit/compile/cached-import times vs sympy.physics.mechanics", _pipeline),
     "steppers": ("ns per step of every method vs hand-written numba loops", _steppers),
     "nonsmooth": ("the lecture's Prandtl/play/Coulomb experiments with cycle figures", _nonsmooth),
+    "precision": ("work-precision diagrams of every stepper vs scipy and sympy.mechanics", _precision),
+    "stability": ("tau = h omega spectral-radius curves, largest stable h per hard case", _stability),
+    "hard": ("HARD_CASES 3-8 with pass/fail verdicts against their references", _hard),
+    "report": ("precision + stability + hard, and the method-choice summary", _report),
 }
 
 
@@ -40,6 +69,8 @@ def add_parser(subparsers):
     p.add_argument("--reports", default="reports", metavar="DIR", help="report directory (default: reports)")
     p.add_argument("--models", default="models", metavar="DIR", help="model directory (default: models)")
     p.add_argument("--quick", action="store_true", help="smaller settings for CI smoke runs")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (precision, stability, hard, report)")
     return p
 
 

@@ -105,6 +105,16 @@ def guarded_run(mod, method, q0, v0, h, t_end, p, save_every=1, repeats=1, **kwa
     return Run(traj, best)
 
 
+def short_error(message):
+    """'step 57 of 1000 (t = 0.57, h = 0.01)' out of a SimulationError's first line (whose form
+    is '<model>, <method>: step ... (t = ..., h = ...): what happened'), else its first 60
+    characters."""
+    head, sep, rest = message.partition(": step ")
+    if sep:
+        return "failed at step " + rest.split(")")[0] + ")"
+    return "failed: " + message[:60]
+
+
 class Progress:
     """One-line text progress bar on stderr: ``[####    ] 12/40 label``; silent when disabled."""
 

@@ -65,25 +65,26 @@ def case3_tau(osc, methods):
 
 COMPLIANCES = (1e-1, 1e-4, 1e-6)
 BOUNDED = frozenset({"accurate", "inaccurate", "stiff mode kept", "over-damped"})
+GREW = "energy grew / blew up"
 _EXPLICIT_AT_TAU_10 = ("explicit_euler", "symplectic_euler", "verlet", "rk4", "composition")
 #: HARD_CASES case 4 and the slides: at low frequency (c = 1e-1) midpoint is accurate; at high
 #: frequency midpoint stays bounded and at tau = 10 keeps the stiff mode, implicit Euler damps
 #: it, explicit methods blow up (at tau = 10 every method with a finite stability interval).
 EXPECT4 = {
     1e-1: {"midpoint": {"accurate"}, "implicit_euler": BOUNDED},
-    1e-4: {"midpoint": BOUNDED, "implicit_euler": {"over-damped"}, "explicit_euler": {"blow-up"}},
+    1e-4: {"midpoint": BOUNDED, "implicit_euler": {"over-damped"}, "explicit_euler": {GREW}},
     1e-6: {"midpoint": {"stiff mode kept"}, "implicit_euler": {"over-damped"},
-           **{m: {"blow-up"} for m in _EXPLICIT_AT_TAU_10}},
+           **{m: {GREW} for m in _EXPLICIT_AT_TAU_10}},
 }
 
 
 def classify_damped(run, e_exact, e0):
-    """Outcome class of a damped-oscillator run from its energy: blow-up (failed, or E ever
-    above 1.5 E0), accurate (|E(T) - E_exact(T)| <= 0.05 E0), stiff mode kept (E(T) >= 0.9 E0
+    """Outcome class of a damped-oscillator run from its energy: GREW (failed, or E ever above
+    1.5 E0: a damped system never gains energy), accurate (|E(T) - E_exact(T)| <= 0.05 E0), stiff mode kept (E(T) >= 0.9 E0
     while the exact system lost most of it), over-damped (E(T) <= 1e-3 E_exact(T)),
     else inaccurate."""
     if not run.ok or float(np.max(run.traj.energy)) > 1.5 * e0:
-        return "blow-up"
+        return GREW
     e_end = float(run.traj.energy[-1])
     if abs(e_end - e_exact) <= 0.05 * e0:
         return "accurate"
@@ -96,7 +97,7 @@ def classify_damped(run, e_exact, e0):
 
 def case4_damped(models_dir, gen_dir, methods):
     """Fixed h = 0.01 to T = 10 at compliance 1e-1, 1e-4, 1e-6 (tau = 0.03, 1, 10)."""
-    rows, oks, energies = [], [], {}
+    rows, oks, energies, outcomes = [], [], {}, {}
     for c in COMPLIANCES:
         sc = scenes.oscillator_scene(c)
         mod = common.load_module(models_dir, sc.stem, gen_dir)
@@ -111,14 +112,16 @@ def case4_damped(models_dir, gen_dir, methods):
             ok = allowed is None or got in allowed
             oks.append(ok)
             energies[(c, method)] = (run.traj.t, run.traj.energy / e0) if run.ok else None
-            e_end = f"{run.traj.energy[-1] / e0:.3g}" if run.ok else run.error[:50]
+            outcomes[(c, method)] = got
+            e_end = f"{run.traj.energy[-1] / e0:.3g}" if run.ok else common.short_error(run.error)
             rows.append([f"{c:g}", f"{sc.h / math.sqrt(c):.3g}", method, e_end,
                          f"{e_exact / e0:.3g}", got,
                          "-" if allowed is None else " or ".join(sorted(allowed)),
                          PASS if ok else FAIL])
     return CaseResult(4, "damped oscillator at high frequency", _verdict(oks),
                       ["compliance c", "tau", "method", "E(T)/E0", "exact E(T)/E0", "outcome",
-                       "expected", "verdict"], rows, data={"energies": energies})
+                       "expected", "verdict"], rows,
+                      data={"energies": energies, "outcomes": outcomes})
 
 
 def _methods(methods):
@@ -162,7 +165,7 @@ def case5_fpu(models_dir, gen_dir, methods, h=0.01):
         if run.ok:
             series[method] = (run.traj.t, scenes.fpu_oscillatory_energies(run.traj.q,
                                                                           run.traj.v))
-        cells = ["failed: " + run.error[:60]] * 3 if at is None else \
+        cells = [common.short_error(run.error), "-", "-"] if at is None else \
             [", ".join(f"{x:.3f}" for x in row) for row in at]
         rows.append([method, *cells, common.fmt(dev, ".3f"), common.fmt(drift, ".1e"),
                      PASS if ok else FAIL])
@@ -201,7 +204,7 @@ def case6_separatrix(models_dir, gen_dir, methods, h=0.01):
     for method in _methods(methods):
         run = common.guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end, p)
         if not run.ok:
-            rows.append([method, "failed: " + run.error[:60], "-", "-", "-", FAIL])
+            rows.append([method, common.short_error(run.error), "-", "-", "-", FAIL])
             good.append(False)
             continue
         tr = run.traj

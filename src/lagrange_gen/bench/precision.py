@@ -296,7 +296,7 @@ def headline(result, target=TARGET):
 def _full_table(points):
     rows = [[pt.method, f"{pt.param:.3g}", _ms(pt.wall), common.fmt(pt.final),
              common.fmt(pt.traj_max), common.fmt(pt.energy), common.fmt(pt.phi),
-             pt.failed[:90] or "ok"] for pt in points]
+             common.short_error(pt.failed) if pt.failed else "ok"] for pt in points]
     return common.md_table(["method", "h or rtol", "wall", "final error", "max error",
                             "max abs(E - E0)", "max abs(Phi)", "status"], rows)
 

@@ -74,15 +74,24 @@ def kkt_rhs(mod, p):
     return f
 
 
-def constraint_residual(mod, p, q):
-    """max |Phi(q)| over the rows of q (S, n) -> (S,)."""
+def constraint_residuals(mod, p, q, v=None):
+    """max_i |Phi_i(q)| and max_i |(J v)_i| per row of q, v (S, n) -> two (S,) arrays (the
+    second is zeros when v is None)."""
     m, n = mod.N_CONSTRAINTS, mod.N_COORDS
     phi, J, gamma = np.empty(m), np.empty((m, n)), np.empty(m)
-    out = np.empty(len(q))
+    out_phi, out_jv = np.zeros(len(q)), np.zeros(len(q))
     for i, qi in enumerate(q):
-        mod.constraints(np.ascontiguousarray(qi), np.zeros(n), p, phi, J, gamma)
-        out[i] = np.max(np.abs(phi)) if m else 0.0
-    return out
+        vi = np.zeros(n) if v is None else np.ascontiguousarray(v[i])
+        mod.constraints(np.ascontiguousarray(qi), vi, p, phi, J, gamma)
+        if m:
+            out_phi[i] = np.max(np.abs(phi))
+            out_jv[i] = np.max(np.abs(J @ vi))
+    return out_phi, out_jv
+
+
+def constraint_residual(mod, p, q):
+    """max |Phi(q)| over the rows of q (S, n) -> (S,)."""
+    return constraint_residuals(mod, p, q)[0]
 
 
 @dataclass

@@ -130,7 +130,7 @@ def tau_table(mod, methods):
 def largest_stable_h(mod, scene, method, p, max_halvings=24, max_steps=2_000_000):
     """(largest stable h on the grid h_max / 2^(j/2), runs tried); None when no h down to the
     step budget is stable. Runs save at most ~20000 rows (the predicates look at saved rows)."""
-    q0, v0 = np.array(scene.q0, float), np.array(scene.v0, float)
+    q0, v0 = scenes.start_of(scene, mod, p)
     for j in range(2 * max_halvings + 1):
         h = scene.h_max / 2 ** (j / 2)
         n_steps = math.ceil(scene.t_end / h)
@@ -227,8 +227,9 @@ def markdown(taus, curves, table, stable_h, scene_list_, max_steps, quick):
     lines += ["", "## Largest stable h per hard case", "",
               f"h = h_max / 2^(j/2) downwards until the run passes the scene's test "
               f"(runs of at most {max_steps:g} steps; '< h' when none was): the energy never "
-              f"exceeds 1.5 E0 (oscillators, FPU: damping passes, growth fails), |theta| < pi "
-              f"throughout (separatrix pendulum: it must not go over the top).", ""]
+              f"rises by more than abs(E0)/2 (damping passes, growth fails; n/a: the method "
+              f"does not apply to the model), |theta| < pi throughout (separatrix pendulum: "
+              f"it must not go over the top).", ""]
     methods = sorted({m for row in stable_h.values() if row for m in row},
                      key=list(common.registry.METHODS).index)
     rows = []
@@ -242,12 +243,13 @@ def markdown(taus, curves, table, stable_h, scene_list_, max_steps, quick):
 
 
 def run_stability(models_dir="models", gen_dir="generated", reports_dir="reports", quick=False,
-                  methods=None, progress=True):
-    """Measure, write reports_dir/stability.md and stability_tau.png; returns the numbers."""
+                  methods=None, progress=True, scene_keys=None):
+    """Measure, write reports_dir/stability.md and stability_tau.png; returns the numbers.
+    methods and scene_keys (Scene.key) restrict the run."""
     taus = np.unique(np.concatenate((np.logspace(-2, 3, 41 if quick else 161), TAUS)))
     mod = oscillator(models_dir, gen_dir)
     ms = _methods_for(mod, methods)
-    scene_list_ = scene_list(quick)
+    scene_list_ = [s for s in scene_list(quick) if scene_keys is None or s.key in scene_keys]
     max_steps = 200_000 if quick else 2_000_000
     bar = common.Progress(len(ms) * (1 + len(scene_list_)), "stability", enabled=progress)
     curves = radius_curves(mod, ms, taus, bar)
