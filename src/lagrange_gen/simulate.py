@@ -60,6 +60,23 @@ class Trajectory:
     compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
     extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     element_names: tuple = ()
+    constraint_names: tuple = ()
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        """(S, m): the constraint forces lam (H qdd = rhs + J^T lam) at each saved state, from a
+        constrained method (see its module docstring for which of its multipliers it reports)."""
+        return self.extra[:, :len(self.constraint_names)]
+
+    @property
+    def constraint_error(self) -> np.ndarray:
+        """(S,): max_i |Phi_i(q)| at each saved state (constrained methods)."""
+        return self.extra[:, len(self.constraint_names)]
+
+    @property
+    def velocity_constraint_error(self) -> np.ndarray:
+        """(S,): max_i |(J(q) v)_i| at each saved state (constrained methods)."""
+        return self.extra[:, len(self.constraint_names) + 1]
 
     @property
     def element_state(self) -> np.ndarray:
@@ -85,7 +102,15 @@ class Trajectory:
                  param_names=np.array(list(self.params)),
                  param_values=np.array(list(self.params.values()), dtype=float),
                  n_steps=self.n_steps, element_names=np.array(self.element_names, dtype=str),
-                 element_state=self.element_state)
+                 element_state=self.element_state,
+                 constraint_names=np.array(self.constraint_names, dtype=str),
+                 multipliers=self.multipliers, **self._constraint_arrays())
+
+    def _constraint_arrays(self):
+        if not self.constraint_names:
+            return {}
+        return dict(constraint_error=self.constraint_error,
+                    velocity_constraint_error=self.velocity_constraint_error)
 
     def to_csv(self, path):
         """Write one row per saved state: t, coordinates, velocities, energy, newton_iters."""
@@ -192,7 +217,7 @@ def _format_state(coords, q, v):
     return ", ".join(parts)
 
 
-def _raise_for_status(code, module, method, step, n_steps, last, max_iter, h):
+def _raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
     """Turn a stepper status into the matching exception (step is 1-based)."""
     n = module.N_COORDS
     t, q, v, resid = last[0], last[1:1 + n], last[1 + n:1 + 2 * n], last[2 + 2 * n]
@@ -204,7 +229,12 @@ def _raise_for_status(code, module, method, step, n_steps, last, max_iter, h):
                                f"(residual {resid:.3g}) from {state}; reduce h or raise max_iter",
                                **kwargs)
     if code == st.SINGULAR_MASS:
-        raise SingularMass(f"{where}: singular mass matrix (or Newton matrix) at {state}", **kwargs)
+        hint = ""
+        if method in registry.CONSTRAINED_METHODS:
+            from .consistent import diagnose_singular
+            hint = diagnose_singular(module, np.ascontiguousarray(q), p)
+        raise SingularMass(f"{where}: singular mass matrix (or Newton matrix) at {state}{hint}",
+                           **kwargs)
     if code == st.NON_FINITE:
         raise BlowUp(f"{where}: the state became non-finite: {state}", **kwargs)
     if code == st.UNSTABLE:
@@ -232,6 +262,9 @@ def _extra_layout(module, method):
     if method == "nonsmooth_euler":
         from .steppers.nonsmooth_euler import extra_size
         return extra_size(module.N_COORDS, module.N_ELEMENTS)
+    if method in registry.CONSTRAINED_METHODS:
+        from .steppers.constrained import extra_size
+        return extra_size(module.N_COORDS, module.N_CONSTRAINTS)
     return 0, 0
 
 
@@ -249,7 +282,8 @@ def _element_energy(module, p, state):
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, params=None,
              save_every=1, newton_tol=1e-12, max_iter=50, t0=0.0, progress=False,
              blowup_bound=1e150, newton_always=False, out_dir="generated",
-             element_state0=None) -> Trajectory:
+             element_state0=None, compliance=0.0, relaxation=2.0,
+             baumgarte=(0.0, 0.0)) -> Trajectory:
     """Integrate a generated model from t0 to t_end with fixed step h.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -267,11 +301,19 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     element_state0: initial states of the nonsmooth elements (ne,), default 0 (virgin material).
         On models with elements, method implicit_euler runs nonsmooth_euler; the trajectory's
         energy then includes the elastic energy k u^2 / 2 stored in Saint-Venant elements.
+    Constrained models (``constraints=`` in the model) need a constrained method
+    (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
+    with a warning (lagrange_gen.consistent), and the Trajectory carries the multipliers and
+    max|Phi|, max|J v| per saved state. compliance (epsilon >= 0) and relaxation (d > 0) are
+    spook's; baumgarte = (alpha, beta) is index1's optional stabilization.
     The final time is t0 + n_steps h with n_steps = (t_end - t0) / h rounded up to a whole step.
     Raises SimulationError (bad input), NewtonDivergence, SingularMass, BlowUp.
     """
     module = load_module(module_or_path, out_dir)
     method = _element_method(module, method)
+    constrained = method in registry.CONSTRAINED_METHODS
+    from .consistent import check_method
+    check_method(module, method, registry.CONSTRAINED_METHODS)
     run = _runner(module, method)
     n = module.N_COORDS
     _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter)
@@ -280,16 +322,23 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME)
     h, t0, save_every, max_iter = float(h), float(t0), int(save_every), int(max_iter)
     settings = make_settings(newton_tol, max_iter, blowup_bound, 1 if newton_always else 0)
+    if constrained:
+        settings, q, v, initial = _constrained_setup(module, q, v, p, t0, settings, compliance,
+                                                     relaxation, baumgarte)
     n_steps = _n_steps(t0, float(t_end), h)
     rows = n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
     out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
     n_saved, n_extra = _extra_layout(module, method)
-    out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, n_extra))
-    if n_saved:
+    # Only the n_saved leading entries of the method's extra buffer are kept per row; the rest
+    # is scratch that run_loop sizes from `last` (steppers/base.py).
+    out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, n_saved))
+    if constrained:
+        out_extra[0] = initial
+    elif n_saved:
         out_extra[0, :n_saved] = _vector("element_state0", element_state0, n_saved, module.ELEMENTS)
     last = np.empty(2 * n + 3 + n_extra)
     chunk = max(1, CHUNK_STEPS // save_every) * save_every
-    compile_time = _warm_up(run, q, v, t0, h, p, settings, n)
+    compile_time = _warm_up(run, q, v, t0, h, p, settings, out_extra[:1].copy(), last.copy())
     bar = _ProgressBar(n_steps) if progress else None
     start = time.perf_counter()
     done, row = 0, 0
@@ -306,7 +355,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
         if row > 0:
             out_stats[row, STAT_ITERS:] = kept[STAT_ITERS:]
         if code != st.OK:
-            _raise_for_status(code, module, method, done + steps + 1, n_steps, last, max_iter, h)
+            _raise_for_status(code, module, method, done + steps + 1, n_steps, last, max_iter, h,
+                              p)
         q, v = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy()
         done += k
         row += saves
@@ -320,7 +370,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
         row += 1
         out_t[row], out_q[row], out_v[row] = t0 + n_steps * h, q, v
         out_stats[row] = (module.energy(q, v, out_t[row], p), last[1 + 2 * n], last[2 + 2 * n])
-        out_extra[row] = last[3 + 2 * n:]
+        out_extra[row] = last[3 + 2 * n:3 + 2 * n + n_saved]
     wall = time.perf_counter() - start
     if bar:
         bar.close()
@@ -332,15 +382,44 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
                       model=module.NAME, params=dict(zip(module.PARAMS, p.tolist())),
                       coords=tuple(module.COORDS), n_steps=n_steps, wall_time=wall,
                       compile_time=compile_time, extra=elements,
-                      element_names=tuple(getattr(module, "ELEMENTS", ())) if n_saved else ())
+                      element_names=tuple(getattr(module, "ELEMENTS", ())) if n_saved and not
+                      constrained else (),
+                      constraint_names=tuple(module.CONSTRAINTS) if constrained else ())
 
 
-def _warm_up(run, q, v, t0, h, p, settings, n):
+def _constrained_setup(module, q, v, p, t0, settings, compliance, relaxation, baumgarte):
+    """Settings of the constrained methods, the consistent initial state, and row 0 of
+    out_extra: (settings, q, v, [lam0, max|Phi|, max|J v|])."""
+    from .consistent import consistent_initial_state
+    from .steppers.constrained import make_constrained_settings
+    for name, value, low in (("compliance", compliance, 0.0), ("relaxation", relaxation, None)):
+        if not isinstance(value, (int, float, np.floating, np.integer)) or not math.isfinite(value) \
+                or (low is not None and value < low) or (low is None and value <= 0):
+            raise SimulationError(f"{name} must be a finite number {'>= 0' if low is not None else '> 0'}"
+                                  f", got {value!r}")
+    try:
+        alpha, beta = (float(x) for x in baumgarte)
+    except (TypeError, ValueError):
+        raise SimulationError(f"baumgarte must be (alpha, beta), got {baumgarte!r}") from None
+    if not (alpha >= 0 and beta >= 0 and math.isfinite(alpha + beta)):
+        raise SimulationError(f"baumgarte coefficients must be finite and >= 0, got {baumgarte!r}")
+    tol, max_iter, bound, mode = settings[:4]
+    settings = make_constrained_settings(tol, max_iter, bound, mode, float(compliance),
+                                         float(relaxation), alpha, beta)
+    # stacklevel 4: the warning points at the user's call of simulate().
+    state = consistent_initial_state(module, q, v, p, t0, tol, stacklevel=4)
+    initial = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
+    return settings, np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial
+
+
+def _warm_up(run, q, v, t0, h, p, settings, extra, last):
     """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
-    measured wall time is integration only. Returns the seconds it took."""
+    measured wall time is integration only. extra (1, n_saved) and last are scratch copies with
+    the method's sizes. Returns the seconds it took."""
+    n = q.shape[0]
     start = time.perf_counter()
     run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
-        np.empty((1, N_STATS)), np.empty((1, 0)), np.empty(2 * n + 3))
+        np.empty((1, N_STATS)), extra, last)
     return time.perf_counter() - start
 
 

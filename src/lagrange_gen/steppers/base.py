@@ -209,7 +209,7 @@ def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, ex
     out_stats[row, STAT_ENERGY] = energy
     out_stats[row, STAT_ITERS] = iters
     out_stats[row, STAT_RESIDUAL] = resid
-    for k in range(extra.shape[0]):
+    for k in range(min(extra.shape[0], out_extra.shape[1])):
         out_extra[row, k] = extra[k]
 
 
@@ -236,7 +236,7 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_extra), whose row 0 also holds the initial extra data.
-    out_last (2n + 3 [+ n_extra],) receives [t, q, v, Newton
+    out_last (2n + 3 [+ n_total],) receives [t, q, v, Newton
     iterations since the last save, Newton residual, extra data] of the final state, or on failure: of the
     state the failing step started from (Newton failure, singular mass) or of the offending state
     after it (NON_FINITE, UNSTABLE).
@@ -251,7 +251,12 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     piv = np.zeros(n, dtype=np.int64)
     # The method's persistent per-run data (element states, multipliers) start from row 0 of
     # out_extra, so a run continued in chunks carries them over.
-    extra = out_extra[0].copy()
+    # The buffer is n_total = max(n_extra, len(out_last) - 2n - 3) long: a method may keep
+    # scratch (or per-step data not worth saving) after the n_extra saved entries, so out_extra
+    # need not store it on every row (the constrained methods: m + 2 saved of O((n + m)^2)).
+    extra = np.zeros(max(out_extra.shape[1], out_last.shape[0] - 3 - 2 * n))
+    for k in range(out_extra.shape[1]):
+        extra[k] = out_extra[0, k]
     bound = settings[S_BOUND]
     status = check_state(q, v, bound)
     if status == OK:

@@ -20,10 +20,13 @@ Glue signature (identical for every method)::
     p          (n_params,)       parameter values in PARAMS order
     settings   (N_SETTINGS,)     base.make_settings(newton_tol, max_iter, bound, mode)
     out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_extra)
-               S = n_steps // save_every + 1; n_extra = 0 for unconstrained methods (room for
-               multipliers and constraint residuals of the constrained methods)
-    out_last   (2 n + 3,)        [t, q, v, Newton iterations since the last save, Newton
-                                 residual] at the end, or at the failure
+               S = n_steps // save_every + 1; n_extra = 0 for the unconstrained methods, the
+               element states of nonsmooth_euler, m + 2 (multipliers, max|Phi|, max|J v|) for
+               the constrained methods (steppers/constrained.py)
+    out_last   (2 n + 3 + n_total,)  [t, q, v, Newton iterations since the last save, Newton
+                                 residual, the method's extra buffer] at the end, or at the
+                                 failure; n_total >= n_extra sizes that buffer (scratch after
+                                 the saved entries; see base.run_loop)
     status     lagrange_gen.status code; steps_done = index of the failing step on failure
 """
 
@@ -32,7 +35,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
-           "composition", "nonsmooth_euler")
+           "composition", "nonsmooth_euler", "rattle", "constrained_midpoint",
+           "constrained_implicit_euler", "spook", "index1")
+
+#: Methods for models with holonomic constraints (extra = multipliers and residuals, see
+#: steppers/constrained.py); simulate() refuses every other method on a constrained model and
+#: these on an unconstrained one. index1 is the acceleration-level formulation that drifts,
+#: kept as the documented bad example.
+CONSTRAINED_METHODS = ("rattle", "constrained_midpoint", "constrained_implicit_euler", "spook",
+                       "index1")
 
 #: Methods that treat nonsmooth elements (SaintVenant, DryFriction); simulate() routes
 #: implicit_euler to nonsmooth_euler on models that have elements.
@@ -63,6 +74,15 @@ INFO = {
     "composition": MethodInfo(4, True, True, True, "Yoshida 4th-order triple jump of verlet"),
     "nonsmooth_euler": MethodInfo(1, False, False, True,
                                   "implicit Euler with Saint-Venant return map and Moreau-Jean friction"),
+    "rattle": MethodInfo(2, True, True, True, "constrained Verlet, Newton on the multipliers"),
+    "constrained_midpoint": MethodInfo(2, True, True, True,
+                                       "midpoint variational integrator with constraints"),
+    "constrained_implicit_euler": MethodInfo(1, False, False, True,
+                                             "index-3 backward Euler with velocity projection"),
+    "spook": MethodInfo(1, False, False, True,
+                        "Lacoursiere's regularized linearly implicit stepper (compliance, relaxation)"),
+    "index1": MethodInfo(4, False, False, False,
+                         "rk4 on the acceleration-level KKT form (drifts: the bad example)"),
 }
 
 # _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
