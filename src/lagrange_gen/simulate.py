@@ -113,9 +113,14 @@ class Trajectory:
                     velocity_constraint_error=self.velocity_constraint_error)
 
     def to_csv(self, path):
-        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters."""
+        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters (and
+        for a constrained method lam_0..lam_m-1, max|Phi|, max|J v|)."""
         header = ["t", *self.coords, *(f"{c}_dot" for c in self.coords), "energy", "newton_iters"]
         data = np.column_stack([self.t, self.q, self.v, self.energy, self.newton_iters])
+        if self.constraint_names:
+            header += [f"lam_{i}" for i in range(len(self.constraint_names))]
+            header += ["constraint_error", "velocity_constraint_error"]
+            data = np.column_stack([data, self.extra])
         _parent(path)
         np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
 

@@ -96,6 +96,9 @@ def test_trajectory_outputs(tmp_path):
     assert traj.constraint_names == tuple(mod.CONSTRAINTS)
     assert traj.constraint_error.shape == traj.velocity_constraint_error.shape == traj.t.shape
     traj.to_npz(tmp_path / "t.npz")
+    traj.to_csv(tmp_path / "t.csv")
+    csv = np.loadtxt(tmp_path / "t.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(csv[:, -4:-2], traj.multipliers)
     data = np.load(tmp_path / "t.npz")
     assert np.array_equal(data["multipliers"], traj.multipliers)
     old = sim.CHUNK_STEPS

@@ -44,8 +44,8 @@ from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
 from .base import (FAST, S_MAX_ITER, S_TOL, W_ACC, explicit_path, max_abs,
                    momentum_from_velocity, run_loop)
-from .constrained import (check_buffers, gauss_solve, increment_converged, phi_small, project,
-                          record, schur_block, solve_rows, velocity_projection, views)
+from .constrained import (check_buffers, flag_index, gauss_solve, increment_converged, phi_small,
+                          project, record, schur_block, solve_rows, velocity_projection, views)
 
 _VH, _Z, _QN, _VN, _F, _U, _W, _PT = 0, 1, 2, 3, 4, 5, 6, 7     # work rows (W_ACC is kept)
 _L, _H, _H1, _JQ, _JQD, _D = 0, 1, 2, 3, 4, 5                  # mats (_L kept: chol(M))
@@ -77,7 +77,10 @@ def _step_explicit(kern, q, v, t, h, p, settings, work, mats, extra):
     for i in range(n):
         vh[i] = v[i] + hh * acc[i]
         z[i] = q[i] + h * vh[i]
-    kern.constraints(q, v, p, phi, Ja, gam)
+    flag = flag_index(m)
+    if extra[flag] == 0.0:                    # else Ja = J(q) is kept from the previous step
+        kern.constraints(q, v, p, phi, Ja, gam)
+        extra[flag] = 1.0
     solve_rows(L, Ja, Y)                      # rows M^-1 J(q)_k^T: q+ = z + Y^T kappa
     for k in range(m):
         kap[k] = hh * h * lam[k]
@@ -125,6 +128,8 @@ def _step_explicit(kern, q, v, t, h, p, settings, work, mats, extra):
         q[i], v[i], acc[i] = q1[i], v1[i], f[i]
     for k in range(m):
         lam[k] = eta[k] / hh
+        for j in range(n):
+            Ja[k, j] = Jb[k, j]               # J(q) of the next step
     record(extra, m, phi, Jb, v)
     return OK, iters, resid
 

@@ -1,0 +1,47 @@
+"""Geometric properties of the constrained methods from the actual step map: symmetry (a step of
+-h undoes a step of h) for rattle and the constrained midpoint, on the explicit path (Cartesian
+pendulum) and the Newton path with H(q) (four-bar); implicit Euler is not symmetric."""
+
+import numpy as np
+import pytest
+
+from constraint_util import four_bar_state, generated_model, params, pendulum_state
+from lagrange_gen.consistent import initial_multipliers
+from lagrange_gen.steppers.base import N_STATS
+from lagrange_gen.steppers.constrained import extra_size, make_constrained_settings
+
+
+def one_step(mod, method, q, v, lam, h, p, t0=0.0):
+    """(q+, v+, lam+) after one step of run_<method> (h may be negative)."""
+    n, m = mod.N_COORDS, mod.N_CONSTRAINTS
+    saved, total = extra_size(n, m)
+    out_extra = np.zeros((2, saved))
+    out_extra[0, :m] = lam
+    out_q, out_v = np.empty((2, n)), np.empty((2, n))
+    status, _ = getattr(mod, f"run_{method}")(
+        np.array(q, float), np.array(v, float), t0, h, 1, 1, p, make_constrained_settings(),
+        np.empty(2), out_q, out_v, np.empty((2, N_STATS)), out_extra, np.empty(2 * n + 3 + total))
+    assert status == 0
+    return out_q[1], out_v[1], out_extra[1, :m]
+
+
+CASES = {"cartesian_pendulum": lambda: pendulum_state(1.0, 2.0),
+         "four_bar": lambda: four_bar_state(0.7, 3.0)}
+
+
+@pytest.mark.parametrize("stem", sorted(CASES))
+@pytest.mark.parametrize("method,symmetric", [("rattle", True), ("constrained_midpoint", True),
+                                              ("constrained_implicit_euler", False)])
+def test_symmetry(stem, method, symmetric):
+    mod = generated_model(stem)
+    p = params(mod)
+    q0, v0 = CASES[stem]()
+    lam0 = initial_multipliers(mod, q0, v0, 0.0, p)
+    h = 0.05
+    q1, v1, lam1 = one_step(mod, method, q0, v0, lam0, h, p)
+    q2, v2, _ = one_step(mod, method, q1, v1, lam1, -h, p, t0=h)
+    back = max(np.abs(q2 - q0).max(), np.abs(v2 - v0).max())
+    if symmetric:
+        assert back < 1e-11, back
+    else:
+        assert back > 1e-4, back
