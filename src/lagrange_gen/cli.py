@@ -21,6 +21,7 @@ examples:
   lagrange-gen models/n_link_pendulum.py --set n=8
   lagrange-gen --check models/*.py                exit 1 if a generated file is missing or stale
   lagrange-gen --methods verlet,midpoint models/double_pendulum.py
+  lagrange-gen --freeze g=9.81,l=1 models/n_link_pendulum.py --set n=16
   lagrange-gen simulate models/cart_pendulum.py --method midpoint --h 1e-3 --t-end 10
   lagrange-gen bench --help
   lagrange-gen identify cycle.csv --kind prandtl --elements 3
@@ -61,6 +62,9 @@ def generate_parser():
                    help="write nothing; exit 1 when a generated file is missing or stale")
     p.add_argument("--methods", metavar="M1,M2",
                    help="emit glue only for these steppers (default: all)")
+    p.add_argument("--freeze", metavar="NAME=VALUE,...",
+                   help="fold these parameters into the kernels as constants (e.g. g=9.81,l=1); "
+                        "they leave PARAMS and cannot be passed at run time")
     p.add_argument("--set", action="append", metavar="NAME=VALUE", dest="options",
                    help="option passed to the model file's build() (e.g. n=8), repeatable")
     p.add_argument("--debug", action="store_true", help="show tracebacks")
@@ -69,12 +73,14 @@ def generate_parser():
 
 def run_generate(args) -> int:
     from .codegen.generate import generate_model, is_current
+    from .derive.freeze import parse_freeze
     methods = args.methods.split(",") if args.methods else None
     options = _parse_options(args.options)
+    freeze = parse_freeze(args.freeze)
     if args.check:
         bad = 0
         for path in args.models:
-            target, current = is_current(path, args.out_dir, methods, options)
+            target, current = is_current(path, args.out_dir, methods, options, freeze)
             if not current:
                 state = "stale" if target.exists() else "missing"
                 print(f"{target}: {state} (run lagrange-gen {path})")
@@ -84,7 +90,7 @@ def run_generate(args) -> int:
         return 1 if bad else 0
     for path in args.models:
         start = time.perf_counter()
-        result = generate_model(path, args.out_dir, methods, options)
+        result = generate_model(path, args.out_dir, methods, options, freeze)
         what = "written" if result.written else "unchanged"
         print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
     return 0

@@ -50,25 +50,32 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True)
     return import_generated(target)
 
 
-def compile_all(module):
-    """Call every kernel of a generated module once on zeros so numba compiles (or loads from its
-    cache) all of them now rather than inside the first simulation step."""
+def _kernel_args(module):
+    """{kernel name: arguments of a call on zeros} for every kernel a module may have."""
     import numpy as np
-    n, m = module.N_COORDS, module.N_CONSTRAINTS
-    q, qd, w, lam = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(m)
+    n, m, ne = module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS
+    q, w, lam, we = np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(ne)
     p = np.ones(module.N_PARAMS)
-    A, B = np.empty((n, n)), np.empty((n, n))
-    v = np.empty(n)
-    module.mass_matrix(q, p, A)
-    module.dynamics(q, qd, 0.0, p, A, v)
-    module.energy(q, qd, 0.0, p)
-    module.momentum_rate(q, qd, 0.0, p, v)
-    module.rhs_jacobian(q, qd, 0.0, p, A, B)
-    module.momentum_rate_jacobian(q, qd, 0.0, p, A, B)
-    module.mass_matvec_dq(q, w, p, A)
-    module.constraints(q, qd, p, np.empty(m), np.empty((m, n)), np.empty(m))
-    module.constraint_dq(q, w, lam, p, np.empty((m, n)), A)
-    module.forward_dynamics(q, qd, 0.0, p, A, v)
-    ne = module.N_ELEMENTS
-    module.elements(q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 3)))
-    module.elements_hessian(q, np.zeros(ne), p, A)
+    A, B, v = np.empty((n, n)), np.empty((n, n)), np.empty(n)
+    return {
+        "mass_matrix": (q, p, A), "dynamics": (q, q, 0.0, p, A, v), "rhs": (q, q, 0.0, p, v),
+        "energy": (q, q, 0.0, p), "momentum_rate": (q, q, 0.0, p, v),
+        "rhs_jacobian": (q, q, 0.0, p, A, B), "momentum_rate_jacobian": (q, q, 0.0, p, A, B),
+        "mass_matvec_dq": (q, w, p, A),
+        "constraints": (q, q, p, np.empty(m), np.empty((m, n)), np.empty(m)),
+        "constraint_dq": (q, w, lam, p, np.empty((m, n)), A),
+        "elements": (q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))),
+        "elements_hessian": (q, we, p, A),
+        "forward_dynamics": (q, q, 0.0, p, A, v),
+    }
+
+
+def compile_all(module):
+    """Call every kernel a generated module has (its KERNELS, plus forward_dynamics) once on
+    zeros so numba compiles (or loads from its cache) all of them now rather than inside the
+    first simulation step. Kernels a module was generated without are skipped."""
+    args = _kernel_args(module)
+    for name in tuple(getattr(module, "KERNELS", ())) + ("forward_dynamics",):
+        if name not in args:
+            raise GenerationError(f"{module.__file__}: unknown kernel {name!r} (regenerate it)")
+        getattr(module, name)(*args[name])

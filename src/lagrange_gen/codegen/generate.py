@@ -10,6 +10,7 @@ from ..derive import derive
 from ..errors import GenerationError
 from ..model import load_model
 from ..keys import generator_hash, make_key, model_hash, read_key
+from .needs import select_kernels
 from .render import render_module
 from .spec import make_kernels
 from .write import write_if_changed
@@ -26,13 +27,27 @@ def output_path(model_name: str, out_dir) -> Path:
     return Path(out_dir) / f"{model_name}.py"
 
 
-def _command(model_path, out_dir, options):
+def _command(model_path, out_dir, options, methods=None, freeze=None):
+    """The command that regenerates this very module (quoted in stale-module errors)."""
+    from ..steppers.registry import METHODS
     cmd = f"lagrange-gen {model_path}"
     if str(out_dir) != "generated":
         cmd += f" -o {out_dir}"
     for k, v in sorted(options.items()):
         cmd += f" --set {k}={v}"
+    if methods is not None and list(methods) != list(METHODS):
+        cmd += f" --methods {','.join(methods)}"
+    if freeze:
+        cmd += " --freeze " + ",".join(f"{k}={v!r}" for k, v in sorted(freeze.items()))
     return cmd
+
+
+def _options(model, methods, freeze):
+    """Generation options recorded in the module and hashed into its KEY."""
+    options = {"build": dict(sorted(model.build_options.items())), "methods": list(methods)}
+    if freeze:
+        options["freeze"] = dict(sorted(freeze.items()))
+    return options
 
 
 def _methods(requested):
@@ -45,42 +60,48 @@ def _methods(requested):
     return [m for m in METHODS if m in requested]
 
 
-def generate_text(model, out_dir="generated", methods=None):
-    """Return (module text, KEY) for a loaded Model; nothing is written."""
+def generate_text(model, out_dir="generated", methods=None, freeze=None):
+    """Return (module text, KEY, target path) for a loaded Model; nothing is written.
+
+    methods: stepper methods to emit glue for (default all); only the kernels they reach are
+    derived and emitted (codegen.needs). freeze: {parameter: value} folded into the kernels.
+    """
     from ..steppers.registry import glue_source
-    methods = _methods(methods)
-    options = {"build": dict(sorted(model.build_options.items())), "methods": methods}
+    methods, freeze = _methods(methods), dict(sorted((freeze or {}).items()))
+    options = _options(model, methods, freeze)
     model_sha, gen_sha = model_hash(model.source_text), generator_hash()
     key = make_key(model_sha, gen_sha, options)
-    dyn = derive(model)
-    kernels = make_kernels(dyn)
+    dyn = derive(model, freeze=freeze)
+    selected = select_kernels(dyn, methods)
+    kernels = make_kernels(dyn, selected)
     target = output_path(model.name, out_dir)
     source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
     text = render_module(dyn, kernels, key=key, model_sha=model_sha, gen_sha=gen_sha,
                          options=options, source_rel=source_rel,
-                         command=_command(model.source_path, out_dir, model.build_options),
-                         methods=methods, glue="\n\n".join(glue_source(m) for m in methods))
+                         command=_command(model.source_path, out_dir, model.build_options, methods, freeze),
+                         methods=methods, glue="\n\n".join(glue_source(m) for m in methods),
+                         why=selected)
     return text, key, target
 
 
-def generate_model(model_path, out_dir="generated", methods=None, options=None) -> GenerationResult:
+def generate_model(model_path, out_dir="generated", methods=None, options=None,
+                   freeze=None) -> GenerationResult:
     """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched)."""
     model = load_model(model_path, **(options or {}))
-    text, key, target = generate_text(model, out_dir, methods)
+    text, key, target = generate_text(model, out_dir, methods, freeze)
     written = write_if_changed(target, text)
     return GenerationResult(target, written, key)
 
 
-def expected_key(model_path, out_dir="generated", methods=None, options=None):
+def expected_key(model_path, out_dir="generated", methods=None, options=None, freeze=None):
     """(target path, KEY the model would get now) without deriving: for --check."""
     model = load_model(model_path, **(options or {}))
-    methods = _methods(methods)
-    opts = {"build": dict(sorted(model.build_options.items())), "methods": methods}
+    opts = _options(model, _methods(methods), dict(sorted((freeze or {}).items())))
     key = make_key(model_hash(model.source_text), generator_hash(), opts)
     return output_path(model.name, out_dir), key
 
 
-def is_current(model_path, out_dir="generated", methods=None, options=None):
+def is_current(model_path, out_dir="generated", methods=None, options=None, freeze=None):
     """(target, True when target exists and carries the KEY the model would get now)."""
-    target, key = expected_key(model_path, out_dir, methods, options)
+    target, key = expected_key(model_path, out_dir, methods, options, freeze)
     return target, read_key(target) == key

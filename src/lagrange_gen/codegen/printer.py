@@ -1,4 +1,8 @@
-"""Print sympy expressions as numba-friendly Python: coordinates become q[i], parameters p[k]."""
+"""Print sympy expressions as numba-friendly Python over placeholder locals (q_0, qd_1, p_2, t).
+
+Inputs maps a model's symbols to those placeholders and to the statements that load them from
+the kernel's argument arrays (q_0 = q[0]); KernelPrinter prints any Symbol by its name.
+"""
 
 from __future__ import annotations
 
@@ -8,19 +12,16 @@ from sympy.printing.pycode import PythonCodePrinter
 
 
 class KernelPrinter(PythonCodePrinter):
-    """PythonCodePrinter with a symbol table (symbol -> array element text) and math.* calls."""
+    """PythonCodePrinter with math.* calls; Symbols (placeholders, CSE temporaries) by name.
 
-    def __init__(self, names):
-        super().__init__({"fully_qualified_modules": True, "standard": "python3"})
-        self._names = names
+    order="none": Add terms in sympy's canonical args order (deterministic) instead of sorting
+    every sum for display, which was a third of the printing time of large kernels."""
+
+    def __init__(self):
+        super().__init__({"fully_qualified_modules": True, "standard": "python3", "order": "none"})
 
     def _print_Symbol(self, expr):
-        name = self._names.get(expr)
-        if name is None:
-            return expr.name  # a CSE temporary
-        return name
-
-    _print_Coordinate = _print_Velocity = _print_Parameter = _print_Symbol
+        return expr.name
 
     def _print_Rational(self, expr):
         return f"{float(expr)!r}"
@@ -44,20 +45,24 @@ class KernelPrinter(PythonCodePrinter):
         return super()._print_Pow(expr, rational=rational)
 
 
-def symbol_table(dyn):
-    """Map every sympy symbol a kernel may see to its array-element text."""
-    names = {}
-    for i, s in enumerate(dyn.q):
-        names[s] = f"q[{i}]"
-    for i, s in enumerate(dyn.qd):
-        names[s] = f"qd[{i}]"
-    for k, s in enumerate(dyn.params):
-        names[s] = f"p[{k}]"
-    for i, s in enumerate(dyn.aux["w"]):
-        names[s] = f"w[{i}]"
-    for i, s in enumerate(dyn.aux["lam"]):
-        names[s] = f"lam[{i}]"
-    for i, s in enumerate(dyn.aux.get("we", [])):
-        names[s] = f"we[{i}]"
-    names[dyn.t] = "t"
-    return names
+class Inputs:
+    """The input symbols of a model's kernels and their placeholders.
+
+    rename: {model symbol: placeholder name}; loads(args): [(placeholder, load text)] for the
+    kernel arguments ``args`` in order, e.g. ("q_0", "q[0]"); ``t`` is a scalar argument.
+    """
+
+    _VECTORS = ("q", "qd", "p", "w", "lam", "we")
+
+    def __init__(self, dyn):
+        symbols = {"q": dyn.q, "qd": dyn.qd, "p": dyn.params, "w": dyn.aux["w"],
+                   "lam": dyn.aux["lam"], "we": dyn.aux.get("we", [])}
+        self.rename = {dyn.t: "t"}
+        self._loads = {}
+        for arg in self._VECTORS:
+            self._loads[arg] = [(f"{arg}_{i}", f"{arg}[{i}]") for i in range(len(symbols[arg]))]
+            for i, s in enumerate(symbols[arg]):
+                self.rename[s] = f"{arg}_{i}"
+
+    def loads(self, args):
+        return [pair for arg in args for pair in self._loads.get(arg, [])]

@@ -45,37 +45,65 @@ class KernelSpec:
     doc: str = ""
 
 
-def make_kernels(dyn) -> list[KernelSpec]:
-    """The symbolic kernels of a model, in a fixed order (see DESIGN.md section 5)."""
-    jac = dyn.jac
-    kernels = [
-        KernelSpec("mass_matrix", ["q", "p"], [Output("H", dyn.H, symmetric=True)],
-                   doc="H(q) (n, n), the generalized inertia"),
-        KernelSpec("dynamics", ["q", "qd", "t", "p"],
-                   [Output("H", dyn.H, symmetric=True), Output("rhs", dyn.rhs)],
-                   doc="H(q) (n, n) and rhs = Q - h - g (n,), so that H qddot = rhs"),
-        KernelSpec("energy", ["q", "qd", "t", "p"], result=dyn.E, doc="E = T + V (scalar)"),
-        KernelSpec("momentum_rate", ["q", "qd", "t", "p"], [Output("out", dyn.momentum_rate)],
-                   doc="dp/dt = dT/dq - dV/dq + Q (n,) for p = H(q) qd"),
-        KernelSpec("rhs_jacobian", ["q", "qd", "t", "p"],
-                   [Output("Jq", jac["drhs_dq"]), Output("Jqd", jac["drhs_dqd"])],
-                   doc="d rhs/dq and d rhs/dqd (n, n)"),
-        KernelSpec("momentum_rate_jacobian", ["q", "qd", "t", "p"],
-                   [Output("Jq", jac["dmom_dq"]), Output("Jqd", jac["dmom_dqd"])],
-                   doc="d(dp/dt)/dq and d(dp/dt)/dqd (n, n)"),
-        KernelSpec("mass_matvec_dq", ["q", "w", "p"], [Output("out_mat", jac["dHw_dq"])],
-                   doc="d(H(q) w)/dq (n, n) for a vector w (n,)"),
-        KernelSpec("constraints", ["q", "qd", "p"],
-                   [Output("phi", dyn.Phi), Output("J", dyn.J), Output("gamma", dyn.gamma)],
-                   doc="Phi(q) (m,), J = dPhi/dq (m, n), gamma = -(dJ/dt) qd (m,)"),
-        KernelSpec("constraint_dq", ["q", "w", "lam", "p"],
-                   [Output("dJw", jac["dJw_dq"]), Output("dJTlam", jac["dJTlam_dq"], symmetric=True)],
-                   doc="d(J w)/dq (m, n) and d(J^T lam)/dq (n, n)"),
-        KernelSpec("elements", ["q", "p"],
-                   [Output("s", dyn.elem_s), Output("G", dyn.elem_grad), Output("coef", dyn.elem_coef)],
-                   doc="nonsmooth elements: strains s (ne,), gradients G = ds/dq (ne, n), "
-                       "coef (ne, 3) = (stiffness, threshold, 0) or (friction bound, 0, 1)"),
-        KernelSpec("elements_hessian", ["q", "we", "p"], [Output("out_mat", dyn.elem_hess_w, symmetric=True)],
-                   doc="sum_e we[e] d2 s_e/dq2 (n, n) for weights we (ne,)"),
-    ]
-    return kernels
+#: Kernels every generated module has, whatever the methods: forward_dynamics/accelerations
+#: (dynamics), the saved energy (energy) and the Legendre transform (mass_matrix).
+CORE_KERNELS = ("mass_matrix", "dynamics", "energy")
+
+
+def kernel_table(dyn) -> dict:
+    """{kernel name: function returning its KernelSpec}, in the fixed order of DESIGN.md
+    section 5. Specs are built on demand: a Jacobian is only derived when its kernel is emitted."""
+    nat, jac = dyn.native, dyn.jac.native
+    table = {
+        "mass_matrix": lambda: KernelSpec("mass_matrix", ["q", "p"], [Output("H", nat["H"], symmetric=True)],
+                                          doc="H(q) (n, n), the generalized inertia"),
+        "dynamics": lambda: KernelSpec(
+            "dynamics", ["q", "qd", "t", "p"], [Output("H", nat["H"], symmetric=True), Output("rhs", nat["rhs"])],
+            doc="H(q) (n, n) and rhs = Q - h - g (n,), so that H qddot = rhs"),
+        "rhs": lambda: KernelSpec("rhs", ["q", "qd", "t", "p"], [Output("out", nat["rhs"])],
+                                  doc="rhs = Q - h - g (n,) alone (for a constant, pre-factored H)"),
+        "energy": lambda: KernelSpec("energy", ["q", "qd", "t", "p"], result=nat["E"], doc="E = T + V (scalar)"),
+        "momentum_rate": lambda: KernelSpec("momentum_rate", ["q", "qd", "t", "p"], [Output("out", nat["momentum_rate"])],
+                                            doc="dp/dt = dT/dq - dV/dq + Q (n,) for p = H(q) qd"),
+        "rhs_jacobian": lambda: KernelSpec(
+            "rhs_jacobian", ["q", "qd", "t", "p"], [Output("Jq", jac("drhs_dq")), Output("Jqd", jac("drhs_dqd"))],
+            doc="d rhs/dq and d rhs/dqd (n, n)"),
+        "momentum_rate_jacobian": lambda: KernelSpec(
+            "momentum_rate_jacobian", ["q", "qd", "t", "p"], [Output("Jq", jac("dmom_dq")), Output("Jqd", jac("dmom_dqd"))],
+            doc="d(dp/dt)/dq and d(dp/dt)/dqd (n, n)"),
+        "mass_matvec_dq": lambda: KernelSpec("mass_matvec_dq", ["q", "w", "p"], [Output("out_mat", jac("dHw_dq"))],
+                                             doc="d(H(q) w)/dq (n, n) for a vector w (n,)"),
+        "constraints": lambda: KernelSpec(
+            "constraints", ["q", "qd", "p"],
+            [Output("phi", nat["Phi"]), Output("J", nat["J"]), Output("gamma", nat["gamma"])],
+            doc="Phi(q) (m,), J = dPhi/dq (m, n), gamma = -(dJ/dt) qd (m,)"),
+        "constraint_dq": lambda: KernelSpec(
+            "constraint_dq", ["q", "w", "lam", "p"],
+            [Output("dJw", jac("dJw_dq")), Output("dJTlam", jac("dJTlam_dq"), symmetric=True)],
+            doc="d(J w)/dq (m, n) and d(J^T lam)/dq (n, n)"),
+        "elements": lambda: KernelSpec(
+            "elements", ["q", "p"],
+            [Output("s", nat["elem_s"]), Output("G", nat["elem_grad"]), Output("coef", nat["elem_coef"])],
+            doc="nonsmooth elements: strains s (ne,), gradients G = ds/dq (ne, n), "
+                "coef (ne, 3) = (stiffness, threshold, 0) or (friction bound, 0, 1)"),
+        "elements_hessian": lambda: KernelSpec(
+            "elements_hessian", ["q", "we", "p"], [Output("out_mat", nat["elem_hess_w"], symmetric=True)],
+            doc="sum_e we[e] d2 s_e/dq2 (n, n) for weights we (ne,)"),
+    }
+    return table
+
+
+def default_kernels(dyn) -> tuple:
+    """The kernels of a module generated for every method: all of kernel_table except ``rhs``,
+    which is added only for a constant mass matrix (forward dynamics with a pre-factored H)."""
+    return tuple(k for k in kernel_table(dyn) if k != "rhs" or dyn.mass_is_constant)
+
+
+def make_kernels(dyn, names=None) -> list[KernelSpec]:
+    """KernelSpecs of ``names`` (default: default_kernels) in the fixed table order."""
+    table = kernel_table(dyn)
+    wanted = set(default_kernels(dyn) if names is None else names)
+    unknown = sorted(wanted - set(table))
+    if unknown:
+        raise KeyError(f"no kernel named {', '.join(unknown)}")
+    return [build() for name, build in table.items() if name in wanted]

@@ -2,20 +2,23 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import sympy as sp
 
 from ..model import Model, t as time_symbol
+from .backend import ops
 from .constraints import derive_constraints
 from .elements import derive_elements
-from .jacobians import derive_jacobians
+from .freeze import freeze_model
+from .jacobians import Jacobians
 from .lagrangian import derive_lagrangian
 
+#: Fields readable as sympy objects (converted from the backend's native objects on first read).
+FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma",
+          "elem_s", "elem_grad", "elem_coef", "elem_hess_w")
 
-@dataclass
+
 class Dynamics:
-    """Everything the generator prints, as sympy objects.
+    """Everything the generator prints.
 
     Shapes (n coordinates, m constraints): H (n, n); h, g, Q, rhs, dTdq, momentum_rate (n, 1);
     Phi (m, 1); J (m, n); gamma (m, 1); E scalar. Jacobian matrices are (n, n) unless noted.
@@ -23,30 +26,32 @@ class Dynamics:
     rhs = Q - h - g (smooth forces only: nonsmooth element forces are the steppers' business).
     Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 3),
     elem_hess_w (n, n). ``momentum_rate`` = dT/dq - dV/dq + Q is dp/dt for p = H qdot.
+
+    Each field is a sympy Matrix (or Expr) built from ``native[field]`` when first read; code
+    generation reads ``native`` and ``jac.native(name)`` and never pays for the conversion.
+    ``model`` is the model as derived (frozen parameters substituted; ``frozen`` {name: value}).
     """
 
-    model: Model
-    q: list
-    qd: list
-    params: list
-    t: sp.Symbol
-    H: sp.Matrix
-    h: sp.Matrix
-    g: sp.Matrix
-    Q: sp.Matrix
-    rhs: sp.Matrix
-    dTdq: sp.Matrix
-    momentum_rate: sp.Matrix
-    E: sp.Expr
-    Phi: sp.Matrix
-    J: sp.Matrix
-    gamma: sp.Matrix
-    elem_s: sp.Matrix = None
-    elem_grad: sp.Matrix = None
-    elem_coef: sp.Matrix = None
-    elem_hess_w: sp.Matrix = None
-    jac: dict = field(default_factory=dict)
-    aux: dict = field(default_factory=dict)   # auxiliary input vectors (w, lam) by name
+    def __init__(self, model, ops_, native, jac_parts, aux, frozen):
+        self.model, self.ops, self.native, self.aux, self.frozen = model, ops_, native, aux, frozen
+        self.q, self.qd = list(model.coords), list(model.velocities)
+        self.params, self.t = list(model.params), time_symbol
+        self._names = {s.name: s for s in self.q + self.qd + self.params + [time_symbol]}
+        self._names.update({s.name: s for v in aux.values() for s in v})
+        o = ops_
+        self.jac = Jacobians(o, jac_parts, o.symbols(self.q), o.symbols(self.qd),
+                             o.symbols(aux["w"]), o.symbols(aux["lam"]), self.to_sympy)
+        self._sympy = {}
+
+    def to_sympy(self, obj):
+        return self.ops.to_sympy(obj, self._names)
+
+    def __getattr__(self, name):
+        if name in FIELDS:
+            if name not in self._sympy:
+                self._sympy[name] = self.to_sympy(self.native[name])
+            return self._sympy[name]
+        raise AttributeError(name)
 
     @property
     def n(self):
@@ -54,33 +59,39 @@ class Dynamics:
 
     @property
     def m(self):
-        return self.Phi.shape[0]
+        return self.native["Phi"].shape[0]
 
     @property
     def n_elements(self):
-        return self.elem_s.shape[0]
+        return self.native["elem_s"].shape[0]
 
     @property
     def mass_is_constant(self):
-        return not (self.H.free_symbols & set(self.q))
+        return not ({str(s) for s in self.native["H"].free_symbols} & {s.name for s in self.q})
 
     @property
     def forces_velocity_free(self):
-        return not (self.rhs.free_symbols & set(self.qd))
+        return not ({str(s) for s in self.native["rhs"].free_symbols} & {s.name for s in self.qd})
 
 
-def derive(model: Model, check_samples: int = 8) -> Dynamics:
-    """Derive H, h, g, Q, constraints, energy and Newton Jacobians of a model.
+def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
+    """Derive H, h, g, Q, constraints, energy (and, on demand, Newton Jacobians) of a model.
 
     ``check_samples`` random states are used to check that T is quadratic in the velocities and
-    H positive definite (ModelError naming the state otherwise).
+    H positive definite (ModelError naming the state otherwise). ``freeze`` {parameter name:
+    value} substitutes those parameters by numbers before anything is derived.
     """
-    parts = derive_lagrangian(model, check_samples=check_samples)
-    cons = derive_constraints(model)
-    dyn = Dynamics(model=model, q=list(model.coords), qd=list(model.velocities),
-                   params=list(model.params), t=time_symbol, **parts, **cons)
-    dyn.jac, dyn.aux = derive_jacobians(dyn)
-    dyn.aux["we"] = list(sp.symbols(f"we_0:{len(model.elements)}", real=True))
-    for key, value in derive_elements(model, dyn.aux["we"]).items():
-        setattr(dyn, key, value)
-    return dyn
+    frozen = dict(freeze or {})
+    model = freeze_model(model, frozen) if frozen else model
+    o = ops()
+    parts = derive_lagrangian(model, o, check_samples=check_samples)
+    q = o.symbols(model.coords)
+    parts.update(derive_constraints(model, o, q))
+    n, m = len(model.coords), len(model.constraints)
+    aux = {"w": list(sp.symbols(f"w_0:{n}", real=True)) if n else [],
+           "lam": list(sp.symbols(f"lam_0:{m}", real=True)) if m else [],
+           "we": list(sp.symbols(f"we_0:{len(model.elements)}", real=True))}
+    for key, value in derive_elements(model, aux["we"]).items():
+        parts[key] = o.matrix(*value.shape, list(value))
+    native = {k: parts[k] for k in FIELDS}
+    return Dynamics(model, o, native, parts, aux, frozen)

@@ -1,38 +1,89 @@
-"""Derivatives that Newton-based steppers need, all exact (no finite differences)."""
+"""Derivatives that Newton-based steppers need, all exact (no finite differences), each built
+only when a kernel that needs it is emitted (see Jacobians)."""
 
 from __future__ import annotations
 
-import sympy as sp
+from collections.abc import Mapping
 
-from .backend import jacobian
+from .lagrangian import _dot
+
+#: name -> what it is (shapes for n coordinates, m constraints).
+JACOBIANS = {
+    "drhs_dq": "d rhs/dq (n, n) of rhs = Q - h - g",
+    "drhs_dqd": "d rhs/dqd (n, n), from dH/dq: dQ/dqd - (D + Hdot - D^T), D_jl = (dH/dq_l qd)_j",
+    "dmom_dq": "d momentum_rate/dq (n, n) of momentum_rate = dT/dq - dV/dq + Q",
+    "dmom_dqd": "d momentum_rate/dqd (n, n) = D^T + dQ/dqd",
+    "dHw_dq": "d(H(q) w)/dq (n, n) for an input vector w",
+    "dJw_dq": "d(J(q) w)/dq (m, n)",
+    "dJTlam_dq": "d(J(q)^T lam)/dq (n, n), symmetric",
+}
 
 
-def derive_jacobians(dyn):
-    """Return (jacobians, auxiliary symbols).
+class Jacobians(Mapping):
+    """The Jacobians by name (JACOBIANS), built on first access and kept.
 
-    jacobians (by name, shapes for n coordinates, m constraints):
-      drhs_dq, drhs_dqd (n, n)   of rhs = Q - h - g
-      dmom_dq, dmom_dqd (n, n)   of momentum_rate = dT/dq - dV/dq + Q
-      dHw_dq (n, n)              d(H(q) w)/dq for an input vector w
-      dJw_dq (m, n)              d(J(q) w)/dq
-      dJTlam_dq (n, n)           d(J(q)^T lam)/dq, symmetric
-    auxiliary symbols: {"w": [n symbols], "lam": [m symbols]} that become kernel inputs.
+    ``native(name)`` gives the backend's matrix (for code generation), ``self[name]`` the sympy
+    Matrix. Velocity Jacobians are assembled from the first derivatives dH/dq_i and d2Phi/dq2
+    that the derivation already has; only d/dq of rhs and momentum_rate differentiates again.
     """
-    q, qd = dyn.q, dyn.qd
-    n, m = len(q), dyn.Phi.shape[0]
-    w = sp.Matrix(sp.symbols(f"w_0:{n}", real=True)) if n else sp.zeros(0, 1)
-    lam = sp.Matrix(sp.symbols(f"lam_0:{m}", real=True)) if m else sp.zeros(0, 1)
-    jac = {
-        "drhs_dq": jacobian(dyn.rhs, q),
-        "drhs_dqd": jacobian(dyn.rhs, qd),
-        "dmom_dq": jacobian(dyn.momentum_rate, q),
-        "dmom_dqd": jacobian(dyn.momentum_rate, qd),
-        "dHw_dq": jacobian(dyn.H * w, q),
-    }
-    if m:
-        jac["dJw_dq"] = jacobian(dyn.J * w, q)
-        jac["dJTlam_dq"] = jacobian(dyn.J.T * lam, q)
-    else:
-        jac["dJw_dq"] = sp.zeros(0, n)
-        jac["dJTlam_dq"] = sp.zeros(n, n)
-    return jac, {"w": list(w), "lam": list(lam)}
+
+    def __init__(self, o, parts, q, qd, w, lam, to_sympy):
+        self._o, self._p = o, parts
+        self._q, self._qd, self._w, self._lam = q, qd, w, lam
+        self._to_sympy = to_sympy
+        self._native, self._sympy = {}, {}
+
+    def native(self, name):
+        if name not in self._native:
+            if name not in JACOBIANS:
+                raise KeyError(name)
+            self._native[name] = getattr(self, f"_{name}")()
+        return self._native[name]
+
+    def __getitem__(self, name):
+        if name not in self._sympy:
+            self._sympy[name] = self._to_sympy(self.native(name))
+        return self._sympy[name]
+
+    def __iter__(self):
+        return iter(JACOBIANS)
+
+    def __len__(self):
+        return len(JACOBIANS)
+
+    def _contract(self, rows, cols, entry):
+        return self._o.matrix(rows, cols, [entry(j, l) for j in range(rows) for l in range(cols)])
+
+    def _D(self, vec):
+        """D(vec)_jl = sum_k dH/dq_l[j, k] vec_k = d(H vec)/dq with vec held fixed (n, n)."""
+        dH, n, zero = self._p["dH"], len(self._q), self._o.native(0)
+        return self._contract(n, n, lambda j, l: _dot([dH[l][j, k] for k in range(n)], vec, zero))
+
+    def _dQ_dqd(self):
+        return self._o.jacobian(self._p["Q"], self._qd)
+
+    def _drhs_dq(self):
+        return self._o.jacobian(self._p["rhs"], self._q)
+
+    def _drhs_dqd(self):
+        D, Hdot, dQ = self._D(self._qd), self._p["Hdot"], self._dQ_dqd()
+        n = len(self._q)
+        return self._contract(n, n, lambda j, l: dQ[j, l] - (D[j, l] + Hdot[j, l] - D[l, j]))
+
+    def _dmom_dq(self):
+        return self._o.jacobian(self._p["momentum_rate"], self._q)
+
+    def _dmom_dqd(self):
+        D, dQ, n = self._D(self._qd), self._dQ_dqd(), len(self._q)
+        return self._contract(n, n, lambda j, l: D[l, j] + dQ[j, l])
+
+    def _dHw_dq(self):
+        return self._D(self._w)
+
+    def _dJw_dq(self):
+        d2, n, zero = self._p["d2Phi"], len(self._q), self._o.native(0)
+        return self._contract(len(d2), n, lambda i, l: _dot([d2[i][k, l] for k in range(n)], self._w, zero))
+
+    def _dJTlam_dq(self):
+        d2, n, zero = self._p["d2Phi"], len(self._q), self._o.native(0)
+        return self._contract(n, n, lambda k, l: _dot([d2[i][k, l] for i in range(len(d2))], self._lam, zero))

@@ -1,49 +1,78 @@
-"""H, h (Christoffel form), g, Q, energy: the unconstrained Lagrangian part."""
+"""H, h (Christoffel form), g, Q, energy: the unconstrained Lagrangian part, in native objects."""
 
 from __future__ import annotations
 
 import numpy as np
-import sympy as sp
 
 from ..errors import ModelError
-from .backend import gradient, jacobian
+from .backend import Mat
 
 
-def derive_lagrangian(model, check_samples=8):
-    """Return a dict with H, h, g, Q, rhs, dTdq, momentum_rate, E (see Dynamics).
+def derive_lagrangian(model, o, check_samples=8):
+    """Return a dict of native objects: H (n, n); h, g, Q, rhs, dTdq, momentum_rate (n, 1);
+    E; and dH, the list of the n matrices dH/dq_i (n, n), for the Jacobians.
 
     H = d2T/dqdot2 is checked free of velocities and time (T quadratic, scleronomic) and then
     checked numerically: T = 1/2 qdot^T H qdot and H positive definite at random states.
     h_j = sum_ik (dH_jk/dq_i - 1/2 dH_ik/dq_j) qdot_i qdot_k is assembled from the n matrices
-    dH/dq_i computed once; no symbolic inverse, no global simplify.
+    dH/dq_i computed once, as h = Hdot qdot - dT/dq with Hdot_jk = sum_i dH_jk/dq_i qdot_i kept
+    as a nested sum (never expanded): no symbolic inverse, no global simplify.
     """
-    q, qd = list(model.coords), list(model.velocities)
+    q, qd = o.symbols(model.coords), o.symbols(model.velocities)
     n = len(q)
-    qd_vec = sp.Matrix(qd)
-    H = jacobian(gradient(model.T, qd), qd)
-    H = sp.Matrix(n, n, lambda i, j: H[min(i, j), max(i, j)])   # exactly symmetric
-    bad = sorted(str(s) for s in H.free_symbols & set(qd))
+    T, V = o.native(model.T), o.native(model.V)
+    H = _mass_matrix(model, o, T, qd)
+    _check_quadratic_and_definite(model, o, H, T, check_samples)
+    dH = [o.matrix(n, n, [H[j, k].diff(qi) for j in range(n) for k in range(n)]) for qi in q]
+    zero = o.native(0)
+    Hdot = o.matrix(n, n, [_dot([dH[i][j, k] for i in range(n)], qd, zero)
+                           for j in range(n) for k in range(n)])
+    dTdq = [_quadratic(dH[j], qd, zero) / 2 for j in range(n)]
+    h = [_dot([Hdot[j, k] for k in range(n)], qd, zero) - dTdq[j] for j in range(n)]
+    g = [V.diff(qi) for qi in q]
+    D = o.native(model.dissipation)
+    Q = [o.native(f) - D.diff(v) for f, v in zip(model.forces, qd)]
+    col = o.column
+    return dict(H=H, h=col(h), g=col(g), Q=col(Q), rhs=col([Q[j] - h[j] - g[j] for j in range(n)]),
+                dTdq=col(dTdq), momentum_rate=col([dTdq[j] - g[j] + Q[j] for j in range(n)]),
+                E=T + V, dH=dH, Hdot=Hdot)
+
+
+def _mass_matrix(model, o, T, qd):
+    """H = d2T/dqdot2 (n, n), exactly symmetric (upper triangle mirrored); ModelError if it
+    still depends on a velocity."""
+    n = len(qd)
+    grad = [T.diff(v) for v in qd]
+    upper = {(j, k): grad[j].diff(qd[k]) for j in range(n) for k in range(j, n)}
+    H = o.matrix(n, n, [upper[min(j, k), max(j, k)] for j in range(n) for k in range(n)])
+    names = {s.name for s in model.velocities}
+    bad = sorted(str(s) for s in H.free_symbols if str(s) in names)
     if bad:
         raise ModelError(f"model {model.name}: T is not quadratic in the velocities "
                          f"(d2T/dqdot2 still depends on {', '.join(bad)})")
-    _check_quadratic_and_definite(model, H, check_samples)
+    return H
 
-    # dH/dq_i for all i from one Jacobian of the upper triangle of H.
-    upper = [(j, k) for j in range(n) for k in range(j, n)]
-    dU = jacobian([H[j, k] for j, k in upper], q)
-    dH = [sp.zeros(n, n) for _ in range(n)]
-    for row, (j, k) in enumerate(upper):
-        for i in range(n):
-            dH[i][j, k] = dH[i][k, j] = dU[row, i]
-    Hdot = sp.zeros(n, n)
+
+def _sum(terms, zero):
+    return sum(terms[1:], terms[0]) if terms else zero
+
+
+def _dot(coeffs, vec, zero):
+    """sum_i coeffs_i vec_i over the nonzero coefficients (structural zeros skipped)."""
+    return _sum([c * v for c, v in zip(coeffs, vec) if c != 0], zero)
+
+
+def _quadratic(M: Mat, vec, zero):
+    """vec^T M vec for symmetric M, summing the upper triangle once (off-diagonal doubled)."""
+    n = len(vec)
+    terms = []
     for i in range(n):
-        Hdot += dH[i] * qd[i]
-    dTdq = sp.Matrix([(qd_vec.T * dH[j] * qd_vec)[0, 0] / 2 for j in range(n)])
-    h = Hdot * qd_vec - dTdq
-    g = gradient(model.V, q)
-    Q = sp.Matrix(model.forces) - gradient(model.dissipation, qd)
-    return dict(H=H, h=h, g=g, Q=Q, rhs=Q - h - g, dTdq=dTdq, momentum_rate=dTdq - g + Q,
-                E=model.T + model.V)
+        if M[i, i] != 0:
+            terms.append(M[i, i] * vec[i] ** 2)
+        for k in range(i + 1, n):
+            if M[i, k] != 0:
+                terms.append(2 * M[i, k] * vec[i] * vec[k])
+    return _sum(terms, zero)
 
 
 def sample_values(model):
@@ -51,29 +80,29 @@ def sample_values(model):
     return [1.0 if d is None else d for d in model.defaults()]
 
 
-def _check_quadratic_and_definite(model, H, samples):
-    """Numeric checks at random states; they name the first state that fails."""
+def _check_quadratic_and_definite(model, o, H, T, samples):
+    """Numeric checks at random states; they name the first state that fails. T and H are
+    evaluated separately (no symbolic qdot^T H qdot, which costs n^2 products)."""
     if samples <= 0:
         return
-    q, qd, params = list(model.coords), list(model.velocities), list(model.params)
+    n = len(model.coords)
+    args = o.symbols(list(model.coords) + list(model.velocities) + list(model.params))
+    f_T, f_H = o.lambdify(args, [T]), o.lambdify(args, list(H))
     rng = np.random.default_rng(20261122)
     pvals = sample_values(model)
-    f_H = sp.lambdify([q, params], H, modules="numpy")
-    residual = model.T - (sp.Matrix(qd).T * H * sp.Matrix(qd))[0, 0] / 2
-    f_res = sp.lambdify([q, qd, params], residual, modules="numpy")
     for _ in range(samples):
-        qs = rng.uniform(-np.pi, np.pi, len(q))
-        vs = rng.uniform(-1.0, 1.0, len(q))
-        state = ", ".join(f"{c}={v:.3g}" for c, v in zip(q, qs))
-        Hs = np.array(f_H(qs, pvals), dtype=float)
-        scale = 1.0 + abs(f_res(qs, np.zeros(len(q)), pvals)) + np.abs(Hs).max()
-        if abs(f_res(qs, vs, pvals)) > 1e-9 * scale:
+        qs, vs = rng.uniform(-np.pi, np.pi, n), rng.uniform(-1.0, 1.0, n)
+        state = ", ".join(f"{c}={v:.3g}" for c, v in zip(model.coords, qs))
+        Hs = np.asarray(f_H([*qs, *vs, *pvals]), dtype=float).reshape(n, n)
+        t_rest = f_T([*qs, *np.zeros(n), *pvals])[0]
+        scale = 1.0 + abs(t_rest) + np.abs(Hs).max()
+        if abs(f_T([*qs, *vs, *pvals])[0] - vs @ Hs @ vs / 2) > 1e-9 * scale:
             raise ModelError(f"model {model.name}: T is not a quadratic form in the velocities "
                              f"(T != 1/2 qdot^T H qdot at {state}); linear or velocity-free terms are not supported")
         try:
             np.linalg.cholesky(Hs)
         except np.linalg.LinAlgError:
             eig = np.linalg.eigvalsh(Hs)
-            weakest = q[int(np.argmin(np.abs(np.diag(Hs))))]
+            weakest = model.coords[int(np.argmin(np.abs(np.diag(Hs))))]
             raise ModelError(f"model {model.name}: H = d2T/dqdot2 is not positive definite at {state} "
                              f"(smallest eigenvalue {eig.min():.3g}; check the terms in {weakest}.d)") from None

@@ -1,0 +1,152 @@
+"""Which generated kernels a stepper method needs, read from the steppers' source (AST).
+
+A stepper core reaches the generated module only as ``kern`` (see steppers/base.py), so the
+kernels a method needs are the attributes ``kern.<name>`` accessed by the functions of
+``steppers/<method>.py`` and, transitively, by every function of the package they call
+(``from .base import accel``, ``verlet.step`` through ``from . import verlet``, ...). Reading
+the source instead of keeping a table means a newly added method (rattle, spook, ...) is
+specialized correctly without touching the generator. The analysis is conservative: a kernel
+used on any branch counts (numba types every branch, so it must exist to compile).
+"""
+
+from __future__ import annotations
+
+import ast
+from functools import lru_cache
+from pathlib import Path
+
+_PACKAGE = Path(__file__).resolve().parent.parent     # src/lagrange_gen
+_KERN = "kern"                                         # the parameter naming the generated module
+
+
+def method_needs(method: str) -> frozenset:
+    """Names ``kern.<name>`` used by ``steppers/<method>.py`` and everything it calls."""
+    module = f"steppers.{method}"
+    roots = [(module, name) for name in _parse(module).functions]
+    seen, needs = set(), set()
+    while roots:
+        key = roots.pop()
+        if key in seen:
+            continue
+        seen.add(key)
+        info = _parse(key[0])
+        fn = info.functions.get(key[1])
+        if fn is None:
+            continue
+        needs |= fn.kern_attrs
+        roots += [target for target in (info.resolve(c) for c in fn.calls) if target]
+    return frozenset(needs)
+
+
+def methods_needs(methods) -> dict:
+    """{method: sorted tuple of kern attributes} for several methods."""
+    return {m: tuple(sorted(method_needs(m))) for m in methods}
+
+
+class _Function:
+    def __init__(self, node):
+        self.kern_attrs, self.calls = set(), []
+        for sub in ast.walk(node):
+            if isinstance(sub, ast.Attribute) and isinstance(sub.value, ast.Name) and sub.value.id == _KERN:
+                self.kern_attrs.add(sub.attr)
+            elif isinstance(sub, ast.Call):
+                if isinstance(sub.func, ast.Name):
+                    self.calls.append((None, sub.func.id))
+                elif isinstance(sub.func, ast.Attribute) and isinstance(sub.func.value, ast.Name):
+                    self.calls.append((sub.func.value.id, sub.func.attr))
+
+
+class _Module:
+    """Top-level functions of one package module and its imports, for call resolution."""
+
+    def __init__(self, dotted, tree):
+        self.dotted = dotted
+        self.functions = {n.name: _Function(n) for n in tree.body if isinstance(n, ast.FunctionDef)}
+        self.names, self.modules = {}, {}   # imported function name -> module; alias -> module
+        for node in tree.body:
+            if isinstance(node, ast.ImportFrom) and node.level:
+                base = _relative(dotted, node.level, node.module)
+                for alias in node.names:
+                    child = f"{base}.{alias.name}" if base else alias.name
+                    if _path(child) is not None:
+                        self.modules[alias.asname or alias.name] = child
+                    else:
+                        self.names[alias.asname or alias.name] = (base, alias.name)
+
+    def resolve(self, call):
+        """(module, function) a call refers to inside the package, or None."""
+        owner, name = call
+        if owner is None:
+            if name in self.functions:
+                return self.dotted, name
+            return self.names.get(name)
+        if owner in self.modules:
+            return self.modules[owner], name
+        return None
+
+
+def _relative(dotted, level, module):
+    parts = dotted.split(".")[:-level] if level <= dotted.count(".") + 1 else []
+    if module:
+        parts += module.split(".")
+    return ".".join(parts)
+
+
+def _path(dotted):
+    """File of a package module given relative to lagrange_gen (None if not a module file)."""
+    path = _PACKAGE.joinpath(*dotted.split(".")) if dotted else _PACKAGE
+    if path.with_suffix(".py").is_file():
+        return path.with_suffix(".py")
+    if (path / "__init__.py").is_file():
+        return path / "__init__.py"
+    return None
+
+
+@lru_cache(maxsize=None)
+def _parse_cached(dotted, mtime):
+    path = _path(dotted)
+    return _Module(dotted, ast.parse(path.read_text(), str(path)))
+
+
+def _parse(dotted):
+    """Parsed module (cached per file modification time: steppers change while we run)."""
+    path = _path(dotted)
+    if path is None:
+        return _Module(dotted, ast.Module(body=[], type_ignores=[]))
+    return _parse_cached(dotted, path.stat().st_mtime_ns)
+
+
+#: Functions every generated module defines besides the kernels (a stepper may call them).
+MODULE_FUNCTIONS = ("forward_dynamics",)
+
+
+def select_kernels(dyn, methods) -> dict:
+    """{kernel name: why it is emitted} for a model and the requested methods, in table order.
+
+    Why: the methods whose steppers reach it (``kern.<name>``), or the Python-side use that
+    every module of this model needs (forward dynamics, saved energy, consistent initial
+    conditions of constrained models, element energy). A method needing a name that is neither
+    a kernel nor a module function is a GenerationError naming both. No methods at all (an
+    empty list, not None) asks for a kernel library without steppers: every kernel is emitted.
+    """
+    from ..errors import GenerationError
+    from .spec import CORE_KERNELS, default_kernels, kernel_table
+    table = kernel_table(dyn)
+    if not methods:
+        return {name: ["no stepper requested: kernel library"] for name in default_kernels(dyn)}
+    why = {name: ["always (forward dynamics, energy, Legendre transform)"] for name in CORE_KERNELS}
+    if dyn.mass_is_constant:
+        why.setdefault("rhs", []).append("constant H: forward dynamics with the factor from import")
+    if dyn.m:
+        why.setdefault("constraints", []).append("constrained model (consistent initial conditions)")
+    if dyn.n_elements:
+        why.setdefault("elements", []).append("model with nonsmooth elements (element energy)")
+    for method, names in methods_needs(methods).items():
+        for name in names:
+            if name.isupper() or name in MODULE_FUNCTIONS:
+                continue           # module constants and functions are always present
+            if name not in table:
+                raise GenerationError(f"stepper {method} uses kern.{name}, which lagrange-gen does not "
+                                      f"generate (kernels: {', '.join(table)})")
+            why.setdefault(name, []).append(method)
+    return {name: why[name] for name in table if name in why}

@@ -1,0 +1,64 @@
+"""Freezing parameters: substitute numbers for some parameters before derivation.
+
+A frozen parameter disappears from the generated module's PARAMS (its value is folded into the
+kernels as a constant, so products like m * g * l shrink to one number) and is recorded in
+FROZEN; passing it at run time is an error (lagrange_gen.params.resolve_params).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import sympy as sp
+
+from ..errors import GenerationError
+
+
+def parse_freeze(text):
+    """'g=9.81,l=1' -> {'g': 9.81, 'l': 1.0} (GenerationError on a malformed item)."""
+    frozen = {}
+    for item in (text or "").split(","):
+        if not item.strip():
+            continue
+        name, sep, value = item.partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not sep or not name.strip() or not math.isfinite(number):
+            raise GenerationError(f"--freeze {item.strip()}: expected NAME=NUMBER (finite), e.g. g=9.81")
+        frozen[name.strip()] = number
+    return frozen
+
+
+def freeze_model(model, frozen):
+    """A copy of ``model`` with the parameters named in ``frozen`` replaced by their values.
+
+    The copy's params and defaults no longer list them; every expression (T, V, dissipation,
+    forces, constraints, element strains and coefficients) has them substituted.
+    """
+    by_name = {p.name: p for p in model.params}
+    unknown = sorted(set(frozen) - set(by_name))
+    if unknown:
+        raise GenerationError(f"model {model.name}: cannot freeze {', '.join(unknown)}: not a parameter "
+                              f"(parameters: {', '.join(by_name) or 'none'})")
+    sub = {by_name[k]: sp.Float(v) if v != int(v) else sp.Integer(int(v)) for k, v in frozen.items()}
+    out = copy.copy(model)
+    out.T, out.V = model.T.xreplace(sub), model.V.xreplace(sub)
+    out.dissipation = model.dissipation.xreplace(sub)
+    out.forces = [f.xreplace(sub) for f in model.forces]
+    out.constraints = [c.xreplace(sub) for c in model.constraints]
+    out.elements = [_freeze_element(e, sub) for e in model.elements]
+    out.params = [p for p in model.params if p.name not in frozen]
+    out.param_defaults = {k: v for k, v in model.param_defaults.items() if k not in frozen}
+    return out
+
+
+def _freeze_element(element, sub):
+    """A copy of a nonsmooth element with every sympy attribute substituted."""
+    out = copy.copy(element)
+    for key, value in vars(element).items():
+        if isinstance(value, sp.Basic):
+            setattr(out, key, value.xreplace(sub))
+    return out

