@@ -55,3 +55,15 @@ def test_rattle_energy_bounded_on_cartesian_double_pendulum():
     assert err[-tenth:].max() < 1.5 * err[:tenth].max() + 1e-6, (err[:tenth].max(), err[-tenth:].max())
     assert traj.constraint_error.max() < 1e-11
     assert traj.velocity_constraint_error.max() < 1e-11
+
+
+def test_rattle_newton_path_equals_explicit_path():
+    """For constant H the Newton path (generalized RATTLE in (u, w, nu), used for H(q)) is the
+    same scheme as the explicit classical RATTLE: equal to the Newton tolerance."""
+    mod = generated_model("cartesian_pendulum")
+    q0, v0 = pendulum_state(THETA0, OMEGA0)
+    fast = simulate(mod, "rattle", q0, v0, t_end=1.0, h=1e-2)
+    newton = simulate(mod, "rattle", q0, v0, t_end=1.0, h=1e-2, newton_always=True)
+    assert fast.newton_iters.sum() <= 200          # at most two Newton updates per step
+    assert np.abs(fast.q - newton.q).max() < 1e-11
+    assert np.abs(fast.v - newton.v).max() < 1e-10

@@ -41,9 +41,9 @@ LINKAGE_RUNS = (
     ("index1 (rk4, no stabilization)", "index1", {}),
     (f"index1 + Baumgarte alpha = beta = {BAUMGARTE[0]:g}", "index1", {"baumgarte": BAUMGARTE}),
 )
-#: A distance to the rigid pendulum (length 1) above this counts as broken even without a
-#: blow-up past simulate's bound (explicit Euler grows, but slowly).
-WRONG = 0.5
+#: A bob farther than this from the pivot (rest length 1) counts as broken even without a
+#: blow-up past simulate's bound (explicit Euler's energy grows, but slowly).
+WRONG = 10.0
 STIFF_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "composition", "rk4",
                  "midpoint", "implicit_euler", "spook")
 
@@ -111,31 +111,57 @@ def _pendulum(theta, l=1.0):
     return np.array([l * np.sin(theta), -l * np.cos(theta)])
 
 
+def _spring_run(spring, rigid, method, k, t_end):
+    """Trajectory of the stretchable pendulum with stiffness k (spook: the rigid model with
+    compliance 1/k); the stiff mode starts at rest (spring at its static stretch, m = l = 1)."""
+    if method == "spook":
+        return simulate(rigid, "spook", _pendulum(STIFF_THETA0), np.zeros(2), t_end=t_end,
+                        h=STIFF_H, compliance=1.0 / k)
+    q0 = _pendulum(STIFF_THETA0, 1.0 + 9.81 * np.cos(STIFF_THETA0) / k)
+    return simulate(spring, method, q0, np.zeros(2), t_end=t_end, h=STIFF_H, params={"k": k})
+
+
+def _attempt(spring, rigid, method, k, t_end):
+    """(trajectory, '') of the run at stiffness k, or (None, why it broke)."""
+    try:
+        traj = _spring_run(spring, rigid, method, k, t_end)
+    except SimulationError as exc:
+        return None, type(exc).__name__
+    if np.hypot(traj.q[:, 0], traj.q[:, 1]).max() > WRONG:
+        return None, "unbounded"
+    return traj, ""
+
+
+def breaking_stiffness(spring, rigid, method, k_ok, k_bad, t_end, rel=0.01):
+    """Bisection in log k between a stiffness that runs and one that breaks: the breaking k to
+    about ``rel`` relative precision."""
+    while k_bad / k_ok > 1.0 + rel:
+        mid = np.sqrt(k_ok * k_bad)
+        if _attempt(spring, rigid, method, mid, t_end)[1]:
+            k_bad = mid
+        else:
+            k_ok = mid
+    return k_bad
+
+
 def stiffness_scan(spring, rigid, ks, t_end):
     """{method: [(k, distance to rigid rattle or None, failure text)]} and {method: (first k
-    where it fails or strays beyond WRONG, why)}."""
-    q_rigid0 = _pendulum(STIFF_THETA0)
-    ref = simulate(rigid, "rattle", q_rigid0, np.zeros(2), t_end=t_end, h=STIFF_H)
+    where it fails or the bob strays beyond WRONG, why)}."""
+    ref = simulate(rigid, "rattle", _pendulum(STIFF_THETA0), np.zeros(2), t_end=t_end,
+                   h=STIFF_H)
     table, breaks = {}, {}
     for method in STIFF_METHODS:
         table[method] = []
         for k in ks:
-            try:
-                if method == "spook":
-                    traj = simulate(rigid, "spook", q_rigid0, np.zeros(2), t_end=t_end, h=STIFF_H,
-                                    compliance=1.0 / k)
-                else:
-                    # Stiff mode at rest: the spring at its static stretch (m = l = 1).
-                    q0 = _pendulum(STIFF_THETA0, 1.0 + 9.81 * np.cos(STIFF_THETA0) / k)
-                    traj = simulate(spring, method, q0, np.zeros(2), t_end=t_end, h=STIFF_H,
-                                    params={"k": k})
-                dist = float(np.abs(traj.q - ref.q).max())
-                table[method].append((k, dist, ""))
-                if dist > WRONG:
-                    breaks.setdefault(method, (k, "unbounded"))
-            except SimulationError as exc:
-                table[method].append((k, None, type(exc).__name__))
-                breaks.setdefault(method, (k, type(exc).__name__))
+            traj, why = _attempt(spring, rigid, method, k, t_end)
+            if why:
+                table[method].append((k, None, why))
+                if method not in breaks:
+                    k_ok = ks[ks.index(k) - 1] if ks.index(k) else k / 10.0
+                    breaks[method] = (breaking_stiffness(spring, rigid, method, k_ok, k, t_end),
+                                      why)
+                continue
+            table[method].append((k, float(np.abs(traj.q - ref.q).max()), ""))
     return table, breaks
 
 
@@ -179,12 +205,17 @@ def _markdown(linkage, n_link, costs, n_cost, table, breaks, ks, t_end, figure):
               f"{ks[0]:g}..{ks[-1]:g}", "",
               "Distance max_t |q - q_rigid| to the rigid pendulum integrated by rattle at the "
               "same h; spook runs the rigid model with compliance 1/k. The radial mode has "
-              "omega = sqrt(k), so h omega = 2 at k = 4e6.", ""]
-    headers = ["method", "breaks at k"] + [f"{k:.0e}" for k in ks]
+              "omega = sqrt(k), so h omega = 2 at k = 4e6. 'breaks at k': the smallest k (by "
+              "bisection, 1 %) with a blow-up, a Newton failure, or the bob farther than "
+              f"{WRONG:g} from the pivot within the run; linear stability limits of the explicit "
+              "methods: h omega = 2 (verlet, symplectic Euler), 2.83 (rk4), 1.57 (composition), "
+              "0 (explicit Euler, whose growth is slow at small h omega).", ""]
+    headers = ["method", "breaks at k", "h omega there"] + [f"{k:.0e}" for k in ks]
     rows = []
     for method, cells in table.items():
         where = breaks.get(method)
-        rows.append([method, f"{where[0]:.0e} ({where[1]})" if where else "never"]
+        rows.append([method, f"{where[0]:.3g} ({where[1]})" if where else "never",
+                     f"{STIFF_H * np.sqrt(where[0]):.3g}" if where else "-"]
                     + [fmt(d, ".1e") if d is not None else err for _, d, err in cells])
     lines += md_table(headers, rows)
     lines += ["", "Explicit methods break where h omega passes their stability limit; midpoint "
