@@ -49,6 +49,11 @@ def _report(args):
     print(run_report(**_suite_kwargs(args))["report"])
 
 
+def _scale(args):
+    from .scale import run_scale_bench
+    run_scale_bench(args.models, args.reports, quick=args.quick)
+
+
 SUITES = {
     "pipeline": ("derive/emit/compile/cached-import times vs sympy.physics.mechanics", _pipeline),
     "steppers": ("ns per step of every method vs hand-written numba loops", _steppers),
@@ -57,6 +62,7 @@ SUITES = {
     "stability": ("tau = h omega spectral-radius curves, largest stable h per hard case", _stability),
     "hard": ("HARD_CASES 3-8 with pass/fail verdicts against their references", _hard),
     "report": ("precision + stability + hard, and the method-choice summary", _report),
+    "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
 }
 
 

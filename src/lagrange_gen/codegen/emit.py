@@ -37,6 +37,7 @@ class KernelText:
     n_zero: int = 0          # structurally zero entries (not computed)
     n_entries: int = 0       # all computed-or-zero entries (mirrored symmetric ones counted once)
     n_temps: int = 0         # CSE temporaries
+    cse_exprs: list = field(default_factory=list)   # temporaries' and outputs' CSE'd sympy exprs
 
 
 @dataclass
@@ -65,30 +66,31 @@ def _flat_name(out):
     return out.name if out.is_vector else f"{out.name}_f"
 
 
-def _targets(entry):
-    """Flat-index store targets of an entry (two for an off-diagonal symmetric entry)."""
+def _flat(entry):
+    """Flat indices an entry is stored at (two for an off-diagonal symmetric entry)."""
     out, i, j = entry.out, entry.i, entry.j
-    if out.is_vector:
-        return [f"{out.name}[{i}]"]
     cols = out.matrix.shape[1]
-    flat = [i * cols + j] + ([j * cols + i] if out.symmetric and i != j else [])
-    return [f"{out.name}_f[{k}]" for k in flat]
+    return [i * cols + j] + ([j * cols + i] if out.symmetric and i != j else [])
+
+
+def _targets(entry):
+    """Store targets of an entry: rhs[3] for a vector, H_f[7] (flat view) for a matrix."""
+    return [f"{_flat_name(entry.out)}[{k}]" for k in _flat(entry)]
 
 
 def _zero_lines(spec, zeros):
     """Statements and module constants that write the structural zeros of each output."""
     lines, constants = [], []
     for out in spec.outputs:
-        mine = [t for e in zeros if e.out is out for t in _targets(e)]
-        if not mine:
+        index = sorted(k for e in zeros if e.out is out for k in _flat(e))
+        if not index:
             continue
         size = out.matrix.shape[0] * out.matrix.shape[1]
-        if len(mine) < ZERO_LOOP_MIN:
-            lines += [f"    {t} = 0.0" for t in mine]
-        elif len(mine) == size:
+        if len(index) < ZERO_LOOP_MIN:
+            lines += [f"    {_flat_name(out)}[{k}] = 0.0" for k in index]
+        elif len(index) == size:
             lines += [f"    for k in range({size}):", f"        {_flat_name(out)}[k] = 0.0"]
         else:
-            index = sorted(int(t[t.index("[") + 1:-1]) for t in mine)
             const = f"_ZEROS_{spec.name.upper()}_{out.name.upper()}"
             constants.append(f"{const} = np.array({index!r}, dtype=np.int64)")
             lines += [f"    for k in {const}:", f"        {_flat_name(out)}[k] = 0.0"]
@@ -134,7 +136,8 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
     elif len(lines) == 3:
         lines.append("    return None")
     return KernelText(spec.name, constants, "\n".join(lines), n_zero=len(zeros),
-                      n_entries=len(entries), n_temps=len(temps))
+                      n_entries=len(entries), n_temps=len(temps),
+                      cse_exprs=[e for _, e in temps] + list(reduced))
 
 
 def _doc(spec, zeros, entries):

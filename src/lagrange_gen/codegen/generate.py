@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -10,7 +11,9 @@ from ..derive import derive
 from ..errors import GenerationError
 from ..model import load_model
 from ..keys import generator_hash, make_key, model_hash, read_key
+from .emit import render_kernel
 from .needs import select_kernels
+from .printer import Inputs
 from .render import render_module
 from .spec import make_kernels
 from .write import write_if_changed
@@ -60,28 +63,55 @@ def _methods(requested):
     return [m for m in METHODS if m in requested]
 
 
+@dataclass
+class GenerationParts:
+    """Everything one generation produced: the text and what the scale benchmark reports.
+
+    texts: one emit.KernelText per kernel; seconds: {"derive": model -> symbolic kernels
+    (Jacobians are derived here, on demand), "emit": CSE + printing + module text}.
+    """
+
+    text: str
+    key: str
+    target: Path
+    dyn: object
+    texts: list
+    seconds: dict
+
+
+def generate_parts(model, out_dir="generated", methods=None, freeze=None) -> GenerationParts:
+    """Derive and emit a loaded Model (nothing is written); see generate_text."""
+    from ..steppers.registry import glue_source
+    methods, freeze = _methods(methods), dict(sorted((freeze or {}).items()))
+    options = _options(model, methods, freeze)
+    model_sha, gen_sha = model_hash(model.source_text), generator_hash()
+    key = make_key(model_sha, gen_sha, options)
+    start = time.perf_counter()
+    dyn = derive(model, freeze=freeze)
+    selected = select_kernels(dyn, methods)
+    kernels = make_kernels(dyn, selected)
+    derived = time.perf_counter()
+    inputs = Inputs(dyn)
+    texts = [render_kernel(spec, inputs) for spec in kernels]
+    target = output_path(model.name, out_dir)
+    source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
+    text = render_module(dyn, texts, key=key, model_sha=model_sha, gen_sha=gen_sha,
+                         options=options, source_rel=source_rel,
+                         command=_command(model.source_path, out_dir, model.build_options, methods, freeze),
+                         methods=methods, glue="\n\n".join(glue_source(m) for m in methods),
+                         why=selected)
+    seconds = {"derive": derived - start, "emit": time.perf_counter() - derived}
+    return GenerationParts(text, key, target, dyn, texts, seconds)
+
+
 def generate_text(model, out_dir="generated", methods=None, freeze=None):
     """Return (module text, KEY, target path) for a loaded Model; nothing is written.
 
     methods: stepper methods to emit glue for (default all); only the kernels they reach are
     derived and emitted (codegen.needs). freeze: {parameter: value} folded into the kernels.
     """
-    from ..steppers.registry import glue_source
-    methods, freeze = _methods(methods), dict(sorted((freeze or {}).items()))
-    options = _options(model, methods, freeze)
-    model_sha, gen_sha = model_hash(model.source_text), generator_hash()
-    key = make_key(model_sha, gen_sha, options)
-    dyn = derive(model, freeze=freeze)
-    selected = select_kernels(dyn, methods)
-    kernels = make_kernels(dyn, selected)
-    target = output_path(model.name, out_dir)
-    source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
-    text = render_module(dyn, kernels, key=key, model_sha=model_sha, gen_sha=gen_sha,
-                         options=options, source_rel=source_rel,
-                         command=_command(model.source_path, out_dir, model.build_options, methods, freeze),
-                         methods=methods, glue="\n\n".join(glue_source(m) for m in methods),
-                         why=selected)
-    return text, key, target
+    parts = generate_parts(model, out_dir, methods, freeze)
+    return parts.text, parts.key, parts.target
 
 
 def generate_model(model_path, out_dir="generated", methods=None, options=None,

@@ -23,6 +23,11 @@ class KernelPrinter(PythonCodePrinter):
     def _print_Symbol(self, expr):
         return expr.name
 
+    def _print_DiracDelta(self, expr):
+        # Derivatives of sign/Heaviside (e.g. the Jacobian of a drag -c |v| v): zero everywhere
+        # except at the kink, where any element of the generalized Jacobian will do for Newton.
+        return "0.0"
+
     def _print_Rational(self, expr):
         return f"{float(expr)!r}"
 

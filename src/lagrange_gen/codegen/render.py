@@ -5,9 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..derive.elements import KIND_CODES
-from .emit import render_kernel
 from .forward import factor_at_import, forward_source
-from .printer import Inputs
 from .spec import default_kernels
 
 
@@ -57,12 +55,11 @@ def _specialization(dyn, methods, why, texts):
     return lines
 
 
-def render_module(dyn, kernels, *, key, model_sha, gen_sha, options, source_rel, command,
+def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, command,
                   methods, glue, why=None) -> str:
     """The whole generated module as text. ``glue`` is the per-stepper source to append;
-    ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels)."""
-    inputs = Inputs(dyn)
-    texts = [render_kernel(spec, inputs) for spec in kernels]
+    ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
+    ``texts`` are the rendered kernels (emit.render_kernel), in module order."""
     defaults = dyn.model.defaults()
     default_arr = ", ".join("float('nan')" if d is None else repr(d) for d in defaults)
     parts = [
@@ -105,7 +102,7 @@ def render_module(dyn, kernels, *, key, model_sha, gen_sha, options, source_rel,
         f"MASS_IS_CONSTANT = {dyn.mass_is_constant}",
         f"FORCES_VELOCITY_FREE = {dyn.forces_velocity_free}",
         f"METHODS = {tuple(methods)!r}",
-        f"KERNELS = {tuple(k.name for k in kernels)!r}",
+        f"KERNELS = {tuple(k.name for k in texts)!r}",
         "",
     ]
     constants = [c for t in texts for c in t.constants]

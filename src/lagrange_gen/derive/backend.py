@@ -104,6 +104,29 @@ class Mat:
         return out
 
 
+#: symengine functions whose derivatives symengine writes in closed form. Others (Abs, sign,
+#: Min, Piecewise, sympy-only functions wrapped as PyFunction, ...) come back as unevaluated
+#: Derivative objects that cannot be printed, so a model using them is derived by sympy.
+_SMOOTH = {"sin", "cos", "tan", "cot", "sec", "csc", "asin", "acos", "atan", "acot", "asec", "acsc",
+           "sinh", "cosh", "tanh", "coth", "sech", "csch", "asinh", "acosh", "atanh", "acoth",
+           "exp", "log", "atan2", "LambertW", "erf", "erfc", "gamma"}
+
+
+def backend_for(exprs, backend=None) -> str:
+    """The backend to derive ``exprs`` (sympy expressions) with: BACKEND (or ``backend``),
+    unless symengine cannot convert them or differentiate one of their functions exactly."""
+    name = backend or BACKEND
+    if name != "symengine" or _se is None:
+        return "sympy"
+    try:
+        for expr in exprs:
+            if any(type(f).__name__ not in _SMOOTH for f in _se.sympify(expr).atoms(_se.Function)):
+                return "sympy"
+    except Exception:  # noqa: BLE001  not representable in symengine
+        return "sympy"
+    return "symengine"
+
+
 def ops(backend=None) -> Ops:
     """The Ops of ``backend`` (default: the module-level BACKEND, read at call time)."""
     name = backend or BACKEND

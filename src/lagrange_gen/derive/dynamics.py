@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..model import Model, t as time_symbol
-from .backend import ops
+from .backend import backend_for, ops
 from .constraints import derive_constraints
 from .elements import derive_elements
 from .freeze import freeze_model
@@ -83,7 +83,7 @@ def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
     """
     frozen = dict(freeze or {})
     model = freeze_model(model, frozen) if frozen else model
-    o = ops()
+    o = ops(backend_for(expr for _, expr in model._all_expressions()))
     parts = derive_lagrangian(model, o, check_samples=check_samples)
     q = o.symbols(model.coords)
     parts.update(derive_constraints(model, o, q))
