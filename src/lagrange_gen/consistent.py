@@ -193,7 +193,8 @@ def consistent_initial_state(module, q0, v0, p, t0=0.0, tol=1e-12, warn=True, st
     if warn and float((np.abs(jv0) / gscale).max()) > tol * vscale:
         warnings.warn(f"{module.NAME}: v0 is not tangent to the constraints (max|J v0| = "
                       f"{np.abs(jv0).max():.3g}); replaced by the closest tangent velocity in the "
-                      f"kinetic-energy metric, changing v0 by max|dv| = {dv:.3g}", stacklevel=stacklevel)
+                      f"kinetic-energy metric, changing v0 by max|dv| = {dv:.3g}",
+                      stacklevel=stacklevel)
     phi, J, _ = evaluate(module, q, v, p)
     lam = initial_multipliers(module, q, v, t0, p)
     return ConsistentState(q=q, v=v, lam=lam, phi_norm=float(np.abs(phi).max()),

@@ -397,11 +397,11 @@ def _constrained_setup(module, q, v, p, t0, settings, compliance, relaxation, ba
     out_extra: (settings, q, v, [lam0, max|Phi|, max|J v|])."""
     from .consistent import consistent_initial_state
     from .steppers.constrained import make_constrained_settings
-    for name, value, low in (("compliance", compliance, 0.0), ("relaxation", relaxation, None)):
-        if not isinstance(value, (int, float, np.floating, np.integer)) or not math.isfinite(value) \
-                or (low is not None and value < low) or (low is None and value <= 0):
-            raise SimulationError(f"{name} must be a finite number {'>= 0' if low is not None else '> 0'}"
-                                  f", got {value!r}")
+    for name, value, positive in (("compliance", compliance, False), ("relaxation", relaxation, True)):
+        number = isinstance(value, (int, float, np.floating, np.integer)) and math.isfinite(value)
+        if not number or value < 0 or (positive and value == 0):
+            raise SimulationError(f"{name} must be a finite number {'> 0' if positive else '>= 0'}, "
+                                  f"got {value!r}")
     try:
         alpha, beta = (float(x) for x in baumgarte)
     except (TypeError, ValueError):

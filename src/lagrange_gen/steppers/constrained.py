@@ -41,9 +41,8 @@ S_BAUMGARTE_ALPHA = N_SETTINGS + 2  # index1: Phi'' + 2 alpha Phi' + beta^2 Phi 
 S_BAUMGARTE_BETA = N_SETTINGS + 3
 N_CONSTRAINED_SETTINGS = N_SETTINGS + 4
 
-#: Scratch layout after the m + 2 saved entries (see ``views``): one flag, m-vectors, (m, n)
-#: matrices, then an augmented system b (size,), K (size, size).
-FLAG = 0
+#: Scratch after the m + 2 saved entries (see ``views``): one flag, _N_MVEC m-vectors, _N_MMAT
+#: (m, n) matrices, then room for the largest augmented system b (big,), K (big, big).
 _N_MVEC = 5
 _N_MMAT = 4
 
@@ -56,17 +55,23 @@ def make_constrained_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0
     return np.concatenate((base, more))
 
 
-def system_size(n, m):
-    """Largest augmented system of any constrained method: rattle's (u, w, nu) for H(q)."""
-    return 2 * n + m
+@njit(inline="always")
+def _layout(n, m):
+    """Offsets in extra of the scratch parts: (flag, vectors, matrices, b, K, end)."""
+    big = 2 * n + m         # the largest augmented system: rattle's (u, w, nu) for H(q)
+    flag = m + 2
+    vec = flag + 1
+    mat = vec + _N_MVEC * m
+    rhs = mat + _N_MMAT * m * n
+    kkt = rhs + big
+    return flag, vec, mat, rhs, kkt, kkt + big * big
 
 
 @njit(cache=True)
 def extra_size(n, m):
     """(saved, total) entries of the extra buffer for n coordinates and m constraints (callable
     from Python and from jitted code)."""
-    big = 2 * n + m                        # system_size(n, m)
-    return m + 2, m + 3 + _N_MVEC * m + _N_MMAT * m * n + big + big * big
+    return m + 2, _layout(n, m)[5]
 
 
 @njit(inline="always")
@@ -88,7 +93,7 @@ def check_buffers(kern, q0, settings, out_extra, out_last):
 def flag_index(m):
     """Index in extra of a scratch flag that is 0.0 at the start of every run (run_loop zeroes
     the scratch): a method sets it once it has cached data from a previous step there."""
-    return m + 2 + FLAG
+    return m + 2
 
 
 @njit(inline="always")
@@ -98,22 +103,19 @@ def views(extra, n, m, size):
     lam (m,) saved multipliers; phi, gam, c1, c2, c3 (m,) scratch vectors; Ja, Jb, Y, T (m, n)
     scratch matrices (constraint Jacobians, H^-1 J^T rows); b (size,) and K (size, size) the
     right-hand side and matrix of an augmented system of the given size."""
+    _, o, mat, rhs, kkt, _ = _layout(n, m)
     lam = extra[0:m]
-    o = m + 3
     phi = extra[o:o + m]
     gam = extra[o + m:o + 2 * m]
     c1 = extra[o + 2 * m:o + 3 * m]
     c2 = extra[o + 3 * m:o + 4 * m]
     c3 = extra[o + 4 * m:o + 5 * m]
-    o += _N_MVEC * m
-    Ja = extra[o:o + m * n].reshape((m, n))
-    Jb = extra[o + m * n:o + 2 * m * n].reshape((m, n))
-    Y = extra[o + 2 * m * n:o + 3 * m * n].reshape((m, n))
-    T = extra[o + 3 * m * n:o + 4 * m * n].reshape((m, n))
-    o += _N_MMAT * m * n
-    big = 2 * n + m
-    b = extra[o:o + size]
-    K = extra[o + big:o + big + size * size].reshape((size, size))
+    Ja = extra[mat:mat + m * n].reshape((m, n))
+    Jb = extra[mat + m * n:mat + 2 * m * n].reshape((m, n))
+    Y = extra[mat + 2 * m * n:mat + 3 * m * n].reshape((m, n))
+    T = extra[mat + 3 * m * n:mat + 4 * m * n].reshape((m, n))
+    b = extra[rhs:rhs + size]
+    K = extra[kkt:kkt + size * size].reshape((size, size))
     return lam, phi, gam, c1, c2, c3, Ja, Jb, Y, T, b, K
 
 
@@ -121,8 +123,8 @@ def views(extra, n, m, size):
 def schur_block(extra, n, m):
     """The (m, m) matrix at the place of K (for the velocity projections, after a Newton solve
     is done with K)."""
-    o = m + 3 + _N_MVEC * m + _N_MMAT * m * n + 2 * n + m
-    return extra[o:o + m * m].reshape((m, m))
+    kkt = _layout(n, m)[4]
+    return extra[kkt:kkt + m * m].reshape((m, m))
 
 
 @njit(cache=True, **FAST)
