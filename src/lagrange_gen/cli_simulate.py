@@ -45,6 +45,12 @@ def add_parser(subparsers):
     p.add_argument("--gen-dir", default="generated", metavar="DIR",
                    help="where model files are generated (default: generated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
+    p.add_argument("--compliance", type=float, default=0.0, metavar="EPS",
+                   help="spook: constraint compliance epsilon >= 0 (0: rigid; 1/k: a spring of stiffness k)")
+    p.add_argument("--relaxation", type=float, default=2.0, metavar="D",
+                   help="spook: relaxation d > 0 in steps (default 2)")
+    p.add_argument("--baumgarte", type=float, nargs=2, default=(0.0, 0.0), metavar=("ALPHA", "BETA"),
+                   help="index1: Baumgarte stabilization gains (default 0 0)")
     return p
 
 
@@ -73,7 +79,8 @@ def run(args) -> int:
     traj = simulate(args.model, args.method, args.q0, args.v0, t_end=args.t_end, h=args.h,
                     params=_parse_params(args.param), save_every=args.save_every,
                     newton_tol=args.newton_tol, max_iter=args.max_iter, t0=args.t0,
-                    progress=args.progress, out_dir=args.gen_dir)
+                    progress=args.progress, out_dir=args.gen_dir, compliance=args.compliance,
+                    relaxation=args.relaxation, baumgarte=tuple(args.baumgarte))
     per_step = traj.wall_time / max(traj.n_steps, 1)
     print(f"model {traj.model}, method {traj.method}, h = {traj.h:g}, "
           f"{traj.n_steps} steps to t = {traj.t[-1]:.9g}")
@@ -81,6 +88,9 @@ def run(args) -> int:
           f"compile/load {traj.compile_time:.2f} s")
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")
     print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
+    if traj.multipliers.size:
+        print(f"max |Phi| = {traj.constraint_error.max():.3e}, "
+              f"max |J v| = {traj.velocity_constraint_error.max():.3e}")
     if traj.newton_iters.sum():
         print(f"Newton iterations per step: {traj.newton_iters.sum() / max(traj.n_steps, 1):.2f}")
     if args.out:

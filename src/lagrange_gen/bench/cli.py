@@ -49,6 +49,11 @@ def _report(args):
     print(run_report(**_suite_kwargs(args))["report"])
 
 
+def _constraints(args):
+    from .constraints import run_constraints_bench
+    run_constraints_bench(Path(args.reports) / "constraints.md", quick=args.quick, models_dir=args.models)
+
+
 def _scale(args):
     from .scale import run_scale_bench
     run_scale_bench(args.models, args.reports, quick=args.quick)
@@ -62,6 +67,7 @@ SUITES = {
     "stability": ("tau = h omega spectral-radius curves, largest stable h per hard case", _stability),
     "hard": ("HARD_CASES 3-8 with pass/fail verdicts against their references", _hard),
     "report": ("precision + stability + hard, and the method-choice summary", _report),
+    "constraints": ("linkage drift per method, rattle vs verlet cost, breaking stiffness", _constraints),
     "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
 }
 

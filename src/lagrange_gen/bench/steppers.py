@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from ..steppers.base import N_STATS, make_settings
-from ..steppers.registry import METHODS
+from .common import unconstrained_methods
 
 ROOT = Path(__file__).resolve().parents[3]
 Q0, V0, H_STEP = (0.1, 0.5), (0.0, 0.0), 1e-3
@@ -270,7 +270,7 @@ def measure_step_times(mod, n_steps=100_000, repeats=5):
     q0, v0, p = np.array(Q0), np.array(V0), mod.DEFAULT_PARAMS
     kernel_loops = _kernel_loops(mod)
     rows = []
-    for method in METHODS:
+    for method in unconstrained_methods():
         go = _library_runner(mod, method, n_steps)
         go()                                                      # compile or load
         ours, (state, iters) = _best_of(go, repeats)
