@@ -1,6 +1,7 @@
-"""Damped linear oscillator written with a compliance: m x'' + b x' + x / c = 0 (HARD_CASES cases 3
-and 4). omega = 1 / sqrt(m c); a small compliance c is a stiff spring (Lacoursiere: constraints
-are the limit c -> 0). With b = 0 it is the test equation of the tau = h omega stability analysis."""
+"""Damped linear oscillator written with a compliance: m x'' + b x' + x / c = 0 (HARD_CASES
+cases 3 and 4). omega = 1 / sqrt(m c); a small compliance c is a stiff spring (Lacoursiere:
+constraints are the limit c -> 0). With b = 0 it is the test equation of the tau = h omega
+stability analysis."""
 from lagrange_gen import Model, coordinates, parameters
 
 x = coordinates("x")

@@ -13,6 +13,13 @@ import numpy as np
 from . import common, hard_cases, hard_constrained, scenes, stability
 
 
+#: Models of each case, for precompile: [(stem, build options)].
+CASE_MODELS = {3: [("damped_oscillator", {})], 4: [("damped_oscillator", {})],
+               5: [("fpu", {})], 6: [("n_link_pendulum", {"n": 1})],
+               7: [("stretchable_pendulum", {}), ("cartesian_pendulum", {})],
+               8: [("four_bar", {})]}
+
+
 def run_cases(models_dir, gen_dir, methods=None, quick=False, cases=None, progress=None):
     """Run the selected case numbers (default 3-8) -> [CaseResult]. quick shortens case 8
     (1e4 instead of 1e5 steps); the others are cheap at their fixed h."""
@@ -108,6 +115,8 @@ def run_hard(models_dir="models", gen_dir="generated", reports_dir="reports", qu
              methods=None, cases=None, progress=True):
     """Run the cases, write reports_dir/hard.md and its figures; returns the CaseResults."""
     wanted = cases or (3, 4, 5, 6, 7, 8)
+    stems = {(stem, tuple(opts.items())) for n in wanted for stem, opts in CASE_MODELS[n]}
+    common.precompile(models_dir, gen_dir, [(s, dict(o)) for s, o in sorted(stems)], methods)
     bar = common.Progress(len(wanted), "hard", enabled=progress)
     results = run_cases(models_dir, gen_dir, methods, quick, wanted, bar)
     bar.finish()

@@ -113,7 +113,8 @@ def case4_damped(models_dir, gen_dir, methods):
             oks.append(ok)
             energies[(c, method)] = (run.traj.t, run.traj.energy / e0) if run.ok else None
             outcomes[(c, method)] = got
-            e_end = f"{run.traj.energy[-1] / e0:.3g}" if run.ok else common.short_error(run.error)
+            e_end = f"{run.traj.energy[-1] / e0:.3g}" if run.ok else \
+                common.short_error(run.error)
             rows.append([f"{c:g}", f"{sc.h / math.sqrt(c):.3g}", method, e_end,
                          f"{e_exact / e0:.3g}", got,
                          "-" if allowed is None else " or ".join(sorted(allowed)),

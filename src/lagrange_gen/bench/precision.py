@@ -71,8 +71,11 @@ class Settings:
 FULL = Settings(k_max=12, repeats=3, budget=2.0, second="Radau",
                 dop_rtols=tuple(10.0 ** -k for k in range(3, 14)),
                 radau_rtols=tuple(10.0 ** -k for k in range(3, 11)))
+# quick: the headline model and the constrained one (each model costs numba compiles when cold)
 QUICK = Settings(k_max=6, repeats=2, budget=0.2, second="LSODA",
-                 dop_rtols=(1e-4, 1e-7, 1e-10), radau_rtols=(1e-4, 1e-7))
+                 dop_rtols=(1e-4, 1e-7, 1e-10), radau_rtols=(1e-4, 1e-7),
+                 cases=tuple(c for c in CASES if c.stem in ("cart_pendulum",
+                                                             "cartesian_pendulum")))
 
 
 @dataclass
@@ -338,7 +341,9 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
     """Run the suite, write reports_dir/precision.md and precision_<model>.png; returns
     {"results": [case result], "report": path}."""
     settings = QUICK if quick else FULL
-    cases = [c for c in settings.cases if cases is None or c.stem in cases]
+    cases = [c for c in (settings.cases if cases is None else CASES) if cases is None
+             or c.stem in cases]
+    common.precompile(models_dir, gen_dir, [(c.stem, {}) for c in cases], methods)
     n_methods = len(common.registry.METHODS) + 4
     bar = common.Progress(sum(n_methods * (settings.k_max + 1) for _ in cases), "precision",
                           enabled=progress)

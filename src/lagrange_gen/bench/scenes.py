@@ -124,8 +124,21 @@ def four_bar_start(mod, p, th1=math.pi / 2):
     return np.array([th1, *x])
 
 
-#: Scenes whose start is computed from the generated module: stem -> f(mod, p) -> q0.
-STARTS = {"four_bar": four_bar_start}
+def cartesian_pendulum_start(mod, p, theta=0.5):
+    """(l sin theta, -l cos theta): on |x| = l."""
+    l = dict(zip(mod.PARAMS, p))["l"]
+    return np.array([l * math.sin(theta), -l * math.cos(theta)])
+
+
+#: Consistent starts computed from the generated module: stem -> f(mod, p) -> q0 (n,).
+STARTS = {"four_bar": four_bar_start, "cartesian_pendulum": cartesian_pendulum_start}
+
+
+def model_start(mod):
+    """A valid q0 (n,) for a module at its default parameters: STARTS, else zeros."""
+    start = STARTS.get(mod.NAME)
+    p = np.asarray(mod.DEFAULT_PARAMS, dtype=float)
+    return start(mod, p) if start else np.zeros(mod.N_COORDS)
 
 
 def start_of(scene, mod, p):

@@ -247,9 +247,11 @@ def run_stability(models_dir="models", gen_dir="generated", reports_dir="reports
     """Measure, write reports_dir/stability.md and stability_tau.png; returns the numbers.
     methods and scene_keys (Scene.key) restrict the run."""
     taus = np.unique(np.concatenate((np.logspace(-2, 3, 41 if quick else 161), TAUS)))
+    scene_list_ = [s for s in scene_list(quick) if scene_keys is None or s.key in scene_keys]
+    common.precompile(models_dir, gen_dir, [("damped_oscillator", {})] +
+                      [(s.stem, s.options) for s in scene_list_], methods)
     mod = oscillator(models_dir, gen_dir)
     ms = _methods_for(mod, methods)
-    scene_list_ = [s for s in scene_list(quick) if scene_keys is None or s.key in scene_keys]
     max_steps = 200_000 if quick else 2_000_000
     bar = common.Progress(len(ms) * (1 + len(scene_list_)), "stability", enabled=progress)
     curves = radius_curves(mod, ms, taus, bar)
