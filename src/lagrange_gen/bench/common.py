@@ -121,6 +121,7 @@ class Run:
     traj: object
     wall: float
     error: str = ""
+    fail_time: float = float("nan")     # simulated time of the failure (SimulationError.time)
 
     @property
     def ok(self):
@@ -140,7 +141,9 @@ def guarded_run(mod, method, q0, v0, h, t_end, p, save_every=1, repeats=1, **kwa
         except SimulationError as exc:
             # The time to failure includes the glue's warm-up call (a cache load once the
             # method has run before): an upper bound, only used to place the failure marker.
-            return Run(None, time.perf_counter() - start, str(exc).splitlines()[0])
+            when = getattr(exc, "time", None)
+            return Run(None, time.perf_counter() - start, str(exc).splitlines()[0],
+                       float("nan") if when is None else float(when))
         best = min(best, traj.wall_time)
     return Run(traj, best)
 

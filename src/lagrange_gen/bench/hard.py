@@ -67,25 +67,32 @@ def fpu_figure(result, path):
 
 
 def damped_figure(result, path, compliance=1e-6):
-    """E(t)/E0 of every method at the stiffest compliance, log scale, against the exact one."""
-    energies = {m: v for (c, m), v in result.data["energies"].items()
-                if c == compliance and v is not None}
-    if not energies:
+    """E(t)/E0 of every method at the stiffest compliance, log scale, against the exact one;
+    a run that failed is a cross at its failure time on the top edge."""
+    runs = {m: v for (c, m), v in result.data["energies"].items() if c == compliance}
+    if not runs:
         return None
     fig, ax = common.new_figure(figsize=(7, 4.5))
-    for i, (method, (t, e)) in enumerate(energies.items()):
-        ax.semilogy(t, np.maximum(e, 1e-300), color=f"C{i}", label=method)
+    top = 1e3
+    for i, (method, run) in enumerate(runs.items()):
+        style = dict(color=f"C{i}", ls="-" if i % 2 == 0 else "--")
+        if isinstance(run, tuple):
+            t, e = run
+            ax.semilogy(t, np.clip(e, 1e-300, top), label=method, **style)
+        else:
+            ax.semilogy([run], [top / 2], marker="x", ms=9, ls="none", color=style["color"],
+                        label=f"{method}: failed (blow-up) at t = {run:.3g}")
     sc = scenes.oscillator_scene(compliance)
     t = np.linspace(0, sc.t_end, 2001)
     x, v = scenes.oscillator_exact(t, 1.0, compliance, sc.params["b"])
-    ax.semilogy(t, (0.5 * v**2 + 0.5 * x**2 / compliance) * 2 * compliance, "k--", lw=1,
+    ax.semilogy(t, (0.5 * v**2 + 0.5 * x**2 / compliance) * 2 * compliance, "k:", lw=1.5,
                 label="exact")
-    ax.set_ylim(1e-12, 1e3)
+    ax.set_ylim(1e-12, top)
     ax.set_xlabel("t")
     ax.set_ylabel("E / E0")
     ax.set_title(f"damped oscillator, c = {compliance:g}, h = {sc.h:g} (tau = "
                  f"{sc.h / np.sqrt(compliance):g})")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="center right")
     return common.save_figure(fig, path)
 
 

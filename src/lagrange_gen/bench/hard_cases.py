@@ -111,7 +111,8 @@ def case4_damped(models_dir, gen_dir, methods):
             allowed = EXPECT4[c].get(method)
             ok = allowed is None or got in allowed
             oks.append(ok)
-            energies[(c, method)] = (run.traj.t, run.traj.energy / e0) if run.ok else None
+            energies[(c, method)] = (run.traj.t, run.traj.energy / e0) if run.ok else \
+                run.fail_time
             outcomes[(c, method)] = got
             e_end = f"{run.traj.energy[-1] / e0:.3g}" if run.ok else \
                 common.short_error(run.error)

@@ -119,13 +119,18 @@ def pydy_rhs(model_file, param_names, p):
     Fu = F[n:, :].xreplace(rep)
     by_name = {s.name: s for s in params}
     psyms = [by_name[name] for name in param_names]
+    import sympy as sp
+    rhs, errors = None, []
     for generator in ("cython", "lambdify"):
         try:
             rhs = generate_ode_function(Fu, qs, us, psyms, mass_matrix=Mu,
-                                        coordinate_derivatives=us, generator=generator)
+                                        coordinate_derivatives=sp.Matrix(us),
+                                        generator=generator)
             break
-        except Exception:       # noqa: BLE001  (cython missing or failing: try the next one)
-            continue
+        except Exception as exc:    # noqa: BLE001  (cython missing or failing: next one)
+            errors.append(f"{generator}: {exc}")
+    if rhs is None:
+        raise RuntimeError("PyDy could not generate a right-hand side: " + "; ".join(errors))
     pv = np.asarray(p, dtype=float)
 
     def f(t, y):
