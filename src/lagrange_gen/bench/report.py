@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from . import common, hard, precision, stability
+from . import common, hard, precision, precision_report, stability
 from ..steppers import registry
 
 ENERGY_TARGET = 1e-6
@@ -150,7 +150,7 @@ def run_report(models_dir="models", gen_dir="generated", reports_dir="reports", 
              f"[stability.md](stability.md), [hard.md](hard.md)).", ""]
     cart = _result(prec["results"], "cart_pendulum")
     if cart:
-        lines += ["## Headline", "", *precision.headline_lines(cart),
+        lines += ["## Headline", "", *precision_report.headline_lines(cart),
                   "![cart pendulum work-precision](precision_cart_pendulum.png)", ""]
     lines += ["## Which method for which scene", "",
               *choice_table(prec["results"], stab, hrd["results"]), "",
