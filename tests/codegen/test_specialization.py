@@ -27,6 +27,7 @@ RTOL = 1e-12
 
 
 def _generate(tmp_path, model, **kwargs):
+    tmp_path.mkdir(parents=True, exist_ok=True)
     model.source_path = model.source_path or str(tmp_path / "model.py")
     text, _, target = generate_text(model, tmp_path, **kwargs)
     target.write_text(text)
@@ -139,3 +140,22 @@ def test_cli_freeze_and_its_errors(tmp_path, capsys):
     assert "cannot freeze gravity: not a parameter (parameters: m, l, g)" in capsys.readouterr().err
     assert main([str(model), "-o", str(tmp_path), "--freeze", "g=abc"]) == 2
     assert "expected NAME=NUMBER" in capsys.readouterr().err
+
+
+def test_composed_kernels_equal_the_symbolic_ones(tmp_path):
+    """verlet + midpoint compose dynamics and momentum_rate_jacobian from other kernels
+    (codegen.compose); a kernel library (no methods) has them fully symbolic."""
+    composed = _generate(tmp_path / "c", n_link_pendulum(3), methods=["verlet", "midpoint"])
+    symbolic = _generate(tmp_path / "s", n_link_pendulum(3), methods=[])
+    assert "composed from kernels" in composed.__doc__ and "composed" not in symbolic.__doc__
+    rng = np.random.default_rng(21)
+    p = composed.DEFAULT_PARAMS * np.array([1.3, 0.8, 1.1])
+    out = {m: [np.empty((3, 3)), np.empty(3), np.empty((3, 3)), np.empty((3, 3))] for m in ("c", "s")}
+    for _ in range(5):
+        q, v = rng.uniform(-2, 2, 3), rng.uniform(-2, 2, 3)
+        for key, mod in (("c", composed), ("s", symbolic)):
+            H, rhs, Jq, Jqd = out[key]
+            mod.dynamics(q, v, 0.0, p, H, rhs)
+            mod.momentum_rate_jacobian(q, v, 0.0, p, Jq, Jqd)
+        for a, b in zip(out["c"], out["s"]):
+            np.testing.assert_allclose(a, b, rtol=RTOL, atol=1e-13 * np.abs(b).max())

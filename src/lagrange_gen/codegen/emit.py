@@ -110,7 +110,7 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
     """
     entries = _entries(spec)
     live = [e for e in entries if e.expr != 0]
-    zeros = [e for e in entries if e.expr == 0 and e.out is not None]
+    zeros = [e for e in entries if e.expr == 0 and e.out is not None and not e.out.accumulate]
     temps, reduced = cse([e.expr for e in live], inputs.rename)
     printer = KernelPrinter()
     body = [f"    {name} = {printer.doprint(e)}" for name, e in temps]
@@ -121,15 +121,17 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
         if entry.out is None:
             result = text
         else:
-            stores.append(f"    {' = '.join(_targets(entry))} = {text}")
+            op = "+=" if entry.out.accumulate else "="
+            stores.append(f"    {' = '.join(_targets(entry))} {op} {text}")
     used = set()
     for expr in [e for _, e in temps] + list(reduced):
         used |= {s.name for s in expr.free_symbols}
     zero_lines, constants = _zero_lines(spec, zeros)
     views = [f"    {o.name}_f = {o.name}.reshape({o.matrix.shape[0] * o.matrix.shape[1]})"
              for o in spec.outputs if not o.is_vector and o.matrix.shape[0] * o.matrix.shape[1]]
-    args = ", ".join(spec.args + [o.name for o in spec.outputs])
+    args = ", ".join(spec.signature)
     lines = ["@njit(cache=True, _nrt=False)", f"def {spec.name}({args}):", f'    """{_doc(spec, zeros, entries)}"""']
+    lines += [f"    {line}" for line in spec.prologue]
     lines += _load_lines(used, inputs.loads(spec.args)) + body + views + stores + zero_lines
     if spec.result is not None:
         lines.append(f"    return {result}")

@@ -12,7 +12,8 @@ from ..errors import GenerationError
 from ..model import load_model
 from ..keys import generator_hash, make_key, model_hash, read_key
 from .emit import render_kernel
-from .needs import select_kernels
+from .compose import compositions
+from .needs import methods_needs, select_kernels
 from .printer import Inputs
 from .render import render_module
 from .spec import make_kernels
@@ -89,7 +90,10 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None) -> Gen
     start = time.perf_counter()
     dyn = derive(model, freeze=freeze)
     selected = select_kernels(dyn, methods)
-    kernels = make_kernels(dyn, selected)
+    composed = compositions(dyn, selected, methods_needs(methods)) if methods else {}
+    for name, how in composed.items():
+        selected[name] = selected[name] + [f"composed from kernels ({how})"]
+    kernels = make_kernels(dyn, selected, composed)
     derived = time.perf_counter()
     inputs = Inputs(dyn)
     texts = [render_kernel(spec, inputs) for spec in kernels]

@@ -12,12 +12,15 @@ class Output:
     """An in-place output array of a kernel.
 
     name: argument name; matrix: sympy Matrix whose shape is the array's shape (a column vector
-    becomes a 1-D array); symmetric: only the upper triangle is computed, then mirrored.
+    becomes a 1-D array); symmetric: only the upper triangle is computed, then mirrored;
+    accumulate: the kernel's prologue already filled the array and the nonzero entries are added
+    to it (``+=``; zero entries are left alone).
     """
 
     name: str
     matrix: sp.Matrix
     symmetric: bool = False
+    accumulate: bool = False
 
     @property
     def is_vector(self):
@@ -36,6 +39,9 @@ class KernelSpec:
     """One kernel: ``def name(*args, *outputs)`` filling outputs in place, or returning ``result``.
 
     args: input argument names in order (q, qd, t, p, w, lam); doc: one line for the docstring.
+    out_args: output argument names when they are not exactly the symbolic outputs' names (a
+    composed kernel, see codegen.compose); prologue: statements run first (calls of other kernels,
+    numeric loops).
     """
 
     name: str
@@ -43,6 +49,12 @@ class KernelSpec:
     outputs: list = field(default_factory=list)
     result: sp.Expr | None = None
     doc: str = ""
+    out_args: list | None = None
+    prologue: list = field(default_factory=list)
+
+    @property
+    def signature(self):
+        return self.args + (self.out_args if self.out_args is not None else [o.name for o in self.outputs])
 
 
 #: Kernels every generated module has, whatever the methods: forward_dynamics/accelerations
@@ -99,11 +111,14 @@ def default_kernels(dyn) -> tuple:
     return tuple(k for k in kernel_table(dyn) if k != "rhs" or dyn.mass_is_constant)
 
 
-def make_kernels(dyn, names=None) -> list[KernelSpec]:
-    """KernelSpecs of ``names`` (default: default_kernels) in the fixed table order."""
+def make_kernels(dyn, names=None, composed=()) -> list[KernelSpec]:
+    """KernelSpecs of ``names`` (default: default_kernels) in the fixed table order; the kernels
+    in ``composed`` are built from other kernels (codegen.compose) instead of symbolically."""
+    from .compose import composed_spec
     table = kernel_table(dyn)
     wanted = set(default_kernels(dyn) if names is None else names)
     unknown = sorted(wanted - set(table))
     if unknown:
         raise KeyError(f"no kernel named {', '.join(unknown)}")
-    return [build() for name, build in table.items() if name in wanted]
+    return [composed_spec(name, dyn) if name in composed else build()
+            for name, build in table.items() if name in wanted]

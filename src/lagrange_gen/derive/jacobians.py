@@ -14,6 +14,7 @@ JACOBIANS = {
     "dmom_dq": "d momentum_rate/dq (n, n) of momentum_rate = dT/dq - dV/dq + Q",
     "dmom_dqd": "d momentum_rate/dqd (n, n) = D^T + dQ/dqd",
     "dHw_dq": "d(H(q) w)/dq (n, n) for an input vector w",
+    "dQ_dqd": "dQ/dqd (n, n) of the generalized forces",
     "dJw_dq": "d(J(q) w)/dq (m, n)",
     "dJTlam_dq": "d(J(q)^T lam)/dq (n, n), symmetric",
 }
@@ -31,7 +32,7 @@ class Jacobians(Mapping):
         self._o, self._p = o, parts
         self._q, self._qd, self._w, self._lam = q, qd, w, lam
         self._to_sympy = to_sympy
-        self._native, self._sympy = {}, {}
+        self._native, self._sympy, self._d_cache = {}, {}, {}
 
     def native(self, name):
         if name not in self._native:
@@ -55,12 +56,18 @@ class Jacobians(Mapping):
         return self._o.matrix(rows, cols, [entry(j, l) for j in range(rows) for l in range(cols)])
 
     def _D(self, vec):
-        """D(vec)_jl = sum_k dH/dq_l[j, k] vec_k = d(H vec)/dq with vec held fixed (n, n)."""
-        dH, n, zero = self._p["dH"], len(self._q), self._o.native(0)
-        return self._contract(n, n, lambda j, l: _dot([dH[l][j, k] for k in range(n)], vec, zero))
+        """D(vec)_jl = sum_k dH/dq_l[j, k] vec_k = d(H vec)/dq with vec held fixed (n, n);
+        D(qd) is kept (both velocity Jacobians use it)."""
+        key = id(vec)
+        if key not in self._d_cache:
+            dH, n, zero = self._p["dH"], len(self._q), self._o.native(0)
+            self._d_cache[key] = self._contract(n, n, lambda j, l: _dot([dH[l][j, k] for k in range(n)], vec, zero))
+        return self._d_cache[key]
 
     def _dQ_dqd(self):
-        return self._o.jacobian(self._p["Q"], self._qd)
+        if "dQ_dqd" not in self._native:
+            self._native["dQ_dqd"] = self._o.jacobian(self._p["Q"], self._qd)
+        return self._native["dQ_dqd"]
 
     def _drhs_dq(self):
         return self._o.jacobian(self._p["rhs"], self._q)
