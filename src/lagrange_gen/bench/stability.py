@@ -207,7 +207,8 @@ def _interval(limit):
 def _h_cell(h, scene, max_steps):
     if h is None:
         return f"< {scene.t_end / max_steps:.1e}"
-    return f"{h:.3g}"
+    # stable already at the start of the search: the true limit may be larger
+    return f">= {h:.3g}" if h == scene.h_max else f"{h:.3g}"
 
 
 def markdown(taus, curves, table, stable_h, scene_list_, max_steps, quick):
@@ -227,7 +228,8 @@ def markdown(taus, curves, table, stable_h, scene_list_, max_steps, quick):
                               for m, t, r, c in table])
     lines += ["", "## Largest stable h per hard case", "",
               f"h = h_max / 2^(j/2) downwards until the run passes the scene's test "
-              f"(runs of at most {max_steps:g} steps; '< h' when none was): the energy never "
+              f"(runs of at most {max_steps:g} steps; '< h' when none was, '>= h_max' when the "
+              f"first was): the energy never "
               f"rises by more than abs(E0)/2 (damping passes, growth fails; n/a: the method "
               f"does not apply to the model), |theta| < pi throughout (separatrix pendulum: "
               f"it must not go over the top).", ""]
