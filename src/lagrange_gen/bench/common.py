@@ -166,8 +166,9 @@ class Progress:
         self.width, self.done = width, 0
         self.stream = stream or sys.stderr
 
-    def step(self, label=""):
-        self.done += 1
+    def step(self, label="", count=1):
+        """Count ``count`` items done (a sweep that stops early passes what it skipped)."""
+        self.done += count
         if not self.enabled:
             return
         filled = self.width * min(self.done, self.total) // self.total

@@ -126,6 +126,7 @@ def sweep_ours(mod, method, case, p, reference, settings, progress):
         points.append(_errors(Point(method, "ours", h, run.wall), mod, p, reference, t_grid,
                               y_grid, y_grid[:, -1]))
         if points[-1].final < settings.floor or run.wall > settings.budget:
+            progress.step(count=settings.k_max - k)      # the runs this sweep skips
             break
     return points
 
@@ -147,6 +148,7 @@ def sweep_peer(name, f, jac, method, rtols, mod, case, p, reference, settings, p
         points.append(_errors(Point(name, "peer", rtol, wall), mod, p, reference, t_grid,
                               y_grid, y_end))
         if wall > settings.budget:
+            progress.step(count=len(rtols) - 1 - rtols.index(rtol))
             break
     return points
 
@@ -231,8 +233,7 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
     cases = [c for c in (settings.cases if cases is None else CASES) if cases is None
              or c.stem in cases]
     common.precompile(models_dir, gen_dir, [(c.stem, {}) for c in cases], methods)
-    n_methods = len(common.registry.METHODS) + 4
-    bar = common.Progress(sum(n_methods * (settings.k_max + 1) for _ in cases), "precision",
+    bar = common.Progress(sum(_n_runs(c, settings, methods) for c in cases), "precision",
                           enabled=progress)
     results, lines = [], _intro(settings, quick)
     for case in cases:
@@ -249,6 +250,16 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
     bar.finish()
     path = common.write_report(Path(reports_dir) / "precision.md", lines)
     return {"results": results, "report": path}
+
+
+def _n_runs(case, settings, methods):
+    """Runs of a case for the progress bar (sweeps that stop early count what they skip)."""
+    import importlib.util
+    pool = common.constrained_methods() if case.constrained else common.unconstrained_methods()
+    ours = sum(1 for m in pool if methods is None or m in methods) * (settings.k_max + 1)
+    dop, radau = len(settings.dop_rtols), len(settings.radau_rtols)
+    with_pydy = importlib.util.find_spec("pydy") is not None
+    return ours + (dop if case.constrained else (3 if with_pydy else 2) * dop + radau)
 
 
 def _intro(settings, quick):
