@@ -86,19 +86,12 @@ def measure_all_methods(model_file, n, work):
             "count": len(gen["kernels"])}
 
 
-def measure_lagranges_method(sizes, budget):
-    """{n: seconds or None (skipped)} and the n that exceeded the budget (or None)."""
-    times, exceeded = {}, None
-    for n in sizes:
-        if exceeded is not None:
-            times[n] = None
-            continue
-        try:
-            times[n] = _run_child(["lm", n], tempfile.gettempdir(), timeout=budget)["seconds"]
-        except subprocess.TimeoutExpired:
-            times[n], exceeded = None, n
-        print(f"LagrangesMethod n={n}: {times[n] if times[n] is not None else f'> {budget:.0f} s'}", flush=True)
-    return times, exceeded
+def measure_lagranges_method(n, budget):
+    """Seconds of sympy LagrangesMethod on the n-link chain, or None past the budget."""
+    try:
+        return _run_child(["lm", n], tempfile.gettempdir(), timeout=budget)["seconds"]
+    except subprocess.TimeoutExpired:
+        return None
 
 
 def installed(name):
@@ -106,25 +99,35 @@ def installed(name):
 
 
 def run_scale_bench(models_dir="models", reports_dir="reports", quick=False):
-    """Measure every size, write reports/scale.md and reports/scale.png; returns the rows."""
+    """Measure every size, write reports/scale.md and reports/scale.png; returns the rows.
+
+    LagrangesMethod runs right after our measurements of the same n, so that both see the
+    same load on a shared machine; once a case exceeds the budget, larger n are skipped.
+    """
     from .scale_report import write_report
     model_file = Path(models_dir) / "n_link_pendulum.py"
     sizes = QUICK_SIZES if quick else SIZES
     budget = QUICK_BUDGET_S if quick else BUDGET_S
-    rows = []
+    rows, lm, exceeded = [], {}, None
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for n in sizes:
             rows.append(measure_case(model_file, n, work))
-            r = rows[-1]
-            print(f"n={n}: derive {r['derive']:.2f} s, emit {r['emit']:.2f} s, kernels "
-                  f"{r['kernels_compile']:.2f} s, glue {r['glue_compile']:.2f} s, cached first step "
-                  f"{r['cached_first_step']:.3f} s", flush=True)
+            lm[n] = measure_lagranges_method(n, budget) if exceeded is None else None
+            if exceeded is None and lm[n] is None:
+                exceeded = n
+            _print_row(rows[-1], lm[n], budget)
         extra = measure_all_methods(model_file, ALL_METHODS_AT, work) if ALL_METHODS_AT in sizes else None
-    lm, exceeded = measure_lagranges_method(sizes, budget)
     peers = {name: installed(name) for name in ("pydy", "mujoco")}
     write_report(Path(reports_dir), rows, lm, exceeded, budget, extra, peers)
     return rows
+
+
+def _print_row(r, lm, budget):
+    ref = f"{lm:.2f} s" if lm is not None else f"> {budget:.0f} s or skipped"
+    print(f"n={r['n']}: derive {r['derive']:.2f} s, emit {r['emit']:.2f} s, kernels "
+          f"{r['kernels_compile']:.2f} s, glue {r['glue_compile']:.2f} s, cached first step "
+          f"{r['cached_first_step']:.3f} s; LagrangesMethod {ref}", flush=True)
 
 
 # ---------------------------------------------------------------- child processes
