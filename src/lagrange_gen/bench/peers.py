@@ -134,5 +134,7 @@ def pydy_rhs(model_file, param_names, p):
     pv = np.asarray(p, dtype=float)
 
     def f(t, y):
-        return rhs(y, t, pv)
+        # PyDy returns one reused output buffer; solve_ivp keeps the previous f(t, y) and would
+        # see it overwritten (4x more evaluations, wrong steps), so copy as a user must.
+        return rhs(y, t, pv).copy()
     return f, time.perf_counter() - start, generator

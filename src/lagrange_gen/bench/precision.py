@@ -252,14 +252,17 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
     return {"results": results, "report": path}
 
 
+def _has_pydy():
+    import importlib.util
+    return importlib.util.find_spec("pydy") is not None
+
+
 def _n_runs(case, settings, methods):
     """Runs of a case for the progress bar (sweeps that stop early count what they skip)."""
-    import importlib.util
     pool = common.constrained_methods() if case.constrained else common.unconstrained_methods()
     ours = sum(1 for m in pool if methods is None or m in methods) * (settings.k_max + 1)
     dop, radau = len(settings.dop_rtols), len(settings.radau_rtols)
-    with_pydy = importlib.util.find_spec("pydy") is not None
-    return ours + (dop if case.constrained else (3 if with_pydy else 2) * dop + radau)
+    return ours + (dop if case.constrained else (3 if _has_pydy() else 2) * dop + radau)
 
 
 def _intro(settings, quick):
@@ -268,6 +271,7 @@ def _intro(settings, quick):
             f"through `simulate` at h = h0 / 2^k, k <= {settings.k_max}; peers: scipy solve_ivp "
             f"on our generated right-hand side (DOP853; Radau with the generated Jacobian), and "
             f"sympy.physics.mechanics LagrangesMethod lambdified + DOP853 on the model's own "
-            f"L = T - V. Wall time: integration only, min of {settings.repeats} repeats after a "
+            f"L = T - V, and PyDy's generate_ode_function + DOP853 when pydy is installed "
+            f"({'installed' if _has_pydy() else 'not installed for this run'}). Wall time: integration only, min of {settings.repeats} repeats after a "
             f"warm-up, all in one process on a shared 2-core machine (compare ratios, not "
             f"absolute times). Failed runs are listed and drawn as crosses.", ""]
