@@ -55,36 +55,26 @@ def _specialization(dyn, methods, why, texts):
     return lines
 
 
-def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, command,
-                  methods, glue, why=None) -> str:
-    """The whole generated module as text. ``glue`` is the per-stepper source to append;
-    ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
-    ``texts`` are the rendered kernels (emit.render_kernel), in module order."""
+_IMPORTS = [
+    "import math",
+    "",
+    "import numpy as np",
+    "from numba import njit",
+    "",
+    "from lagrange_gen.keys import check_fresh",
+    "from lagrange_gen.errors import SingularMass",
+    "from lagrange_gen.linalg import cholesky_inplace, cholesky_solve_inplace",
+    "from lagrange_gen.params import resolve_params",
+    "from lagrange_gen.status import OK, SINGULAR_MASS",
+]
+
+
+def _model_constants(dyn, methods, texts):
+    """NAME, orderings, sizes, structure flags and what was emitted, as module constants."""
     defaults = dyn.model.defaults()
     default_arr = ", ".join("float('nan')" if d is None else repr(d) for d in defaults)
-    parts = [
-        f"# lagrange-gen generated module. DO NOT EDIT. KEY = {key}",
-        f'"""{module_docstring(dyn, source_rel, methods, why, texts)}\n"""',
-        "# fmt: off",
-        f'KEY = "{key}"',
-        f'MODEL_SHA = "{model_sha}"',
-        f'GENERATOR_SHA = "{gen_sha}"',
-        f"OPTIONS = {options!r}",
-        f"MODEL_PATH = {source_rel!r}",
-        "",
-        "import math",
-        "",
-        "import numpy as np",
-        "from numba import njit",
-        "",
-        "from lagrange_gen.keys import check_fresh",
-        "from lagrange_gen.errors import SingularMass",
-        "from lagrange_gen.linalg import cholesky_inplace, cholesky_solve_inplace",
-        "from lagrange_gen.params import resolve_params",
-        "from lagrange_gen.status import OK, SINGULAR_MASS",
-        "",
-        f"check_fresh(__file__, KEY, MODEL_SHA, GENERATOR_SHA, MODEL_PATH, OPTIONS, {command!r})",
-        "",
+    elements = dyn.model.elements
+    return [
         f"NAME = {dyn.model.name!r}",
         f"COORDS = {tuple(c.name for c in dyn.q)!r}",
         f"VELOCITIES = {tuple(c.name for c in dyn.qd)!r}",
@@ -97,13 +87,32 @@ def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, c
         f"N_PARAMS = {len(dyn.params)}",
         f"CONSTRAINTS = {tuple(sp.sstr(c) for c in dyn.Phi)!r}",
         f"N_ELEMENTS = {dyn.n_elements}",
-        f"ELEMENTS = {tuple(e.name for e in dyn.model.elements)!r}",
-        f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in dyn.model.elements)!r}  # 0 Saint-Venant, 1 dry friction",
+        f"ELEMENTS = {tuple(e.name for e in elements)!r}",
+        f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in elements)!r}  # 0 Saint-Venant, 1 dry friction",
         f"MASS_IS_CONSTANT = {dyn.mass_is_constant}",
         f"FORCES_VELOCITY_FREE = {dyn.forces_velocity_free}",
         f"METHODS = {tuple(methods)!r}",
         f"KERNELS = {tuple(k.name for k in texts)!r}",
-        "",
+    ]
+
+
+def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, command,
+                  methods, glue, why=None) -> str:
+    """The whole generated module as text. ``glue`` is the per-stepper source to append;
+    ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
+    ``texts`` are the rendered kernels (emit.render_kernel), in module order."""
+    parts = [
+        f"# lagrange-gen generated module. DO NOT EDIT. KEY = {key}",
+        f'"""{module_docstring(dyn, source_rel, methods, why, texts)}\n"""',
+        "# fmt: off",
+        f'KEY = "{key}"',
+        f'MODEL_SHA = "{model_sha}"',
+        f'GENERATOR_SHA = "{gen_sha}"',
+        f"OPTIONS = {options!r}",
+        f"MODEL_PATH = {source_rel!r}",
+        "", *_IMPORTS, "",
+        f"check_fresh(__file__, KEY, MODEL_SHA, GENERATOR_SHA, MODEL_PATH, OPTIONS, {command!r})",
+        "", *_model_constants(dyn, methods, texts), "",
     ]
     constants = [c for t in texts for c in t.constants]
     if constants:
