@@ -324,7 +324,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter)
     q = _vector("q0", q0, n, module.COORDS)
     v = _vector("v0", v0, n, module.COORDS)
-    p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME)
+    p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME,
+                       frozen=getattr(module, "FROZEN", None))
     h, t0, save_every, max_iter = float(h), float(t0), int(save_every), int(max_iter)
     settings = make_settings(newton_tol, max_iter, blowup_bound, 1 if newton_always else 0)
     if constrained:
