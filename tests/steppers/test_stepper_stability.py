@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from stepper_util import model, one_step, params  # model is a fixture
+from lagrange_gen.bench.stability import CLOSED_FORMS, spectral_radius  # closed forms of case 3
 from lagrange_gen.steppers.base import make_settings
 
 TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)
@@ -23,47 +24,6 @@ def step_matrix(mod, method, tau, settings=None):
     cols = [np.concatenate(one_step(mod, method, [q], [v], h, p, settings=settings))
             for q, v in ((1.0, 0.0), (0.0, 1.0))]
     return np.column_stack(cols)
-
-
-def spectral_radius(A):
-    return float(np.max(np.abs(np.linalg.eigvals(A))))
-
-
-def verlet_radius(tau):
-    """Closed form: trace 2 - tau^2, determinant 1."""
-    half_trace = 1.0 - tau**2 / 2
-    if abs(half_trace) <= 1.0:
-        return 1.0
-    return abs(half_trace) + math.sqrt(half_trace**2 - 1.0)
-
-
-def verlet_matrix(tau):
-    """Velocity Verlet on x'' = -x in (x, v) with h = tau (omega = 1)."""
-    return np.array([[1 - tau**2 / 2, tau], [-tau * (1 - tau**2 / 4), 1 - tau**2 / 2]])
-
-
-def composition_radius(tau):
-    """Yoshida's triple jump: the product of three Verlet matrices."""
-    g1 = 1 / (2 - 2 ** (1 / 3))
-    g2 = 1 - 2 * g1
-    outer, inner = verlet_matrix(g1 * tau), verlet_matrix(g2 * tau)
-    return spectral_radius(outer @ inner @ outer)
-
-
-def rk4_radius(tau):
-    z = 1j * tau
-    return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
-
-
-CLOSED_FORMS = {
-    "explicit_euler": lambda tau: math.sqrt(1 + tau**2),
-    "implicit_euler": lambda tau: 1 / math.sqrt(1 + tau**2),
-    "midpoint": lambda tau: 1.0,
-    "verlet": verlet_radius,
-    "symplectic_euler": verlet_radius,   # same trace and determinant as Verlet
-    "rk4": rk4_radius,
-    "composition": composition_radius,
-}
 
 
 @pytest.mark.parametrize("method", sorted(CLOSED_FORMS))
