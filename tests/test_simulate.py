@@ -6,10 +6,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import lagrange_gen.simulate as simulate_module
+import lagrange_gen.simulation as simulate_module
 from lagrange_gen.cli import main
 from lagrange_gen.cli_simulate import add_parser, run as run_cli
-from lagrange_gen.simulate import simulate
+from lagrange_gen.simulation import simulate
 
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"

@@ -18,7 +18,7 @@ _LAZY = {
     "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
     "t": "model", "load_model": "model", "SaintVenant": "model", "DryFriction": "model",
     "import_generated": "loader", "load": "loader",
-    "simulate": "simulate", "Trajectory": "simulate",
+    "simulate": "simulation", "Trajectory": "simulation",
 }
 
 __all__ = sorted(_LAZY) + [

@@ -73,7 +73,7 @@ def _vector(values):
 
 def run(args) -> int:
     """Run the subcommand; returns the exit status."""
-    from .simulate import simulate
+    from .simulation import simulate
     if args.out and Path(args.out).suffix not in (".npz", ".csv"):
         raise SimulationError(f"--out {args.out}: use a .npz or .csv file name")
     traj = simulate(args.model, args.method, args.q0, args.v0, t_end=args.t_end, h=args.h,

@@ -6,7 +6,7 @@ import pytest
 
 from constraint_util import generated_model, one_angle_pendulum, pendulum_state
 from lagrange_gen.consistent import initial_multipliers
-from lagrange_gen.simulate import simulate
+from lagrange_gen.simulation import simulate
 from lagrange_gen.steppers.registry import INFO
 
 THETA0, OMEGA0, T_END = 1.0, 0.5, 1.0

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen import ModelError, SimulationError, load_model
-from lagrange_gen.simulate import simulate
+from lagrange_gen.simulation import simulate
 from nonsmooth_util import ns_model  # noqa: F401  (fixture)
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.loader import import_generated
-from lagrange_gen.simulate import simulate
+from lagrange_gen.simulation import simulate
 
 TWO_BLOCKS = """
 from lagrange_gen import DryFriction, Model, coordinates, parameters

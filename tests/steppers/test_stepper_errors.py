@@ -9,7 +9,7 @@ import pytest
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.errors import BlowUp, NewtonDivergence, SimulationError, SingularMass
 from lagrange_gen.loader import import_generated
-from lagrange_gen.simulate import simulate
+from lagrange_gen.simulation import simulate
 
 from stepper_util import MODEL_FILES, model  # model is a fixture
 

@@ -2,7 +2,7 @@
 through the public ``simulate`` driver, which methods exist in this build, a progress bar and
 markdown/figure output.
 
-Every run goes through :func:`lagrange_gen.simulate.simulate`, the path a user takes: its
+Every run goes through :func:`lagrange_gen.simulation.simulate`, the path a user takes: its
 ``wall_time`` is the integration only (the glue is compiled or loaded from numba's cache before
 the clock starts), and its exceptions are what a failed run looks like to a user.
 """
@@ -62,7 +62,7 @@ def load_module(models_dir, stem, gen_dir, **options):
 _COMPILE_CHILD = r"""
 import json, sys
 from lagrange_gen.errors import SimulationError
-from lagrange_gen.simulate import simulate
+from lagrange_gen.simulation import simulate
 for path, methods, q0 in json.loads(sys.argv[1]):
     for method in methods:
         try:
@@ -131,7 +131,7 @@ class Run:
 def guarded_run(mod, method, q0, v0, h, t_end, p, save_every=1, repeats=1, **kwargs):
     """simulate(...) repeated ``repeats`` times, keeping the fastest wall_time; a SimulationError
     (blow-up, Newton divergence, singular mass, refused input) becomes a failed Run."""
-    from ..simulate import simulate
+    from ..simulation import simulate
     best, traj = np.inf, None
     for _ in range(max(1, repeats)):
         start = time.perf_counter()

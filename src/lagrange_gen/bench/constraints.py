@@ -24,7 +24,7 @@ import numpy as np
 
 from ..consistent import consistent_initial_state
 from ..errors import SimulationError
-from ..simulate import simulate
+from ..simulation import simulate
 from ..steppers.base import N_STATS, make_settings
 from ..steppers.constrained import extra_size, make_constrained_settings
 from .common import ROOT, _best_of, fmt, md_table, new_figure, save_figure, write_report

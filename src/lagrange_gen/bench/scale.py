@@ -138,7 +138,7 @@ def _child_imports():
     import numba  # noqa: F401
     import numpy  # noqa: F401
     from ..loader import compile_all, import_generated  # noqa: F401
-    from ..simulate import simulate  # noqa: F401
+    from ..simulation import simulate  # noqa: F401
     return time.perf_counter() - start
 
 
@@ -168,7 +168,7 @@ def _child_cold(path):
 
 def _step_cost(mod, method, h=1e-3, target_s=0.3):
     """(glue compile seconds, ns per step inside the jitted loop) of one method."""
-    from ..simulate import simulate
+    from ..simulation import simulate
     q0, v0 = _state(mod.N_COORDS)
     probe = simulate(mod, method, q0, v0, t_end=20 * h, h=h, save_every=20)
     steps = int(min(200_000, max(50, target_s / max(probe.wall_time / 20, 1e-9))))
@@ -210,7 +210,7 @@ def _child_warm(path):
     """A second process with a warm cache: import, load the kernels, take one verlet step."""
     out = {"warm_imports": _child_imports()}
     from ..loader import compile_all, import_generated
-    from ..simulate import simulate
+    from ..simulation import simulate
     start = time.perf_counter()
     mod = import_generated(path)
     q0, v0 = _state(mod.N_COORDS)

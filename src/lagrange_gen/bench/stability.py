@@ -33,7 +33,7 @@ def oscillator(models_dir="models", gen_dir="generated"):
 def step_matrix(mod, method, tau, omega=OMEGA):
     """A (2, 2): columns are one step of ``method`` from (x, v) = (1, 0) and (0, 1) on
     x'' = -omega^2 x with h = tau / omega. Raises SimulationError when the step fails."""
-    from ..simulate import simulate
+    from ..simulation import simulate
     p = common.params_of(mod, m=1.0, c=1.0 / omega**2, b=0.0)
     h = tau / omega
     cols = []

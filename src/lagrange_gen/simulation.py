@@ -1,6 +1,6 @@
 """Python driver: integrate a generated module with a stepper, get a Trajectory.
 
-    from lagrange_gen.simulate import simulate
+    from lagrange_gen.simulation import simulate
     traj = simulate("models/cart_pendulum.py", method="midpoint", q0=[0.1, 0.5], t_end=10, h=1e-3)
     traj.plot("traj.png"); traj.to_npz("traj.npz")
 
