@@ -11,7 +11,9 @@ from .errors import StaleModuleError
 
 _PACKAGE = Path(__file__).resolve().parent
 # Sources whose change alters generated text or the compiled code a generated module pulls in.
-_GENERATOR_PARTS = ("model.py", "linalg.py", "params.py", "status.py", "errors.py", "keys.py", "derive", "codegen", "steppers", "nonsmooth")
+# (nonsmooth/play.py only: the return map the steppers compile; experiments.py is a report.)
+_GENERATOR_PARTS = ("model.py", "linalg.py", "params.py", "status.py", "errors.py", "keys.py", "derive", "codegen",
+                    "steppers", "nonsmooth/play.py")
 
 
 def _version(dist):
