@@ -103,6 +103,21 @@ def increment_small(dx, x, tol):
 
 
 @njit(cache=True, **FAST)
+def increment_converged(d, xmax, prev, tol):
+    """The stopping rule of newton_converged on precomputed norms: d = max|dx| of this
+    iteration, xmax = max|x| after the update, prev = d of the previous iteration (0 on the
+    first)."""
+    size = tol * max(1.0, xmax)
+    if d <= size:
+        return True
+    if prev > 0.0:
+        theta = d / prev
+        if theta < 1.0 and theta / (1.0 - theta) * d <= size:
+            return True
+    return False
+
+
+@njit(cache=True, **FAST)
 def newton_converged(dx, x, prev, tol):
     """Newton stopping test after the update x += dx; returns (converged, max|dx|).
 
@@ -111,15 +126,8 @@ def newton_converged(dx, x, prev, tol):
     contraction theta = |dx| / |prev| < 1 bounds the error left in x by theta / (1 - theta) |dx|
     below that (Hairer-Wanner, Solving ODEs II, sec. IV.8): in the quadratic regime this saves
     the last iteration, which would only confirm convergence."""
-    size = tol * max(1.0, max_abs(x))
     d = max_abs(dx)
-    if d <= size:
-        return True, d
-    if prev > 0.0:
-        theta = d / prev
-        if theta < 1.0 and theta / (1.0 - theta) * d <= size:
-            return True, d
-    return False, d
+    return increment_converged(d, max_abs(x), prev, tol), d
 
 
 @njit(cache=True, **FAST)

@@ -168,20 +168,6 @@ def gauss_solve(A, b):
 
 
 @njit(cache=True, **FAST)
-def increment_converged(d, xmax, prev, tol):
-    """base.newton_converged on precomputed norms: d = max|dx| of this iteration, xmax =
-    max|x| after the update, prev = d of the previous iteration (0 on the first)."""
-    size = tol * max(1.0, xmax)
-    if d <= size:
-        return True
-    if prev > 0.0:
-        theta = d / prev
-        if theta < 1.0 and theta / (1.0 - theta) * d <= size:
-            return True
-    return False
-
-
-@njit(cache=True, **FAST)
 def phi_small(phi, J, q, tol):
     """Position-level stopping test: every constraint is within tol of its manifold, measured
     as a distance |Phi_i| / max_j |J_ij| relative to max(1, max|q|) (the scale of the Newton

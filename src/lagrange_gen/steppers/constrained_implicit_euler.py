@@ -31,8 +31,8 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, S_MAX_ITER, S_TOL, max_abs, run_loop
-from .constrained import (check_buffers, gauss_solve, increment_converged, record, schur_block,
+from .base import FAST, S_MAX_ITER, S_TOL, increment_converged, max_abs, run_loop
+from .constrained import (check_buffers, gauss_solve, record, schur_block,
                           velocity_projection, views)
 
 _V1, _Q1, _DV, _RHS = 0, 1, 2, 3     # work rows

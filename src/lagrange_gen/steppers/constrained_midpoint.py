@@ -32,8 +32,9 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, S_MAX_ITER, S_TOL, max_abs, momentum_from_velocity, run_loop
-from .constrained import (check_buffers, gauss_solve, increment_converged, record, schur_block,
+from .base import (FAST, S_MAX_ITER, S_TOL, increment_converged, max_abs, momentum_from_velocity,
+                   run_loop)
+from .constrained import (check_buffers, gauss_solve, record, schur_block,
                           velocity_projection, views)
 
 _VB, _QB, _Q1, _V1, _F, _PT = 0, 1, 2, 3, 4, 5     # work rows

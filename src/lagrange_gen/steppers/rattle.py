@@ -42,9 +42,9 @@ from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import (FAST, S_MAX_ITER, S_TOL, W_ACC, explicit_path, max_abs,
+from .base import (FAST, increment_converged, S_MAX_ITER, S_TOL, W_ACC, explicit_path, max_abs,
                    momentum_from_velocity, run_loop)
-from .constrained import (check_buffers, flag_index, gauss_solve, increment_converged, phi_small,
+from .constrained import (check_buffers, flag_index, gauss_solve, phi_small,
                           project, record, schur_block, solve_rows, velocity_projection, views)
 
 _VH, _Z, _QN, _VN, _F, _U, _W, _PT = 0, 1, 2, 3, 4, 5, 6, 7     # work rows (W_ACC is kept)
