@@ -43,8 +43,10 @@ class KernelPrinter(PythonCodePrinter):
     def _print_Pow(self, expr, rational=False):
         base, exp = expr.args
         if exp.is_Integer and 2 <= int(exp) <= 4 and base.is_Symbol:
-            b = self.parenthesize(base, PRECEDENCE["Mul"] + 1)
-            return "*".join([b] * int(exp))
+            # A product is cheaper than pow in numba, but it must stay one factor wherever the
+            # power sits: the parent printed it as a Pow (tighter than Mul), so ``a/x**2`` would
+            # otherwise read ``a/x*x``. The parentheses make the product an atom.
+            return "(" + "*".join([self._print(base)] * int(exp)) + ")"
         if exp == -1:
             return f"1.0/{self.parenthesize(base, PRECEDENCE['Pow'])}"
         return super()._print_Pow(expr, rational=rational)
