@@ -1,0 +1,16 @@
+"""Heavy symmetric top with a fixed tip, Euler angles (theta nutation from the upward vertical,
+phi precession, psi spin): moments of inertia I1 = I2 about the tip and I3 about the symmetry
+axis, mass m, centre of mass at distance l from the tip. phi and psi are cyclic."""
+import sympy as sp
+
+from lagrange_gen import Model, coordinates, parameters
+
+theta, phi, psi = coordinates("theta phi psi")
+I1, I3, m, g, l = parameters("I1 I3 m g l", defaults=(1.0, 0.5, 1.0, 9.81, 0.5))
+
+T = (I1 * (theta.d**2 + phi.d**2 * sp.sin(theta)**2) / 2
+     + I3 * (psi.d + phi.d * sp.cos(theta))**2 / 2)
+V = m * g * l * sp.cos(theta)
+
+model = Model("heavy_top", coords=[theta, phi, psi], T=T, V=V,
+              description="Heavy symmetric top in Euler angles (Lagrange top).")

@@ -1,0 +1,66 @@
+"""Helpers of the zoo tests: the method list, runs through lagrange_gen.simulate, order fits.
+
+Every zoo model is unconstrained and has no nonsmooth element, so the methods that apply are the
+registry's methods minus the constrained and the nonsmooth ones (taken from the registry, so a new
+stepper is tested here without editing this file). Each test module generates its model once per
+session through the top-level ``generated`` fixture; numba compiles a run_<method> only when a
+test calls it.
+
+Tolerances: order fits compare log-log slopes with the method's order (registry.INFO); quantities
+a method keeps to roundoff are bounded by roundoff_bound, one rounding of the quantity per step.
+"""
+
+import numpy as np
+
+from lagrange_gen import simulate
+from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
+
+UNCONSTRAINED_METHODS = tuple(m for m in METHODS
+                              if m not in CONSTRAINED_METHODS and m not in NONSMOOTH_METHODS)
+SYMPLECTIC_METHODS = tuple(m for m in UNCONSTRAINED_METHODS if INFO[m].symplectic)
+EPS = np.finfo(np.float64).eps
+
+#: A fitted order must be within this of the expected one (step counts are chosen in the
+#: asymptotic range of every method, where the measured slopes are within 0.1 of it).
+ORDER_SLACK = 0.3
+
+
+def order(method):
+    return INFO[method].order
+
+
+def assert_model_allows_every_method(mod):
+    """The zoo runs every unconstrained method: the model must have neither constraints nor
+    nonsmooth elements (simulate would refuse or reroute the methods otherwise)."""
+    assert getattr(mod, "N_CONSTRAINTS", 0) == 0 and getattr(mod, "N_ELEMENTS", 0) == 0
+    assert set(UNCONSTRAINED_METHODS) <= set(mod.METHODS)
+
+
+def run(mod, method, q0, v0, t_end, n_steps, params, save_every=1):
+    """Trajectory of n_steps steps of size t_end / n_steps (the final state is always saved)."""
+    return simulate(mod, method, q0, v0, t_end=t_end, h=t_end / n_steps, params=params,
+                    save_every=save_every)
+
+
+def fitted_order(step_counts, errors):
+    """Slope of log(error) against log(h) for h proportional to 1 / step_counts."""
+    h = 1.0 / np.asarray(step_counts, dtype=float)
+    return float(np.polyfit(np.log(h), np.log(np.asarray(errors, dtype=float)), 1)[0])
+
+
+def assert_orders(method, step_counts, errors, expected):
+    """errors: {quantity: [error per step count]}; expected: {quantity: order}. Every fitted
+    order within ORDER_SLACK of the expected one; the message lists every fit."""
+    fits = {name: fitted_order(step_counts, errs) for name, errs in errors.items()}
+    report = "; ".join(f"{name}: order {fits[name]:.2f} (expected {expected[name]}), errors "
+                       + ", ".join(f"{e:.2e}" for e in errors[name]) for name in fits)
+    print(f"{method}: {report}")    # shown by pytest -rP: the fitted orders of a passing run
+    bad = [name for name in fits if abs(fits[name] - expected[name]) > ORDER_SLACK]
+    assert not bad, f"{method}, steps {list(step_counts)}: {report}"
+    return fits
+
+
+def roundoff_bound(scale, n_steps):
+    """Largest change of a quantity of size ``scale`` that a method keeps exactly in exact
+    arithmetic: at most one rounding of it per step, eps * scale * n_steps."""
+    return EPS * abs(scale) * max(n_steps, 1)
