@@ -7,7 +7,10 @@ families such as the n-link pendulum). :func:`load_model` executes such a file a
 
 from __future__ import annotations
 
+import itertools
 import keyword
+import math
+import os
 import runpy
 import traceback
 from dataclasses import dataclass
@@ -25,11 +28,8 @@ __all__ = [
 #: The time symbol. Forces and potentials may depend on it; T and constraints may not.
 t = sp.Symbol("t", real=True)
 
-# Defaults of declared parameters, by name, in declaration order. Defaults are not stored on the
-# symbols: sympy caches expressions, so an "equal" symbol from another model file can come back
-# from the cache, and it must not bring another file's default or position with it. load_model
-# starts each file with an empty table.
-_declared: dict = {}
+# Serial numbers of parameter declarations (0: a Parameter made directly, never declared).
+_declarations = itertools.count(1)
 
 
 class Coordinate(sp.Symbol):
@@ -51,10 +51,29 @@ class Velocity(sp.Symbol):
 
 
 class Parameter(sp.Symbol):
-    """A model parameter; its default value is recorded by :func:`parameters`."""
+    """A model parameter, declared by :func:`parameters`: ``default`` (float or None) and
+    ``declaration`` (serial number; Models list their parameters in declaration order).
 
-    def __new__(cls, name):
-        return super().__new__(cls, name, real=True)
+    The declaration is part of the symbol's identity (and the default belongs to it). sympy
+    caches symbols and expressions by equality, so what a symbol carries must take part in
+    equality: two declarations of ``m`` (two model files, two parameters() calls) are two
+    different symbols that print alike, and the cache can never hand one model another's default
+    or position. No table outside the symbols: a model's PARAMS depend on its own declarations
+    only, not on what else the process declared.
+    """
+
+    __slots__ = ("declaration", "default")
+
+    def __new__(cls, name, declaration=0, default=None):
+        obj = sp.Symbol.__xnew__(cls, name, real=True)      # not the cached constructor: see above
+        obj.declaration, obj.default = declaration, default
+        return obj
+
+    def __getnewargs_ex__(self):
+        return ((self.name, self.declaration, self.default), {})
+
+    def _hashable_content(self):
+        return super()._hashable_content() + (self.declaration,)
 
 
 @dataclass(frozen=True)
@@ -134,25 +153,55 @@ def coordinates(names):
 
 
 def parameters(names, defaults=None):
-    """Create parameters, e.g. ``parameters("m l g", defaults=(1.0, 1.0, 9.81))``.
+    """Declare parameters, e.g. ``parameters("m l g", defaults=(1.0, 1.0, 9.81))``.
 
-    ``defaults`` may be a sequence (same length), a dict by name, or None (values required at
-    simulation time). Returns a list of :class:`Parameter` (a single one when one name is given).
+    ``defaults`` may be a sequence (same length), a dict by name, a number (one name), or None
+    (values required at simulation time); each default is a finite number or None. Every call
+    declares new parameters (see :class:`Parameter`). Returns a list of :class:`Parameter` (a
+    single one when one name is given).
     """
     names = _split_names(names)
-    if defaults is None:
-        values = [None] * len(names)
-    elif isinstance(defaults, dict):
-        values = [defaults.get(n) for n in names]
-    else:
-        values = list(defaults)
-        if len(values) != len(names):
-            raise ModelError(f"parameters({' '.join(names)!r}): {len(names)} names but {len(values)} defaults")
-    for n, v in zip(names, values):
+    for n in names:
         _check_name("parameter", n)
-        _declared[n] = None if v is None else float(v)
-    params = [Parameter(n) for n in names]
+    params = [Parameter(n, next(_declarations), _finite_default(n, v))
+              for n, v in zip(names, _default_values(names, defaults))]
     return params[0] if len(params) == 1 else params
+
+
+def _default_values(names, defaults):
+    """One default (unchecked) per name from the forms parameters() accepts."""
+    listed = " ".join(names)
+    if defaults is None:
+        return [None] * len(names)
+    if isinstance(defaults, dict):
+        unknown = sorted(set(map(str, defaults)) - set(names))
+        if unknown:
+            raise ModelError(f"parameters({listed!r}): defaults given for {', '.join(unknown)}, "
+                             "which is not declared here")
+        return [defaults.get(n) for n in names]
+    if isinstance(defaults, (str, bytes)) or not hasattr(defaults, "__iter__"):
+        if len(names) == 1:
+            return [defaults]
+        raise ModelError(f"parameters({listed!r}): defaults must be a sequence of {len(names)} "
+                         f"numbers, a dict by name or None, got {defaults!r}")
+    values = list(defaults)
+    if len(values) != len(names):
+        raise ModelError(f"parameters({listed!r}): {len(names)} names but {len(values)} defaults")
+    return values
+
+
+def _finite_default(name, value):
+    """``value`` as a float, or None; ModelError naming the parameter unless finite."""
+    if value is None:
+        return None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not math.isfinite(number):
+        raise ModelError(f"parameter {name}: default {value!r} is not a finite number "
+                         "(give a finite number, or None for a value required at run time)")
+    return number
 
 
 def _check_name(kind, name):
@@ -189,11 +238,12 @@ class Model:
             raise ModelError(f"model {name}: no coordinates")
         coords, replace = _convert_dynamicsymbols(coords)
         self.coords = coords
-        self.T = _sympify(T, "T", replace)
-        self.V = _sympify(V, "V", replace)
-        self.dissipation = _sympify(dissipation, "dissipation", replace)
+        self.T = self._scalar(T, "T", replace)
+        self.V = self._scalar(V, "V", replace)
+        self.dissipation = self._scalar(dissipation, "dissipation", replace)
         self.forces = self._generalized_forces(forces, replace)
-        self.constraints = [_sympify(c, f"constraint {i}", replace) for i, c in enumerate(constraints)]
+        self.constraints = [self._scalar(c, f"constraint {i}", replace)
+                            for i, c in enumerate(self._sequence(constraints, "constraints", "expressions Phi(q)"))]
         self.elements = self._elements(elements, replace)
         self.params = self._collect_params(params)
         self.source_path = None      # set by load_model
@@ -214,6 +264,21 @@ class Model:
     def n_constraints(self):
         return len(self.constraints)
 
+    def _scalar(self, expr, what, replace):
+        try:
+            return _sympify(expr, what, replace)
+        except ModelError as exc:
+            raise ModelError(f"model {self.name}: {exc}") from None
+
+    def _sequence(self, items, what, of):
+        """``items`` as a list; ModelError naming ``what`` when it is not a sequence."""
+        if isinstance(items, (sp.Basic, str, bytes)) and not getattr(items, "is_Matrix", False):
+            raise ModelError(f"model {self.name}: {what} must be a sequence of {of}, got {items}")
+        try:
+            return list(items)
+        except TypeError:
+            raise ModelError(f"model {self.name}: {what} must be a sequence of {of}, got {items!r}") from None
+
     def _generalized_forces(self, forces, replace):
         n = len(self.coords)
         Q = [sp.S.Zero] * n
@@ -224,20 +289,22 @@ class Model:
                 key = replace.get(key, key)
                 if key not in self.coords:
                     raise ModelError(f"model {self.name}: force given for {key}, which is not a coordinate")
-                Q[self.coords.index(key)] += _sympify(value, f"force on {key}", replace)
+                Q[self.coords.index(key)] += self._scalar(value, f"force on {key}", replace)
             return Q
-        forces = list(forces)
+        forces = self._sequence(forces, "forces", "one Q per coordinate (or a dict {coordinate: Q}, "
+                                "or a list of PointForce)")
         if forces and all(isinstance(f, PointForce) for f in forces):
-            for f in forces:
-                for rk, Fk in zip(f.point, f.force):
-                    rk, Fk = _apply(rk, replace), _apply(Fk, replace)
+            for i, f in enumerate(forces):
+                point = [self._scalar(r, f"point of PointForce {i}", replace) for r in f.point]
+                force = [self._scalar(F, f"force of PointForce {i}", replace) for F in f.force]
+                for rk, Fk in zip(point, force):
                     for j, qj in enumerate(self.coords):
                         Q[j] += Fk * sp.diff(rk, qj)
             return Q
         if len(forces) != n:
             raise ModelError(f"model {self.name}: forces has {len(forces)} entries for {n} coordinates "
                              "(give one per coordinate, a dict, or a list of PointForce)")
-        return [_sympify(f, f"force {i}", replace) for i, f in enumerate(forces)]
+        return [self._scalar(f, f"force {i}", replace) for i, f in enumerate(forces)]
 
     def _elements(self, elements, replace):
         out = []
@@ -246,7 +313,9 @@ class Model:
                 raise ModelError(f"model {self.name}: element {i} is {type(e).__name__}, not SaintVenant or DryFriction")
             e.name = e.name or f"{e.kind}_{i}"
             _check_name("element", e.name)
-            e.strain = _sympify(e.strain, f"strain of element {e.name}", replace)
+            e.strain = self._scalar(e.strain, f"strain of element {e.name}", replace)
+            for c in e.coefficients():
+                self._scalar(c, f"coefficient of element {e.name}", {})
             out.append(e)
         return out
 
@@ -268,24 +337,27 @@ class Model:
                 yield f"coefficient of element {e.name}", c
 
     def _collect_params(self, explicit):
+        """The parameters in PARAMS order: ``explicit`` (params=), or the used ones in
+        declaration order. Fills param_defaults {name: default or None}."""
         found = {}
-        for _, expr in self._all_expressions():
+        for where, expr in self._all_expressions():
             for s in expr.free_symbols:
-                if isinstance(s, Parameter):
-                    found.setdefault(s.name, s)
-        self.param_defaults = {name: _declared.get(name) for name in found}
+                if isinstance(s, Parameter) and found.setdefault(s.name, s) != s:
+                    raise ModelError(f"model {self.name}: parameter {s.name} is declared twice (two "
+                                     f"parameters() calls) and both are used ({where} uses one of "
+                                     "them); declare it once and use that symbol")
+        params = sorted(found.values(), key=lambda s: (s.declaration == 0, s.declaration, s.name))
         if explicit is not None:
-            explicit = list(explicit)
-            for s in explicit:
+            params = list(explicit)
+            for s in params:
                 if not isinstance(s, Parameter):
                     raise ModelError(f"model {self.name}: params entry {s} is not a Parameter")
-                self.param_defaults.setdefault(s.name, _declared.get(s.name))
-            missing = sorted(set(found) - {s.name for s in explicit})
+            missing = [name for name, s in found.items() if s not in params]
             if missing:
-                raise ModelError(f"model {self.name}: parameter(s) {', '.join(missing)} used but not in params=")
-            return explicit
-        position = {name: i for i, name in enumerate(_declared)}
-        return sorted(found.values(), key=lambda s: (position.get(s.name, len(position)), s.name))
+                raise ModelError(f"model {self.name}: parameter(s) {', '.join(sorted(missing))} "
+                                 "used but not in params=")
+        self.param_defaults = {s.name: s.default for s in params}
+        return params
 
     def _validate(self):
         names = {}
@@ -308,6 +380,12 @@ class Model:
                 raise ModelError(f"model {self.name}: {where} contains an undefined function or derivative: {expr}")
         if self.T.free_symbols & {t}:
             raise ModelError(f"model {self.name}: T depends on t; only scleronomic T is supported")
+        moving = [f"{v} ({c}.d)" for c, v in zip(self.coords, self.velocities) if v in self.V.free_symbols]
+        if moving:
+            raise ModelError(f"model {self.name}: V depends on the velocit{'y' if len(moving) == 1 else 'ies'} "
+                             f"{', '.join(moving)}; V is a function of q and t: velocity-dependent "
+                             "potentials belong in T or in forces")
+        _check_rayleigh(self.name, self.dissipation, self.velocities)
         if self.dissipation.free_symbols & {t}:
             raise ModelError(f"model {self.name}: dissipation depends on t")
         for i, c in enumerate(self.constraints):
@@ -328,8 +406,8 @@ class Model:
             for label, c in zip(("stiffness/bound", "threshold"), e.coefficients()):
                 if c.free_symbols - set(self.params):
                     raise ModelError(f"model {self.name}: element {e.name}: {label} {c} must depend on parameters only")
-                value = c.xreplace({p: sp.Float(_declared[p.name]) for p in c.free_symbols
-                                    if _declared.get(p.name) is not None})
+                value = c.xreplace({p: sp.Float(p.default) for p in c.free_symbols
+                                    if isinstance(p, Parameter) and p.default is not None})
                 if e.kind == "dry_friction" and label == "threshold":
                     continue
                 if value.is_number and not float(value) > 0:
@@ -388,13 +466,59 @@ def _apply(expr, replace):
 
 
 def _sympify(expr, what, replace):
+    """``expr`` as a scalar sympy Expr with ``replace`` applied; ModelError naming ``what``."""
     try:
         expr = sp.sympify(expr)
     except (sp.SympifyError, TypeError) as exc:
         raise ModelError(f"{what} is not a SymPy expression: {exc}") from None
+    if getattr(expr, "is_Matrix", False):       # sympy matrices are Expr too
+        rows, cols = expr.shape
+        raise ModelError(f"{what} is a {rows} x {cols} matrix, not a scalar expression "
+                         "(take its entry, e.g. T[0], or sum the terms)")
     if not isinstance(expr, sp.Expr):
         raise ModelError(f"{what} is not a scalar SymPy expression: {expr!r}")
     return _apply(expr, replace) if replace else expr
+
+
+def _check_rayleigh(name, D, velocities):
+    """ModelError naming the first term of the dissipation function D that gives a wrong or no
+    force: D and its velocity gradient must vanish at rest (D quadratic in the velocities, or of
+    higher degree such as c |v|^3 / 3). A velocity-free term gives no force -dD/dqdot at all; a
+    term linear near rest (c x v, c |v|, sin v) gives a force that does not vanish at rest."""
+    if D == 0 or _rayleigh_problem(D, velocities) is None:
+        return
+    for terms in (sp.Add.make_args(D), sp.Add.make_args(sp.expand(D))):
+        for term in terms:
+            why = _rayleigh_problem(term, velocities)
+            if why:
+                raise ModelError(f"model {name}: dissipation term {term} {why}")
+    raise ModelError(f"model {name}: dissipation {D} {_rayleigh_problem(D, velocities)}")
+
+
+def _rayleigh_problem(D, velocities):
+    """Why D is not a Rayleigh function (a phrase), or None. With every velocity scaled by
+    s > 0, D and its velocity gradient must vanish as s -> 0 (s positive lets sign(s v) and
+    |s v| simplify, so that c |v| is seen as linear although its gradient is 0 at v = 0)."""
+    if not (D.free_symbols & set(velocities)):
+        return ("does not depend on any velocity: it gives no force -dD/dqdot (a potential "
+                "belongs in V)")
+    s = sp.Dummy("s", positive=True)
+    scaled = {v: s * v for v in velocities}
+    if not _vanishes_at_rest(D.xreplace(scaled), s):
+        return ("is not zero at rest (a Rayleigh function is quadratic in the velocities, "
+                "e.g. c*x.d**2/2)")
+    if not all(_vanishes_at_rest(D.diff(v).xreplace(scaled), s) for v in velocities):
+        return ("is linear in the velocities near rest, so its force -dD/dqdot does not vanish at "
+                "rest: a Rayleigh function is quadratic in the velocities (e.g. c*x.d**2/2); dry "
+                "friction is DryFriction, other forces go in forces=")
+    return None
+
+
+def _vanishes_at_rest(expr, s):
+    value = expr.subs(s, 0)
+    if value.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+        value = sp.limit(expr, s, 0, "+")
+    return value == 0 or sp.simplify(value) == 0
 
 
 def load_model(path, **options) -> Model:
@@ -417,20 +541,35 @@ def load_model(path, **options) -> Model:
         compile(source, str(path), "exec")
     except SyntaxError as exc:
         raise ModelError(f"{path}:{exc.lineno}: not valid Python: {exc.msg}") from None
-    _declared.clear()
-    try:
-        namespace = runpy.run_path(str(path), run_name=f"lagrange_gen_model_{path.stem}")
-        model = _pick_model(path, namespace, options)
-    except ModelError as exc:
-        msg = str(exc)
-        raise ModelError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
-    except Exception as exc:  # the user's code raised: report file and line, not a traceback
-        line = _user_line(exc, path)
-        raise ModelError(f"{path}{line}: raised {type(exc).__name__}: {exc}") from exc
+    model = _run_model_file(path, options)
     model.source_path = str(path)
     model.source_text = source
     model.build_options = dict(options)
     return model
+
+
+def _run_model_file(path, options):
+    """Run the file and pick its Model; every failure (an exception, sys.exit, any other
+    BaseException but Ctrl-C) becomes a ModelError naming the file and line. The path is resolved
+    before and the working directory restored after, whatever the file does (os.chdir)."""
+    resolved, cwd = path.resolve(), os.getcwd()
+    try:
+        namespace = runpy.run_path(str(resolved), run_name=f"lagrange_gen_model_{path.stem}")
+        return _pick_model(path, namespace, options)
+    except ModelError as exc:
+        msg = str(exc)
+        raise ModelError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
+    except KeyboardInterrupt:   # the user pressed Ctrl-C: the CLI reports "interrupted"
+        raise
+    except SystemExit as exc:
+        line = _user_line(exc, resolved)
+        raise ModelError(f"{path}{line}: exited while loading (SystemExit: {exc.code}); a model file "
+                         "must define `model`, not exit") from None
+    except BaseException as exc:  # the user's code raised: report file and line, not a traceback
+        line = _user_line(exc, resolved)
+        raise ModelError(f"{path}{line}: raised {type(exc).__name__}: {exc}") from exc
+    finally:
+        os.chdir(cwd)
 
 
 def _pick_model(path, namespace, options):
@@ -442,16 +581,24 @@ def _pick_model(path, namespace, options):
     else:
         model = namespace.get("model")
         if model is None:
-            found = [v for v in namespace.values() if isinstance(v, Model)]
-            if len(found) == 1:
-                model = found[0]
+            found = {}          # id -> first name: one Model under two names counts once
+            for name, value in namespace.items():
+                if isinstance(value, Model):
+                    found.setdefault(id(value), (name, value))
+            if len(found) > 1:
+                names = ", ".join(name for name, _ in found.values())
+                raise ModelError(f"{path}: defines {len(found)} Models ({names}) and none is named "
+                                 "`model`: assign the one to generate to `model`")
+            if found:
+                model = next(iter(found.values()))[1]
     if not isinstance(model, Model):
         raise ModelError(f"{path}: defines no Model (assign one to a variable named `model`)")
     return model
 
 
-def _user_line(exc, path):
+def _user_line(exc, resolved):
+    """":LINE" of the innermost frame of the exception in the (resolved) model file, or ""."""
     for frame in reversed(traceback.extract_tb(exc.__traceback__)):
-        if Path(frame.filename).resolve() == path.resolve():
+        if Path(frame.filename) == resolved:
             return f":{frame.lineno}"
     return ""

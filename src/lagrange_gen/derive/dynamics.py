@@ -74,6 +74,14 @@ class Dynamics:
         return not ({str(s) for s in self.native["rhs"].free_symbols} & {s.name for s in self.qd})
 
 
+def input_symbols(vector, count):
+    """Symbols for the entries of a kernel input vector (w, lam, we), named ``w[0]``, ``w[1]``,
+    ...: not identifiers, so no coordinate or parameter (identifiers, by Model's check) shares a
+    name with them in the name-keyed maps of the backend (to_sympy) and of CSE. The printer gives
+    them placeholders (codegen.printer.Inputs) like every other input."""
+    return [sp.Symbol(f"{vector}[{i}]", real=True) for i in range(count)]
+
+
 def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
     """Derive H, h, g, Q, constraints, energy (and, on demand, Newton Jacobians) of a model.
 
@@ -88,9 +96,8 @@ def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
     q = o.symbols(model.coords)
     parts.update(derive_constraints(model, o, q))
     n, m = len(model.coords), len(model.constraints)
-    aux = {"w": list(sp.symbols(f"w_0:{n}", real=True)) if n else [],
-           "lam": list(sp.symbols(f"lam_0:{m}", real=True)) if m else [],
-           "we": list(sp.symbols(f"we_0:{len(model.elements)}", real=True))}
+    aux = {"w": input_symbols("w", n), "lam": input_symbols("lam", m),
+           "we": input_symbols("we", len(model.elements))}
     for key, value in derive_elements(model, aux["we"]).items():
         parts[key] = o.matrix(*value.shape, list(value))
     native = {k: parts[k] for k in FIELDS}

@@ -102,7 +102,16 @@ def _check_quadratic_and_definite(model, o, H, T, samples):
         try:
             np.linalg.cholesky(Hs)
         except np.linalg.LinAlgError:
-            eig = np.linalg.eigvalsh(Hs)
-            weakest = model.coords[int(np.argmin(np.abs(np.diag(Hs))))]
+            eig, vectors = np.linalg.eigh(Hs)
             raise ModelError(f"model {model.name}: H = d2T/dqdot2 is not positive definite at {state} "
-                             f"(smallest eigenvalue {eig.min():.3g}; check the terms in {weakest}.d)") from None
+                             f"(smallest eigenvalue {eig[0]:.3g}; check the terms in "
+                             f"{_weakest_direction(model.coords, vectors[:, 0])})") from None
+
+
+def _weakest_direction(coords, vector):
+    """"y.d, x.d": the velocities along which T is not positive, i.e. the largest components
+    (at least half the largest) of the eigenvector (n,) of H's smallest eigenvalue, largest
+    first. A sign error in one term of T shows there, not in the smallest diagonal entry."""
+    size = np.abs(vector)
+    order = np.argsort(-size, kind="stable")
+    return ", ".join(f"{coords[i]}.d" for i in order if size[i] >= 0.5 * size.max())

@@ -13,6 +13,7 @@ velocity for v, time for t.
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
 import numpy as np
@@ -57,8 +58,7 @@ def read_columns(path):
     path = Path(path)
     if not path.is_file():
         raise IdentificationError(f"{path}: no such file")
-    with path.open(newline="") as handle:
-        rows = [r for r in csv.reader(handle) if r and any(cell.strip() for cell in r)]
+    rows = [r for r in csv.reader(_text_lines(path)) if r and any(cell.strip() for cell in r)]
     if not rows:
         raise IdentificationError(f"{path}: empty file, no samples")
     names = None
@@ -81,6 +81,21 @@ def read_columns(path):
     return names, np.array(data, dtype=float).reshape(len(data), width)
 
 
+def _text_lines(path):
+    """The lines of a UTF-8 text file (a byte-order mark is dropped); IdentificationError naming
+    the file and line when it is binary or in another encoding."""
+    data = path.read_bytes()
+    if b"\x00" in data:
+        raise IdentificationError(f"{path}: not a UTF-8 text file (binary data); expected a CSV file")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise IdentificationError(f"{path}: line {line}: not a UTF-8 text file (byte "
+                                  f"0x{data[exc.start]:02x}); save the CSV as UTF-8") from None
+    return text.splitlines(keepends=True)
+
+
 def _columns(path, names, data, wanted, optional=()):
     """Dict name -> (N,) column; by header name when there is a header, else by position."""
     found = {}
@@ -99,8 +114,16 @@ def _columns(path, names, data, wanted, optional=()):
     return found
 
 
+def _check_options(args):
+    """IdentificationError naming the first option whose value cannot be meant."""
+    if args.noise is not None and not (math.isfinite(args.noise) and args.noise >= 0):
+        raise IdentificationError(f"--noise {args.noise:g}: must be a finite number >= 0 "
+                                  "(the standard deviation of the noise on F)")
+
+
 def run(args) -> int:
     from . import identify_damping, identify_prandtl
+    _check_options(args)
     names, data = read_columns(args.data)
     if args.kind == "prandtl":
         cols = _columns(args.data, names, data, ("x", "F"), ("v", "t") if names else ("v",))
