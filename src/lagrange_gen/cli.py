@@ -67,33 +67,68 @@ def generate_parser():
                         "they leave PARAMS and cannot be passed at run time")
     p.add_argument("--set", action="append", metavar="NAME=VALUE", dest="options",
                    help="option passed to the model file's build() (e.g. n=8), repeatable")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite a generated file even when it was generated from another model "
+                        "file with the same model name (or was not written by lagrange-gen)")
     p.add_argument("--debug", action="store_true", help="show tracebacks")
     return p
 
 
 def run_generate(args) -> int:
-    from .codegen.generate import generate_model, is_current
+    """Generate (or --check) every model file given: a failing model is one line on stderr and
+    does not stop the others; exit 2 if any failed, 1 if any is missing or stale (--check)."""
     from .derive.freeze import parse_freeze
     methods = args.methods.split(",") if args.methods else None
     options = _parse_options(args.options)
     freeze = parse_freeze(args.freeze)
-    if args.check:
-        bad = 0
-        for path in args.models:
-            target, current = is_current(path, args.out_dir, methods, options, freeze)
-            if not current:
-                state = "stale" if target.exists() else "missing"
-                print(f"{target}: {state} (run lagrange-gen {path})")
-                bad += 1
-            else:
-                print(f"{target}: current")
-        return 1 if bad else 0
-    for path in args.models:
-        start = time.perf_counter()
-        result = generate_model(path, args.out_dir, methods, options, freeze)
-        what = "written" if result.written else "unchanged"
-        print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
-    return 0
+    action = _check_one if args.check else _generate_one
+    outcomes = [for_each_model(path, args.debug, action, path, args, methods, options, freeze)
+                for path in args.models]
+    return 2 if None in outcomes else 1 if False in outcomes else 0
+
+
+def _generate_one(path, args, methods, options, freeze):
+    from .codegen.generate import generate_model
+    start = time.perf_counter()
+    result = generate_model(path, args.out_dir, methods, options, freeze, force=args.force)
+    what = "written" if result.written else "unchanged"
+    print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
+    return True
+
+
+def _check_one(path, args, methods, options, freeze):
+    from .codegen.generate import check_generated
+    from .keys import regeneration_command
+    target, problem = check_generated(path, args.out_dir, methods, options, freeze)
+    if problem is None:
+        print(f"{target}: current")
+        return True
+    command = regeneration_command(path, args.out_dir, options, methods, freeze)
+    print(f"{target}: {problem}; run {command}")
+    return False
+
+
+def for_each_model(path, debug, action, *args):
+    """``action(*args)`` for one model file; any failure but Ctrl-C is one line on stderr naming
+    ``path`` and returns None (so the caller goes on with the next model); --debug re-raises."""
+    try:
+        return action(*args)
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:       # SystemExit from a model file too: it must not end the loop
+        if debug:
+            raise
+        print(f"lagrange-gen: error: {_failure_line(path, exc)}", file=sys.stderr)
+        return None
+
+
+def _failure_line(path, exc) -> str:
+    if isinstance(exc, SystemExit):
+        return f"{path}: the model file called sys.exit({exc.code!r})"
+    message = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+    if not isinstance(exc, LagrangeGenError):
+        message = f"{type(exc).__name__}: {message} (an internal error: --debug shows the traceback)"
+    return message if str(path) in message else f"{path}: {message}"
 
 
 def _subcommand_parser(name):

@@ -1,7 +1,10 @@
-"""Import generated modules by path, generating them first when given a model file."""
+"""Import generated modules by path, generating them first when given a model file; the numba
+decorator and self-registration every generated module uses at import."""
 
 from __future__ import annotations
 
+import functools
+import glob
 import hashlib
 import importlib.util
 import sys
@@ -31,23 +34,151 @@ def import_generated(path):
     return module
 
 
-def load(path, out_dir="generated", methods=None, options=None, regenerate=True):
+def load(path, out_dir="generated", methods=None, options=None, regenerate=True, freeze=None,
+         force=False):
     """Return the generated module for ``path``.
 
-    ``path`` is a generated module (it has a KEY line) or a model file; a model file is generated
-    into ``out_dir`` first when its module is missing or stale (``regenerate=False``: raise instead).
+    ``path`` is a generated module (it has a KEY line) or a model file. For a model file the
+    module already in ``out_dir`` is used when it is current and satisfies the request: it has
+    the ``methods`` (None: any), the ``freeze`` (None: whatever it was generated with, e.g. by
+    ``lagrange-gen --freeze``) and the build ``options`` (None: likewise). Otherwise it is
+    generated: when missing, when stale (keeping its own freeze, build and methods unless asked
+    otherwise), or when methods are missing (added to its own). A current module generated with
+    another freeze or build, or from another model file, is refused in one line naming what
+    differs and the command that regenerates it (``force=True`` regenerates it);
+    ``regenerate=False`` raises StaleModuleError instead of generating.
     """
-    from .codegen.generate import generate_model, is_current
+    from .codegen.generate import generate_model
     from .keys import read_key
     path = Path(path)
     if read_key(path) is not None:
         return import_generated(path)
-    target, current = is_current(path, out_dir, methods, options)
-    if not current:
+    target, plan = _plan(path, out_dir, methods, options, freeze, force)
+    if plan is not None:
+        why, build, methods, freeze, command = plan
         if not regenerate:
-            raise StaleModuleError(f"{target} is missing or stale: run lagrange-gen {path}")
-        target = generate_model(path, out_dir, methods, options).path
+            raise StaleModuleError(f"{target} is {why}: run {command}")
+        generate_model(path, out_dir, methods, build, freeze, force=True)
     return import_generated(target)
+
+
+def _plan(path, out_dir, methods, options, freeze, force):
+    """(target, None) when the module on disk serves the request of load(), else (target,
+    (why, build, methods, freeze, command)) to generate with."""
+    from .codegen.generate import (other_source, refuse_overwrite, describe_options, generation_options,
+                                   output_path, resolve_methods)
+    from .keys import generator_hash, make_key, model_hash, read_header, regeneration_command
+    from .model import load_model
+    model = load_model(path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    header = read_header(target) or {}
+    if not force:
+        refuse_overwrite(path, target, model.name)
+    disk = header.get("OPTIONS") if other_source(path, target, header) is None else None
+    if not isinstance(disk, dict):          # missing (or forced over another model's module)
+        build, methods, freeze = dict(options or {}), resolve_methods(methods), dict(freeze or {})
+        return target, ("missing", build, methods, freeze, regeneration_command(path, out_dir, build, methods, freeze))
+    have = list(disk.get("methods", ()))
+    build = dict(disk.get("build", {}) if options is None else options)
+    freeze = dict(disk.get("freeze", {}) if freeze is None else freeze)
+    methods = resolve_methods(have + list(methods or ()))
+    wanted = generation_options(build, methods, freeze)
+    command = regeneration_command(path, out_dir, build, methods, freeze)
+    if header.get("KEY") != make_key(model_hash(model.source_text), generator_hash(), disk):
+        return target, ("stale", build, methods, freeze, command)
+    if (wanted["build"], wanted.get("freeze")) != (disk.get("build"), disk.get("freeze")) and not force:
+        have_options = {"build": disk.get("build"), "freeze": disk.get("freeze")}
+        raise GenerationError(f"{target} was generated with {describe_options(have_options)}, not with "
+                              f"{describe_options(wanted | {'methods': None})} as asked: regenerate it "
+                              f"with `{command}`, or ask for what it has")
+    if wanted != disk:
+        return target, (f"missing method(s) {', '.join(m for m in methods if m not in have)}",
+                        build, methods, freeze, command)
+    return target, None
+
+
+def register_module(namespace):
+    """Make ``sys.modules[namespace['__name__']]`` the module whose globals are ``namespace``.
+
+    Every generated module calls this on import: its stepper glue finds the module in
+    sys.modules, and numba's cache re-imports it by name. Imports through the import system
+    or import_generated have done it already; importlib's spec_from_file_location +
+    exec_module by hand has not.
+    """
+    name = namespace["__name__"]
+    current = sys.modules.get(name)
+    if current is not None and getattr(current, "__dict__", None) is namespace:
+        return
+    import gc
+    import types
+    for owner in gc.get_referrers(namespace):
+        if isinstance(owner, types.ModuleType) and owner.__dict__ is namespace:
+            sys.modules[name] = owner
+            return
+
+
+def njit(*args, **kwargs):
+    """``numba.njit`` for generated modules: with ``cache=True``, an entry of numba's on-disk cache
+    that cannot be loaded (truncated, garbage, written by something else) is a cache miss: the
+    entry is removed, the function compiled again, and one warning line printed per module."""
+    import numba
+    decorate = numba.njit(**kwargs)
+    if args:                                   # used as @njit without arguments
+        return _guard_cache(decorate(args[0]))
+    return lambda fn: _guard_cache(decorate(fn))
+
+
+_WARNED = set()
+
+
+def _guard_cache(dispatcher):
+    from numba.core.caching import FunctionCache
+    cache = getattr(dispatcher, "_cache", None)
+    if type(cache) is FunctionCache:
+        cache.__class__ = _miss_on_error_cache_class()
+    return dispatcher
+
+
+@functools.lru_cache(maxsize=None)
+def _miss_on_error_cache_class():
+    """numba's FunctionCache whose load/save failures are cache misses (defined on first use:
+    numba is imported only by generated modules)."""
+    from numba.core.caching import FunctionCache
+
+    class MissOnErrorCache(FunctionCache):
+        def load_overload(self, sig, target_context):
+            try:
+                return super().load_overload(sig, target_context)
+            except Exception as exc:      # an unreadable entry: remove it and compile again
+                _discard_entry(self, exc)
+                return None
+
+        def save_overload(self, sig, data):
+            try:
+                super().save_overload(sig, data)
+            except Exception as exc:      # the compiled function works; only the cache failed
+                _discard_entry(self, exc)
+
+    return MissOnErrorCache
+
+
+def _discard_entry(cache, exc):
+    """Delete one function's cache files (index and data; names as numba.core.caching makes
+    them) and warn once per generated module."""
+    directory, base = Path(cache.cache_path), cache._impl.filename_base
+    removed = 0
+    for entry in [directory / f"{base}.nbi", *directory.glob(f"{glob.escape(base)}.*.nbc")]:
+        try:
+            entry.unlink()
+            removed += 1
+        except OSError:
+            pass
+    source = cache._py_func.__code__.co_filename
+    if source not in _WARNED:
+        _WARNED.add(source)
+        what = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        print(f"lagrange-gen: warning: numba cache of {source} unreadable ({what}); removed "
+              f"{removed} file(s) in {directory} and compiling again", file=sys.stderr)
 
 
 def _kernel_args(module):

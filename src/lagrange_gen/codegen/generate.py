@@ -1,16 +1,25 @@
-"""The generation pipeline for one model file: load -> derive -> kernels -> render -> write."""
+"""The generation pipeline for one model file: load -> derive -> kernels -> render -> write.
+
+Also what ``--check`` and ``lagrange_gen.load`` decide from a generated file on disk: whether
+its text is what the generator would write now (check_generated), and whether it can be used
+for a request or must be generated (plan_load).
+"""
 
 from __future__ import annotations
 
 import os
+import sys
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..derive import derive
 from ..errors import GenerationError
 from ..model import load_model
-from ..keys import generator_hash, make_key, model_hash, read_key
+from ..keys import (generator_hash, make_key, model_hash, read_header, read_key, regeneration_command,
+                    text_hash)
 from .emit import render_kernel
 from .compose import compositions
 from .needs import methods_needs, select_kernels
@@ -18,6 +27,11 @@ from .printer import Inputs
 from .render import render_module
 from .spec import make_kernels
 from .write import write_if_changed
+
+#: Seconds a generation stage may run before progress lines go to stderr (small models: none).
+PROGRESS_AFTER = 2.0
+#: Seconds between the lines of a stage that is still running.
+PROGRESS_EVERY = 30.0
 
 
 @dataclass
@@ -31,30 +45,52 @@ def output_path(model_name: str, out_dir) -> Path:
     return Path(out_dir) / f"{model_name}.py"
 
 
-def _command(model_path, out_dir, options, methods=None, freeze=None):
-    """The command that regenerates this very module (quoted in stale-module errors)."""
-    from ..steppers.registry import METHODS
-    cmd = f"lagrange-gen {model_path}"
-    if str(out_dir) != "generated":
-        cmd += f" -o {out_dir}"
-    for k, v in sorted(options.items()):
-        cmd += f" --set {k}={v}"
-    if methods is not None and list(methods) != list(METHODS):
-        cmd += f" --methods {','.join(methods)}"
-    if freeze:
-        cmd += " --freeze " + ",".join(f"{k}={v!r}" for k, v in sorted(freeze.items()))
-    return cmd
+class Progress:
+    """Progress lines on stderr for one generation (``label`` names the model file): a stage
+    still running after PROGRESS_AFTER s is announced, again every PROGRESS_EVERY s with what it
+    is doing (``detail``), and its end reported with the elapsed time; fast stages print nothing."""
+
+    def __init__(self, label):
+        self.label, self.detail = str(label), ""
+        self._lock = threading.Lock()
+
+    def say(self, text):
+        with self._lock:
+            print(f"lagrange-gen: {self.label}: {text}", file=sys.stderr, flush=True)
+
+    @contextmanager
+    def stage(self, name):
+        start, done = time.perf_counter(), threading.Event()
+        self.detail = ""
+        watcher = threading.Thread(target=self._watch, args=(name, start, done), daemon=True)
+        watcher.start()
+        try:
+            yield self
+        finally:
+            done.set()
+            watcher.join()
+        elapsed = time.perf_counter() - start
+        if elapsed >= PROGRESS_AFTER:
+            self.say(f"{name} done in {elapsed:.1f} s")
+
+    def _watch(self, name, start, done):
+        wait = PROGRESS_AFTER
+        while not done.wait(wait):
+            detail = f": {self.detail}" if self.detail else ""
+            self.say(f"{name} running ({time.perf_counter() - start:.0f} s){detail}")
+            wait = PROGRESS_EVERY
 
 
-def _options(model, methods, freeze):
+def generation_options(build, methods, freeze):
     """Generation options recorded in the module and hashed into its KEY."""
-    options = {"build": dict(sorted(model.build_options.items())), "methods": list(methods)}
+    options = {"build": dict(sorted(build.items())), "methods": list(methods)}
     if freeze:
         options["freeze"] = dict(sorted(freeze.items()))
     return options
 
 
-def _methods(requested):
+def resolve_methods(requested):
+    """Requested methods in registry order (all for None); GenerationError for unknown ones."""
     from ..steppers.registry import METHODS
     if requested is None:
         return list(METHODS)
@@ -80,30 +116,33 @@ class GenerationParts:
     seconds: dict
 
 
-def generate_parts(model, out_dir="generated", methods=None, freeze=None) -> GenerationParts:
+def generate_parts(model, out_dir="generated", methods=None, freeze=None, progress=None) -> GenerationParts:
     """Derive and emit a loaded Model (nothing is written); see generate_text."""
     from ..steppers.registry import glue_source
-    methods, freeze = _methods(methods), dict(sorted((freeze or {}).items()))
-    options = _options(model, methods, freeze)
+    progress = progress or Progress(model.source_path or model.name)
+    methods, freeze = resolve_methods(methods), dict(sorted((freeze or {}).items()))
+    options = generation_options(model.build_options, methods, freeze)
     model_sha, gen_sha = model_hash(model.source_text), generator_hash()
     key = make_key(model_sha, gen_sha, options)
     start = time.perf_counter()
-    dyn = derive(model, freeze=freeze)
-    selected = select_kernels(dyn, methods)
-    composed = compositions(dyn, selected, methods_needs(methods)) if methods else {}
-    for name, how in composed.items():
-        selected[name] = selected[name] + [f"composed from kernels ({how})"]
-    kernels = make_kernels(dyn, selected, composed)
+    with progress.stage("derive"):
+        dyn = derive(model, freeze=freeze)
+        selected = select_kernels(dyn, methods)
+        composed = compositions(dyn, selected, methods_needs(methods)) if methods else {}
+        for name, how in composed.items():
+            selected[name] = selected[name] + [f"composed from kernels ({how})"]
+        kernels = make_kernels(dyn, selected, composed)
     derived = time.perf_counter()
-    inputs = Inputs(dyn)
-    texts = [render_kernel(spec, inputs) for spec in kernels]
-    target = output_path(model.name, out_dir)
-    source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
-    text = render_module(dyn, texts, key=key, model_sha=model_sha, gen_sha=gen_sha,
-                         options=options, source_rel=source_rel,
-                         command=_command(model.source_path, out_dir, model.build_options, methods, freeze),
-                         methods=methods, glue="\n\n".join(glue_source(m) for m in methods),
-                         why=selected)
+    with progress.stage("emit"):
+        inputs, texts = Inputs(dyn), []
+        for number, spec in enumerate(kernels, 1):
+            progress.detail = f"kernel {number}/{len(kernels)} {spec.name}"
+            texts.append(render_kernel(spec, inputs))
+        target = output_path(model.name, out_dir)
+        source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
+        text = render_module(dyn, texts, key=key, model_sha=model_sha, gen_sha=gen_sha,
+                             options=options, source_rel=source_rel, methods=methods,
+                             glue="\n\n".join(glue_source(m) for m in methods), why=selected)
     seconds = {"derive": derived - start, "emit": time.perf_counter() - derived}
     return GenerationParts(text, key, target, dyn, texts, seconds)
 
@@ -118,24 +157,109 @@ def generate_text(model, out_dir="generated", methods=None, freeze=None):
     return parts.text, parts.key, parts.target
 
 
+def _label(model_path, options):
+    return " ".join([str(model_path)] + [f"--set {k}={v}" for k, v in sorted((options or {}).items())])
+
+
 def generate_model(model_path, out_dir="generated", methods=None, options=None,
-                   freeze=None) -> GenerationResult:
-    """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched)."""
-    model = load_model(model_path, **(options or {}))
-    text, key, target = generate_text(model, out_dir, methods, freeze)
-    written = write_if_changed(target, text)
-    return GenerationResult(target, written, key)
+                   freeze=None, force=False) -> GenerationResult:
+    """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched).
+
+    A file there generated from another model file (or not by lagrange-gen) is not overwritten
+    unless ``force`` (GenerationError naming both files)."""
+    progress = Progress(_label(model_path, options))
+    with progress.stage("load model"):
+        model = load_model(model_path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    if not force:
+        refuse_overwrite(model_path, target, model.name)
+    parts = generate_parts(model, out_dir, methods, freeze, progress)
+    with progress.stage("write"):
+        written = write_if_changed(target, parts.text)
+    return GenerationResult(target, written, parts.key)
+
+
+def other_source(model_path, target, header):
+    """The model file ``target`` was generated from when it is not ``model_path`` and exists."""
+    recorded = header.get("MODEL_PATH")
+    if not isinstance(recorded, str):
+        return None
+    source = Path(os.path.normpath(target.parent / recorded))
+    if not source.is_file() or source.resolve() == Path(model_path).resolve():
+        return None
+    return source
+
+
+def refuse_overwrite(model_path, target, name):
+    """GenerationError when ``target`` holds something generating ``model_path`` (model ``name``)
+    would destroy: a module generated from another existing model file, or a file that
+    lagrange-gen did not write."""
+    if not target.is_file() or target.stat().st_size == 0:
+        return
+    header = read_header(target)
+    if header is None:
+        raise GenerationError(f"{target} exists and was not written by lagrange-gen: not overwritten "
+                              f"(move it, use another -o DIR, or pass --force)")
+    other = other_source(model_path, target, header)
+    if other is not None:
+        raise GenerationError(f"{target} was generated from {other}, not {model_path} (both define model "
+                              f"{name!r}): not overwritten (rename one model, use another -o DIR, or pass --force)")
 
 
 def expected_key(model_path, out_dir="generated", methods=None, options=None, freeze=None):
-    """(target path, KEY the model would get now) without deriving: for --check."""
+    """(target path, KEY the model would get now) without deriving."""
     model = load_model(model_path, **(options or {}))
-    opts = _options(model, _methods(methods), dict(sorted((freeze or {}).items())))
+    opts = generation_options(model.build_options, resolve_methods(methods), dict(sorted((freeze or {}).items())))
     key = make_key(model_hash(model.source_text), generator_hash(), opts)
     return output_path(model.name, out_dir), key
 
 
 def is_current(model_path, out_dir="generated", methods=None, options=None, freeze=None):
-    """(target, True when target exists and carries the KEY the model would get now)."""
+    """(target, True when target exists and carries the KEY the model would get now): the cheap
+    check (model source, generator, options); check_generated compares the whole text."""
     target, key = expected_key(model_path, out_dir, methods, options, freeze)
     return target, read_key(target) == key
+
+
+def check_generated(model_path, out_dir="generated", methods=None, options=None, freeze=None):
+    """(target, None) when the file on disk is exactly what generating with these arguments would
+    write now, else (target, "missing" or "stale (why)"). Re-derives: a changed data file or
+    helper module the model reads is seen when it changes the equations, and only then."""
+    model = load_model(model_path, **(options or {}))
+    text, key, target = generate_text(model, out_dir, methods, freeze)
+    header = read_header(target)
+    if header is None:
+        return target, "stale (not a lagrange-gen module)" if target.exists() else "missing"
+    other = other_source(model_path, target, header)
+    if other is not None:
+        return target, f"stale (generated from {other}, not {model_path})"
+    try:
+        on_disk = target.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        return target, f"stale (unreadable: {exc})"
+    if on_disk == text:
+        return target, None
+    if header.get("KEY") != key:
+        why = _key_difference(header, model, methods, freeze)
+    elif text_hash(on_disk) != header.get("TEXT_SHA"):
+        why = "edited by hand since it was generated"
+    else:
+        why = "its equations changed: a file the model reads or imports changed"
+    return target, f"stale ({why})"
+
+
+def _key_difference(header, model, methods, freeze):
+    wanted = generation_options(model.build_options, resolve_methods(methods), dict(sorted((freeze or {}).items())))
+    if header.get("OPTIONS") != wanted:
+        return f"generated with other options: {describe_options(header.get('OPTIONS') or {})}"
+    if header.get("MODEL_SHA") != model_hash(model.source_text):
+        return "the model file changed"
+    return "the generator changed"
+
+
+def describe_options(options) -> str:
+    """Recorded generation options as command-line options ('--set n=8 --freeze g=1.62'), or
+    'default options'."""
+    command = regeneration_command("M", "generated", options.get("build"), options.get("methods"),
+                                   options.get("freeze"))
+    return command.split(" ", 2)[2] if command.count(" ") >= 2 else "default options"

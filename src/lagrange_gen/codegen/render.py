@@ -5,6 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..derive.elements import KIND_CODES
+from ..keys import TEXT_SHA_PREFIX, text_hash
 from .forward import factor_at_import, forward_source
 from .spec import default_kernels
 
@@ -59,9 +60,9 @@ _IMPORTS = [
     "import math",
     "",
     "import numpy as np",
-    "from numba import njit",
     "",
     "from lagrange_gen.keys import check_fresh",
+    "from lagrange_gen.loader import njit, register_module  # numba.njit; a bad cache entry is a miss",
     "from lagrange_gen.errors import SingularMass",
     "from lagrange_gen.linalg import cholesky_inplace, cholesky_solve_inplace",
     "from lagrange_gen.params import resolve_params",
@@ -96,11 +97,15 @@ def _model_constants(dyn, methods, texts):
     ]
 
 
-def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, command,
+def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel,
                   methods, glue, why=None) -> str:
     """The whole generated module as text. ``glue`` is the per-stepper source to append;
     ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
-    ``texts`` are the rendered kernels (emit.render_kernel), in module order."""
+    ``texts`` are the rendered kernels (emit.render_kernel), in module order.
+
+    The header records TEXT_SHA, the hash of the whole text but that line (keys.text_hash),
+    which the module checks on import. Nothing in the text depends on the working directory or
+    on how the model path was spelled, so ``--check`` can compare texts."""
     parts = [
         f"# lagrange-gen generated module. DO NOT EDIT. KEY = {key}",
         f'"""{module_docstring(dyn, source_rel, methods, why, texts)}\n"""',
@@ -108,10 +113,12 @@ def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, c
         f'KEY = "{key}"',
         f'MODEL_SHA = "{model_sha}"',
         f'GENERATOR_SHA = "{gen_sha}"',
+        f'{TEXT_SHA_PREFIX}""',
         f"OPTIONS = {options!r}",
         f"MODEL_PATH = {source_rel!r}",
         "", *_IMPORTS, "",
-        f"check_fresh(__file__, KEY, MODEL_SHA, GENERATOR_SHA, MODEL_PATH, OPTIONS, {command!r})",
+        "check_fresh(__file__, KEY, MODEL_SHA, GENERATOR_SHA, MODEL_PATH, OPTIONS, TEXT_SHA)",
+        "register_module(globals())  # the stepper glue finds this module in sys.modules",
         "", *_model_constants(dyn, methods, texts), "",
     ]
     constants = [c for t in texts for c in t.constants]
@@ -123,4 +130,5 @@ def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel, c
     parts += ["", forward_source(dyn)]
     if glue:
         parts += ["", glue]
-    return "\n".join(parts).rstrip() + "\n"
+    text = "\n".join(parts).rstrip() + "\n"
+    return text.replace(f'\n{TEXT_SHA_PREFIX}""\n', f'\n{TEXT_SHA_PREFIX}"{text_hash(text)}"\n', 1)
