@@ -59,6 +59,21 @@ def test_sys_exit_in_first_file_stops_the_cli_with_nonzero_exit(tmp_path):
     assert re.search(rf"{re.escape(str(a))}:6: .*SystemExit", run.stderr), run.stderr
 
 
+def test_keyboard_interrupt_while_loading_stays_an_interrupt(tmp_path, monkeypatch, capsys):
+    """Ctrl-C (or a file raising KeyboardInterrupt, which looks the same) is not turned into a
+    model error that a loop over files would skip: the CLI reports "interrupted", exit 130, and
+    the directory the file changed to is left again."""
+    from lagrange_gen.cli import main
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    path = tmp_path / "interrupted.py"
+    path.write_text(f"import os\nos.chdir({str(elsewhere)!r})\nraise KeyboardInterrupt\n")
+    monkeypatch.chdir(tmp_path)
+    assert main([str(path), "-o", str(tmp_path / "out")]) == 130
+    assert capsys.readouterr().err.strip() == "lagrange-gen: interrupted"
+    assert Path.cwd() == tmp_path
+
+
 def test_chdir_in_model_file_does_not_move_the_output(tmp_path, monkeypatch):
     """The file changes directory while loading; the module is written where the CLI says,
     relative to the directory the user ran it from, and that directory is restored."""
