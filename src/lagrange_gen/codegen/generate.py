@@ -226,13 +226,14 @@ def check_generated(model_path, out_dir="generated", methods=None, options=None,
     write now, else (target, "missing" or "stale (why)"). Re-derives: a changed data file or
     helper module the model reads is seen when it changes the equations, and only then."""
     model = load_model(model_path, **(options or {}))
-    text, key, target = generate_text(model, out_dir, methods, freeze)
+    target = output_path(model.name, out_dir)
     header = read_header(target)
     if header is None:
         return target, "stale (not a lagrange-gen module)" if target.exists() else "missing"
     other = other_source(model_path, target, header)
     if other is not None:
         return target, f"stale (generated from {other}, not {model_path})"
+    text, key, _ = generate_text(model, out_dir, methods, freeze)
     try:
         on_disk = target.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
