@@ -16,7 +16,7 @@ from .errors import (BlowUp, GenerationError, LagrangeGenError, ModelError, Newt
 
 _LAZY = {
     "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
-    "t": "model", "load_model": "model", "SaintVenant": "model", "DryFriction": "model",
+    "t": "model", "load_model": "model_file", "SaintVenant": "model", "DryFriction": "model",
     "import_generated": "loader", "load": "loader",
     "simulate": "simulation", "Trajectory": "simulation",
 }

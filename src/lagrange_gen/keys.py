@@ -15,7 +15,7 @@ from .errors import StaleModuleError
 _PACKAGE = Path(__file__).resolve().parent
 # Sources whose change alters generated text or the compiled code a generated module pulls in.
 # (nonsmooth/play.py only: the return map the steppers compile; experiments.py is a report.)
-_GENERATOR_PARTS = ("model.py", "linalg.py", "params.py", "status.py", "errors.py", "keys.py", "derive",
+_GENERATOR_PARTS = ("model.py", "model_file.py", "linalg.py", "params.py", "status.py", "errors.py", "keys.py", "derive",
                     "codegen", "steppers", "nonsmooth/play.py")
 # The header line that records the hash of the rest of the file (it cannot hash itself).
 TEXT_SHA_PREFIX = "TEXT_SHA = "

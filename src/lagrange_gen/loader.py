@@ -68,7 +68,7 @@ def _plan(path, out_dir, methods, options, freeze, force):
     from .codegen.generate import (other_source, refuse_overwrite, describe_options, generation_options,
                                    output_path, resolve_methods)
     from .keys import generator_hash, make_key, model_hash, read_header, regeneration_command
-    from .model import load_model
+    from .model_file import load_model
     model = load_model(path, **(options or {}))
     target = output_path(model.name, out_dir)
     header = read_header(target) or {}

@@ -58,7 +58,7 @@ def mechanics_equations(model_file):
     symbols in the model's order). Raises ValueError for a model this peer does not cover."""
     from sympy.physics import mechanics as me
 
-    from ..model import load_model
+    from ..model_file import load_model
     model = load_model(model_file)
     if model.constraints or model.elements or any(f != 0 for f in model.forces) \
             or model.dissipation != 0:

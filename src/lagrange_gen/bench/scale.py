@@ -37,7 +37,7 @@ def measure_generation(model_file, n, out_dir, methods=METHODS):
     import sympy as sp
     from ..codegen.generate import generate_parts
     from ..codegen.write import write_if_changed
-    from ..model import load_model
+    from ..model_file import load_model
     model = load_model(model_file, n=n)
     parts = generate_parts(model, out_dir, methods=list(methods) if methods else None)
     write_if_changed(parts.target, parts.text)

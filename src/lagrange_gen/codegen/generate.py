@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..derive import derive
 from ..errors import GenerationError
-from ..model import load_model
+from ..model_file import load_model
 from ..keys import (generator_hash, make_key, model_hash, read_header, read_key, regeneration_command,
                     text_hash)
 from .emit import render_kernel
