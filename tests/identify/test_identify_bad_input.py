@@ -70,3 +70,12 @@ def test_binary_file_through_the_installed_command(tmp_path):
     assert run.returncode != 0
     assert "Traceback" not in run.stderr and len(run.stderr.strip().splitlines()) == 1, run.stderr
     assert str(path) in run.stderr and "not a UTF-8 text file" in run.stderr
+
+
+@pytest.mark.parametrize("value", [-1.0, float("nan"), float("inf")])
+def test_python_api_refuses_a_meaningless_noise(value):
+    from lagrange_gen.identify import IdentificationError
+    from lagrange_gen.identify.prandtl import identify_prandtl
+    x = np.linspace(0.0, 1.0, 50)
+    with pytest.raises(IdentificationError, match="noise .*finite number >= 0"):
+        identify_prandtl(x, 2.0 * x, 1, value)

@@ -206,6 +206,9 @@ def identify_prandtl(x, F_minus_mxdd, n_elements=None, noise=None, *, damping=0.
                                   f"'one', got {method!r} and {branches!r}")
     if n_elements is not None and int(n_elements) < 1:
         raise IdentificationError(f"n_elements must be at least 1, got {n_elements}")
+    if noise is not None and not (np.isfinite(noise) and noise >= 0):
+        raise IdentificationError(f"noise {noise!r}: must be a finite number >= 0 "
+                                  "(the standard deviation of the noise on F - m x'')")
     y = _restoring_force(x, y, damping, velocity, t)
     start, stop = loading_branch(x)
     notes = []
