@@ -1,6 +1,7 @@
 """The simulate() driver, its Trajectory and the `lagrange-gen simulate` subcommand."""
 
 import argparse
+import re
 from pathlib import Path
 
 import numpy as np
@@ -114,3 +115,54 @@ def test_cli_errors_are_one_line(cart, capsys):
     assert code != 0 and "h must be > 0" in err and "\n" not in err
     code = main(["simulate", cart.__file__, "--h", "0.1", "--t-end", "1", "--param", "k"])
     assert code != 0 and "expected NAME=VALUE" in capsys.readouterr().err
+
+
+# Output paths (issue 11): checked before the run; a write that still fails loses nothing.
+
+def _simulate_cli(cart, capsys, *extra):
+    code = main(["simulate", cart.__file__, "--method", "rk4", "--h", "1e-2", "--t-end", "1",
+                 "--q0", "0.1", "0.5", *map(str, extra)])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize("option, path, fragment", [
+    ("--out", "/proc/traj.npz", "cannot create files in /proc"),
+    ("--out", "{tmp}/afile/x.csv", "afile is not a directory"),
+    ("--out", "{tmp}/traj.txt", "use a .npz or .csv file name"),
+    ("--out", "{tmp}", "use a .npz or .csv file name"),
+    ("--plot", "{tmp}/traj.npz", "use a .png or .pdf or .svg file name"),
+    ("--plot", "{tmp}/afile/p.png", "afile is not a directory"),
+])
+def test_output_paths_are_checked_before_the_run(cart, capsys, tmp_path, option, path, fragment):
+    (tmp_path / "afile").write_text("a file, not a directory")
+    code, out, err = _simulate_cli(cart, capsys, option, path.format(tmp=tmp_path))
+    assert code != 0 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert fragment in err and option in err
+    assert "steps to t" not in out          # refused before integrating
+
+
+def test_failed_write_after_the_run_saves_the_trajectory_elsewhere(cart, capsys, tmp_path,
+                                                                   monkeypatch):
+    def disk_full(self, path):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(simulate_module.Trajectory, "to_csv", disk_full)
+    code, out, err = _simulate_cli(cart, capsys, "--out", tmp_path / "t.csv")
+    assert code != 0 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert "No space left on device" in err and "steps to t = 1" in out
+    rescued = Path(re.search(r"saved to (\S+\.npz) instead", err).group(1))
+    reference = simulate(cart, "rk4", [0.1, 0.5], None, t_end=1.0, h=1e-2)
+    np.testing.assert_array_equal(np.load(rescued)["q"], reference.q)
+    rescued.unlink()
+
+
+def test_failed_plot_after_the_run_names_the_written_trajectory(cart, capsys, tmp_path,
+                                                                monkeypatch):
+    def broken(self, path):
+        raise RuntimeError("renderer crashed")
+    monkeypatch.setattr(simulate_module.Trajectory, "plot", broken)
+    code, out, err = _simulate_cli(cart, capsys, "--out", tmp_path / "t.npz",
+                                   "--plot", tmp_path / "t.png")
+    assert code != 0 and "Traceback" not in err and "renderer crashed" in err
+    assert f"the trajectory is in {tmp_path / 't.npz'}" in err
+    assert np.load(tmp_path / "t.npz")["q"].shape == (101, 2)

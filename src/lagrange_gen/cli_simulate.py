@@ -4,15 +4,26 @@
         --q0 0.1 0.5 --v0 0 0 --param k=20 --save-every 10 --out traj.npz --plot traj.png
 
 cli.py wires ``add_parser`` and ``run`` in; errors are LagrangeGenError (one line, no traceback).
+Output paths are checked before integrating (known suffix, a directory that can be written); if
+writing still fails after the run, the trajectory is saved to a temporary file and the error
+names it, so a finished run is never lost. Warnings (energy, projected initial state) are one
+line each on stderr.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
+import tempfile
+import warnings
 from pathlib import Path
 
 from .errors import SimulationError
 from .steppers.registry import INFO, METHODS
+
+OUT_SUFFIXES = (".npz", ".csv")
+PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def add_parser(subparsers):
@@ -41,7 +52,8 @@ def add_parser(subparsers):
                    help="Newton tolerance (default 1e-12)")
     p.add_argument("--max-iter", type=int, default=50, help="Newton iteration cap (default 50)")
     p.add_argument("--out", metavar="FILE", help="write the trajectory (.npz or .csv)")
-    p.add_argument("--plot", metavar="FILE.png", help="plot coordinates and energy error")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="plot coordinates and energy error (.png, .pdf or .svg)")
     p.add_argument("--gen-dir", default="generated", metavar="DIR",
                    help="where model files are generated (default: generated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
@@ -71,16 +83,54 @@ def _vector(values):
     return "[" + ", ".join(f"{x:.9g}" for x in values) + "]"
 
 
+def check_output_path(option, path, suffixes):
+    """Before the run: a known suffix, not a directory, and a directory (or the nearest existing
+    ancestor, which the writers create below) in which a file can actually be created."""
+    target = Path(path)
+    if target.suffix not in suffixes:
+        raise SimulationError(f"{option} {path}: use a {' or '.join(suffixes)} file name")
+    if target.is_dir():
+        raise SimulationError(f"{option} {path}: is a directory")
+    parent = target.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise SimulationError(f"{option} {path}: {parent} is not a directory")
+    if target.exists() and not os.access(target, os.W_OK):
+        raise SimulationError(f"{option} {path}: the file is not writable")
+    try:
+        with tempfile.TemporaryFile(dir=parent):
+            pass
+    except OSError as exc:
+        raise SimulationError(f"{option} {path}: cannot create files in {parent} "
+                              f"({exc.strerror or exc})") from None
+
+
 def run(args) -> int:
     """Run the subcommand; returns the exit status."""
     from .simulation import simulate
-    if args.out and Path(args.out).suffix not in (".npz", ".csv"):
-        raise SimulationError(f"--out {args.out}: use a .npz or .csv file name")
-    traj = simulate(args.model, args.method, args.q0, args.v0, t_end=args.t_end, h=args.h,
-                    params=_parse_params(args.param), save_every=args.save_every,
-                    newton_tol=args.newton_tol, max_iter=args.max_iter, t0=args.t0,
-                    progress=args.progress, out_dir=args.gen_dir, compliance=args.compliance,
-                    relaxation=args.relaxation, baumgarte=tuple(args.baumgarte))
+    if args.out:
+        check_output_path("--out", args.out, OUT_SUFFIXES)
+    if args.plot:
+        check_output_path("--plot", args.plot, PLOT_SUFFIXES)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            traj = simulate(args.model, args.method, args.q0, args.v0, t_end=args.t_end,
+                            h=args.h, params=_parse_params(args.param),
+                            save_every=args.save_every, newton_tol=args.newton_tol,
+                            max_iter=args.max_iter, t0=args.t0, progress=args.progress,
+                            out_dir=args.gen_dir, compliance=args.compliance,
+                            relaxation=args.relaxation, baumgarte=tuple(args.baumgarte))
+        finally:
+            for warning in caught:      # one line each, also when the run then failed
+                print(f"lagrange-gen: warning: {warning.message}", file=sys.stderr)
+    _summary(traj)
+    _write_outputs(traj, args.out, args.plot)
+    return 0
+
+
+def _summary(traj):
     per_step = traj.wall_time / max(traj.n_steps, 1)
     print(f"model {traj.model}, method {traj.method}, h = {traj.h:g}, "
           f"{traj.n_steps} steps to t = {traj.t[-1]:.9g}")
@@ -88,15 +138,47 @@ def run(args) -> int:
           f"compile/load {traj.compile_time:.2f} s")
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")
     print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
-    if traj.multipliers.size:
+    if traj.constraint_names:
         print(f"max |Phi| = {traj.constraint_error.max():.3e}, "
               f"max |J v| = {traj.velocity_constraint_error.max():.3e}")
     if traj.newton_iters.sum():
         print(f"Newton iterations per step: {traj.newton_iters.sum() / max(traj.n_steps, 1):.2f}")
-    if args.out:
-        (traj.to_npz if args.out.endswith(".npz") else traj.to_csv)(args.out)
-        print(f"wrote {args.out}")
-    if args.plot:
-        traj.plot(args.plot)
-        print(f"wrote {args.plot}")
-    return 0
+
+
+def _write_outputs(traj, out, plot):
+    """Write --out, then --plot. A failure here comes after a finished run: any exception of the
+    writers (OSError, but also matplotlib's or numpy's own) becomes one line that says where the
+    trajectory is, saved to a temporary .npz when --out was not written."""
+    saved = None
+    if out:
+        try:
+            (traj.to_npz if out.endswith(".npz") else traj.to_csv)(out)
+            print(f"wrote {out}")
+            saved = out
+        except Exception as exc:  # noqa: BLE001 -- see the docstring
+            raise SimulationError(f"--out {out}: writing failed after the run ({_reason(exc)}); "
+                                  f"{_rescue(traj)}") from None
+    if plot:
+        try:
+            traj.plot(plot)
+            print(f"wrote {plot}")
+        except Exception as exc:  # noqa: BLE001 -- see the docstring
+            where = f"the trajectory is in {saved}" if saved else _rescue(traj)
+            raise SimulationError(f"--plot {plot}: writing failed after the run "
+                                  f"({_reason(exc)}); {where}") from None
+
+
+def _rescue(traj):
+    """Save the trajectory to a new temporary .npz; returns the sentence saying where (or
+    that it is lost)."""
+    try:
+        fd, path = tempfile.mkstemp(prefix=f"lagrange-gen-{traj.model}-", suffix=".npz")
+        os.close(fd)
+        traj.to_npz(path)
+    except Exception as exc:  # noqa: BLE001 -- the last resort must not raise
+        return f"saving it to a temporary file failed too ({_reason(exc)}): the trajectory is lost"
+    return f"the trajectory was saved to {path} instead"
+
+
+def _reason(exc):
+    return f"{type(exc).__name__}: {exc}".replace("\n", " ")

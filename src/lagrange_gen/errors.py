@@ -37,8 +37,19 @@ class NewtonDivergence(SimulationError):
 
 
 class SingularMass(SimulationError):
-    """The generalized inertia H(q) (or the augmented KKT matrix) is singular."""
+    """The generalized inertia H(q) (in a constrained method: or J H^-1 J^T) is singular."""
 
 
 class BlowUp(SimulationError):
-    """The state became non-finite."""
+    """The state (or its energy, or a Newton matrix) became non-finite, or the state grew past
+    the blow-up bound."""
+
+
+class SingularNewtonMatrix(NewtonDivergence):
+    """The Newton matrix of an implicit step (its Jacobian, or the constrained KKT matrix) is
+    singular although H(q) may be regular: Newton cannot proceed (reduce h)."""
+
+
+class EnergyWarning(UserWarning):
+    """A run on a conservative model lost (or gained) energy far beyond what its step allows
+    (lagrange_gen.energy_check); the trajectory is kept, with the line in Trajectory.warnings."""

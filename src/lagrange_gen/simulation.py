@@ -6,150 +6,41 @@
 
 The integration itself runs inside the generated module's jitted ``run_<method>`` (see
 steppers/registry.py), in chunks of steps so that a progress bar can be shown; this driver only
-checks inputs, allocates outputs and turns status codes into exceptions that name the step, the
-time, the state and (for Newton) the residual.
+checks inputs (run_checks: element coefficients, step count, time resolution, memory), allocates
+outputs, turns status codes into exceptions that name the step, the time, the state and (for
+Newton) the residual (failures.py), and warns when a conservative run lost its energy
+(energy_check.py).
 """
 
 from __future__ import annotations
 
 import math
+import os
+import shlex
 import sys
 import time
 import types
-from dataclasses import dataclass, field
+import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from . import run_checks
 from . import status as st
-from .errors import BlowUp, NewtonDivergence, SimulationError, SingularMass
+from .energy_check import energy_warning
+from .errors import EnergyWarning, SimulationError
+from .failures import raise_for_status
 from .params import resolve_params
 from .steppers import registry
 from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, make_settings
+from .trajectory import Trajectory
 
 __all__ = ["simulate", "Trajectory", "load_module"]
 
 #: Steps per call into the jitted loop (a multiple of save_every is used): large enough that the
 #: Python overhead per chunk (a few microseconds) is negligible, small enough for a progress bar.
 CHUNK_STEPS = 200_000
-
-
-@dataclass
-class Trajectory:
-    """Saved states of one simulation.
-
-    t (S,), q (S, n), v (S, n), energy (S,) E = T + V, newton_iters (S,) Newton iterations summed
-    over the steps since the previous saved row, newton_residual (S,) the largest final Newton
-    residual over those steps. S = n_steps // save_every + 1 (+1 when the final state does not
-    fall on a save).
-    """
-
-    t: np.ndarray
-    q: np.ndarray
-    v: np.ndarray
-    energy: np.ndarray
-    newton_iters: np.ndarray
-    newton_residual: np.ndarray
-    method: str
-    h: float
-    model: str
-    params: dict
-    coords: tuple
-    n_steps: int
-    wall_time: float = 0.0       # integration only, seconds
-    compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
-    extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    element_names: tuple = ()
-    constraint_names: tuple = ()
-
-    @property
-    def multipliers(self) -> np.ndarray:
-        """(S, m): the constraint forces lam (H qdd = rhs + J^T lam) at each saved state, from a
-        constrained method (see its module docstring for which of its multipliers it reports)."""
-        return self.extra[:, :len(self.constraint_names)]
-
-    @property
-    def constraint_error(self) -> np.ndarray:
-        """(S,): max_i |Phi_i(q)| at each saved state (constrained methods)."""
-        return self.extra[:, len(self.constraint_names)]
-
-    @property
-    def velocity_constraint_error(self) -> np.ndarray:
-        """(S,): max_i |(J(q) v)_i| at each saved state (constrained methods)."""
-        return self.extra[:, len(self.constraint_names) + 1]
-
-    @property
-    def element_state(self) -> np.ndarray:
-        """(S, ne): per nonsmooth element, u (elastic strain of a Saint-Venant element) or r (the
-        dry-friction force) at each saved state."""
-        return self.extra[:, :len(self.element_names)]
-
-    @property
-    def energy_error(self) -> np.ndarray:
-        """E - E0 (S,)."""
-        return self.energy - self.energy[0]
-
-    @property
-    def max_energy_error(self) -> float:
-        return float(np.max(np.abs(self.energy_error)))
-
-    def to_npz(self, path):
-        """Write every array and the metadata to a .npz file."""
-        _parent(path)
-        np.savez(path, t=self.t, q=self.q, v=self.v, energy=self.energy,
-                 newton_iters=self.newton_iters, newton_residual=self.newton_residual,
-                 method=self.method, h=self.h, model=self.model, coords=np.array(self.coords),
-                 param_names=np.array(list(self.params)),
-                 param_values=np.array(list(self.params.values()), dtype=float),
-                 n_steps=self.n_steps, element_names=np.array(self.element_names, dtype=str),
-                 element_state=self.element_state,
-                 constraint_names=np.array(self.constraint_names, dtype=str),
-                 multipliers=self.multipliers, **self._constraint_arrays())
-
-    def _constraint_arrays(self):
-        if not self.constraint_names:
-            return {}
-        return dict(constraint_error=self.constraint_error,
-                    velocity_constraint_error=self.velocity_constraint_error)
-
-    def to_csv(self, path):
-        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters (and
-        for a constrained method lam_0..lam_m-1, max|Phi|, max|J v|)."""
-        header = ["t", *self.coords, *(f"{c}_dot" for c in self.coords), "energy", "newton_iters"]
-        data = np.column_stack([self.t, self.q, self.v, self.energy, self.newton_iters])
-        if self.constraint_names:
-            header += [f"lam_{i}" for i in range(len(self.constraint_names))]
-            header += ["constraint_error", "velocity_constraint_error"]
-            data = np.column_stack([data, self.extra])
-        _parent(path)
-        np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
-
-    def plot(self, path):
-        """PNG (matplotlib Agg): coordinates vs t, and the energy error E - E0 vs t."""
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, (ax_q, ax_e) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-        for i, name in enumerate(self.coords):
-            ax_q.plot(self.t, self.q[:, i], label=name)
-        ax_q.set_ylabel("q")
-        ax_q.legend(loc="upper right")
-        ax_q.set_title(f"{self.model}: {self.method}, h = {self.h:g}")
-        ax_e.plot(self.t, self.energy_error)
-        ax_e.set_ylabel("E - E0")
-        ax_e.set_xlabel("t")
-        fig.tight_layout()
-        _parent(path)
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-
-    def __repr__(self):
-        return (f"Trajectory({self.model}, {self.method}, h={self.h:g}, steps={self.n_steps}, "
-                f"saved={len(self.t)}, t=[{self.t[0]:g}, {self.t[-1]:g}])")
-
-
-def _parent(path):
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
 
 
 def load_module(module_or_path, out_dir="generated"):
@@ -161,21 +52,6 @@ def load_module(module_or_path, out_dir="generated"):
     return load(Path(module_or_path), out_dir=out_dir)
 
 
-def _vector(name, value, n, coords):
-    if value is None:
-        return np.zeros(n)
-    try:
-        arr = np.asarray(value, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError):
-        raise SimulationError(f"{name} must be a sequence of {n} numbers, got {value!r}") from None
-    if arr.shape[0] != n:
-        raise SimulationError(f"{name} has {arr.shape[0]} entries but the model has {n} "
-                              f"coordinates ({', '.join(coords)})")
-    if not np.all(np.isfinite(arr)):
-        raise SimulationError(f"{name} contains a non-finite value: {arr.tolist()}")
-    return np.ascontiguousarray(arr)
-
-
 def _n_steps(t0, t_end, h):
     """Whole steps to reach t_end; rounded up when (t_end - t0) / h is not an integer."""
     ratio = (t_end - t0) / h
@@ -185,67 +61,43 @@ def _n_steps(t0, t_end, h):
     return int(math.ceil(ratio))
 
 
-def _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter):
-    for name, value in (("h", h), ("t0", t0), ("t_end", t_end), ("newton_tol", newton_tol)):
-        if not isinstance(value, (int, float, np.floating, np.integer)) or not math.isfinite(value):
-            raise SimulationError(f"{name} must be a finite number, got {value!r}")
-    if h <= 0:
-        raise SimulationError(f"step size h must be > 0, got {h}")
-    if t_end < t0:
-        raise SimulationError(f"t_end = {t_end} is before t0 = {t0}")
-    if int(save_every) != save_every or save_every < 1:
-        raise SimulationError(f"save_every must be a positive integer, got {save_every!r}")
-    if newton_tol <= 0:
-        raise SimulationError(f"newton_tol must be > 0, got {newton_tol}")
-    if int(max_iter) != max_iter or max_iter < 1:
-        raise SimulationError(f"max_iter must be a positive integer, got {max_iter!r}")
-
-
 def _runner(module, method):
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     run = getattr(module, f"run_{method}", None)
     if run is None:
         have = ", ".join(getattr(module, "METHODS", ())) or "none"
-        model = getattr(module, "MODEL_PATH", None)
-        where = Path(module.__file__).parent / model if model else Path("<model file>")
         raise SimulationError(
             f"{module.NAME}: module {module.__file__} was generated without method {method!r} "
-            f"(it has: {have}); run `lagrange-gen --methods "
-            f"{','.join(sorted(set(getattr(module, 'METHODS', ())) | {method}))} {where}`")
+            f"(it has: {have}); run `{regenerate_command(module, method)}`")
     return run
 
 
-def _format_state(coords, q, v):
-    parts = [f"{c}={x:.6g}" for c, x in zip(coords, q)]
-    parts += [f"{c}_dot={x:.6g}" for c, x in zip(coords, v)]
-    return ", ".join(parts)
+def regenerate_command(module, method):
+    """The command that regenerates ``module`` in place with ``method`` added: its model file,
+    its directory (-o), and the options recorded in OPTIONS (--set, --methods, --freeze),
+    shell-quoted. (codegen.generate._command builds the same for the stale-module message.)"""
+    here = Path(module.__file__).resolve().parent
+    model = getattr(module, "MODEL_PATH", None)
+    options = getattr(module, "OPTIONS", {}) or {}
+    methods = set(options.get("methods", getattr(module, "METHODS", ()))) | {method}
+    words = ["lagrange-gen", _shown(here / model) if model else "MODEL.py", "-o", _shown(here)]
+    for key, value in sorted((options.get("build") or {}).items()):
+        words += ["--set", f"{key}={value}"]
+    if set(registry.METHODS) - methods:
+        words += ["--methods", ",".join(m for m in registry.METHODS if m in methods)]
+    if options.get("freeze"):
+        words += ["--freeze", ",".join(f"{k}={v!r}" for k, v in sorted(options["freeze"].items()))]
+    return " ".join(shlex.quote(w) for w in words)
 
 
-def _raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
-    """Turn a stepper status into the matching exception (step is 1-based)."""
-    n = module.N_COORDS
-    t, q, v, resid = last[0], last[1:1 + n], last[1 + n:1 + 2 * n], last[2 + 2 * n]
-    state = _format_state(module.COORDS, q, v)
-    where = f"{module.NAME}, {method}: step {step} of {n_steps} (t = {t:.9g}, h = {h:g})"
-    kwargs = dict(step=step, time=float(t), state=np.concatenate([q, v]), residual=float(resid))
-    if code == st.NEWTON_DIVERGED:
-        raise NewtonDivergence(f"{where}: Newton did not converge in {max_iter} iterations "
-                               f"(residual {resid:.3g}) from {state}; reduce h or raise max_iter",
-                               **kwargs)
-    if code == st.SINGULAR_MASS:
-        hint = ""
-        if method in registry.CONSTRAINED_METHODS:
-            from .consistent import diagnose_singular
-            hint = diagnose_singular(module, np.ascontiguousarray(q), p)
-        raise SingularMass(f"{where}: singular mass matrix (or Newton matrix) at {state}{hint}",
-                           **kwargs)
-    if code == st.NON_FINITE:
-        raise BlowUp(f"{where}: the state became non-finite: {state}", **kwargs)
-    if code == st.UNSTABLE:
-        raise BlowUp(f"{where}: the state grew past the blow-up bound (unstable at this h?): "
-                     f"{state}", **kwargs)
-    raise SimulationError(f"{where}: stepper returned unknown status {code}", **kwargs)
+def _shown(path):
+    """path relative to the working directory when it lies below it, else absolute."""
+    path = Path(os.path.normpath(path))
+    try:
+        return str(path.relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
 
 
 def _element_method(module, method):
@@ -275,11 +127,9 @@ def _extra_layout(module, method):
 
 def _element_energy(module, p, state):
     """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
-    ne, n = module.N_ELEMENTS, module.N_COORDS
-    if not ne:
+    if not module.N_ELEMENTS:
         return 0.0
-    s, G, coef = np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))
-    module.elements(np.zeros(n), p, s, G, coef)    # coefficients depend on parameters only
+    coef = run_checks.element_coefficients(module, p)
     k = np.where(coef[:, 2] == 0.0, coef[:, 0], 0.0)
     return 0.5 * (state**2 * k).sum(axis=1)
 
@@ -312,85 +162,146 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     max|Phi|, max|J v| per saved state. compliance (epsilon >= 0) and relaxation (d > 0) are
     spook's; baumgarte = (alpha, beta) is index1's optional stabilization.
     The final time is t0 + n_steps h with n_steps = (t_end - t0) / h rounded up to a whole step.
-    Raises SimulationError (bad input), NewtonDivergence, SingularMass, BlowUp.
+    Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
+    SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
+    blowup_bound). A conservative run whose energy error passes energy_check.ENERGY_FRACTION of
+    its energy scale warns (EnergyWarning, the line also in Trajectory.warnings).
     """
     module = load_module(module_or_path, out_dir)
     method = _element_method(module, method)
-    constrained = method in registry.CONSTRAINED_METHODS
     from .consistent import check_method
     check_method(module, method, registry.CONSTRAINED_METHODS)
     run = _runner(module, method)
     n = module.N_COORDS
-    _check_scalars(h, t0, t_end, save_every, newton_tol, max_iter)
-    q = _vector("q0", q0, n, module.COORDS)
-    v = _vector("v0", v0, n, module.COORDS)
+    run_checks.check_scalars(h, t0, t_end, save_every, newton_tol, max_iter, blowup_bound)
+    q = run_checks.vector("q0", q0, n, module.COORDS)
+    v = run_checks.vector("v0", v0, n, module.COORDS)
     p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME,
                        frozen=getattr(module, "FROZEN", None))
+    run_checks.check_element_coefficients(module, p)
     h, t0, save_every, max_iter = float(h), float(t0), int(save_every), int(max_iter)
+    run_checks.check_step_count(t0, float(t_end), h)
+    n_steps = _n_steps(t0, float(t_end), h)
+    run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
+    n_saved, n_extra = _extra_layout(module, method)
+    run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     settings = make_settings(newton_tol, max_iter, blowup_bound, 1 if newton_always else 0)
-    if constrained:
+    initial = np.zeros(0)
+    if method in registry.CONSTRAINED_METHODS:
         settings, q, v, initial = _constrained_setup(module, q, v, p, t0, settings, compliance,
                                                      relaxation, baumgarte)
-    n_steps = _n_steps(t0, float(t_end), h)
-    rows = n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
-    out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
-    n_saved, n_extra = _extra_layout(module, method)
-    # Only the n_saved leading entries of the method's extra buffer are kept per row; the rest
-    # is scratch that run_loop sizes from `last` (steppers/base.py).
-    out_stats, out_extra = np.zeros((rows, N_STATS)), np.zeros((rows, n_saved))
-    if constrained:
-        out_extra[0] = initial
     elif n_saved:
-        out_extra[0, :n_saved] = _vector("element_state0", element_state0, n_saved, module.ELEMENTS)
-    last = np.empty(2 * n + 3 + n_extra)
-    chunk = max(1, CHUNK_STEPS // save_every) * save_every
-    compile_time = _warm_up(run, q, v, t0, h, p, settings, out_extra[:1].copy(), last.copy())
-    bar = _ProgressBar(n_steps) if progress else None
+        initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    task = _Task(module, method, run, p, settings, h, t0, n_steps, save_every, max_iter, n_extra)
+    out = _allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial)
+    compile_time, wall = _integrate(task, q, v, out, progress)
+    return _trajectory(task, out, wall, compile_time)
+
+
+@dataclass
+class _Task:
+    """What one run integrates: the module, the method and its glue, and the run's numbers."""
+
+    module: types.ModuleType
+    method: str
+    run: object
+    p: np.ndarray
+    settings: np.ndarray
+    h: float
+    t0: float
+    n_steps: int
+    save_every: int
+    max_iter: int
+    n_extra: int        # length of the method's extra buffer (saved entries + scratch)
+
+
+def _allocate(rows, n, n_saved, initial):
+    """Output arrays {t (S,), q, v (S, n), stats (S, N_STATS), extra (S, n_saved)}; row 0 of
+    extra holds the initial extra data (multipliers and residuals, or element states).
+    Only the n_saved leading entries of the method's extra buffer are kept per row; the rest is
+    scratch that run_loop sizes from `last` (steppers/base.py)."""
+    out = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
+               stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)))
+    if n_saved:
+        out["extra"][0] = initial
+    return out
+
+
+def _integrate(task, q, v, out, progress):
+    """Run the glue chunk by chunk from (q, v), filling ``out``; fills out["last"] and
+    out["rows"] (rows used). Returns (compile seconds, integration seconds). Raises the
+    exception of a failure status (failures.raise_for_status)."""
+    m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
+    last = np.empty(2 * n + 3 + task.n_extra)
+    compile_time = _warm_up(task.run, q, v, t0, h, task.p, task.settings,
+                            out["extra"][:1].copy(), last.copy())
+    chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
+    bar = _ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
     done, row = 0, 0
     while True:
-        k = min(chunk, n_steps - done)
-        saves = k // save_every
+        k = min(chunk, task.n_steps - done)
+        rows = slice(row, row + k // task.save_every + 1)
         # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
         # Newton statistics, which belong to the steps before it.
-        kept = out_stats[row].copy()
-        code, steps = run(q, v, t0 + done * h, h, k, save_every, p, settings,
-                          out_t[row:row + saves + 1], out_q[row:row + saves + 1],
-                          out_v[row:row + saves + 1], out_stats[row:row + saves + 1],
-                          out_extra[row:row + saves + 1], last)
+        kept = out["stats"][row].copy()
+        code, steps = task.run(q, v, t0 + done * h, h, k, task.save_every, task.p, task.settings,
+                               out["t"][rows], out["q"][rows], out["v"][rows],
+                               out["stats"][rows], out["extra"][rows], last)
         if row > 0:
-            out_stats[row, STAT_ITERS:] = kept[STAT_ITERS:]
+            out["stats"][row, STAT_ITERS:] = kept[STAT_ITERS:]
         if code != st.OK:
-            _raise_for_status(code, module, method, done + steps + 1, n_steps, last, max_iter, h,
-                              p)
+            raise_for_status(code, m, task.method, done + steps + 1, task.n_steps, last,
+                             task.max_iter, h, task.p)
         q, v = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy()
         done += k
-        row += saves
+        row += k // task.save_every
         if bar:
             bar.update(done)
-        if done >= n_steps:
+        if done >= task.n_steps:
             break
-    # Times as t0 + k h, independent of how the run was chunked (each chunk adds its own i h).
-    out_t[:row + 1] = t0 + h * save_every * np.arange(row + 1)
-    if n_steps % save_every:
-        row += 1
-        out_t[row], out_q[row], out_v[row] = t0 + n_steps * h, q, v
-        out_stats[row] = (module.energy(q, v, out_t[row], p), last[1 + 2 * n], last[2 + 2 * n])
-        out_extra[row] = last[3 + 2 * n:3 + 2 * n + n_saved]
     wall = time.perf_counter() - start
     if bar:
         bar.close()
-    elements = out_extra[:, :n_saved].copy()
-    energy = out_stats[:, STAT_ENERGY] + _element_energy(module, p, elements)
-    return Trajectory(t=out_t, q=out_q, v=out_v, energy=energy,
-                      newton_iters=out_stats[:, STAT_ITERS].copy(),
-                      newton_residual=out_stats[:, STAT_RESIDUAL].copy(), method=method, h=h,
-                      model=module.NAME, params=dict(zip(module.PARAMS, p.tolist())),
-                      coords=tuple(module.COORDS), n_steps=n_steps, wall_time=wall,
+    out["last"], out["rows"] = last, row + 1
+    return compile_time, wall
+
+
+def _trajectory(task, out, wall, compile_time):
+    """The Trajectory of a finished run: times t0 + k h (not accumulated, independent of the
+    chunking), the final state when it is not on a save, energies, and the energy warning."""
+    m, n, h, p = task.module, task.module.N_COORDS, task.h, task.p
+    last, row, n_saved = out["last"], out["rows"] - 1, out["extra"].shape[1]
+    out["t"][:row + 1] = task.t0 + h * task.save_every * np.arange(row + 1)
+    if task.n_steps % task.save_every:
+        row += 1
+        q, v = last[1:1 + n], last[1 + n:1 + 2 * n]
+        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v),
+                          task.t0 + task.n_steps * h, p)
+        if not math.isfinite(energy):
+            raise_for_status(st.NON_FINITE, m, task.method, task.n_steps, task.n_steps, last,
+                             task.max_iter, h, p)
+        out["t"][row], out["q"][row], out["v"][row] = task.t0 + task.n_steps * h, q, v
+        out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n])
+        out["extra"][row] = last[3 + 2 * n:3 + 2 * n + n_saved]
+    elements = out["extra"][:, :n_saved].copy()
+    energy = out["stats"][:, STAT_ENERGY] + _element_energy(m, p, elements)
+    constrained = task.method in registry.CONSTRAINED_METHODS
+    traj = Trajectory(t=out["t"], q=out["q"], v=out["v"], energy=energy,
+                      newton_iters=out["stats"][:, STAT_ITERS].copy(),
+                      newton_residual=out["stats"][:, STAT_RESIDUAL].copy(), method=task.method,
+                      h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
+                      coords=tuple(m.COORDS), n_steps=task.n_steps, wall_time=wall,
                       compile_time=compile_time, extra=elements,
-                      element_names=tuple(getattr(module, "ELEMENTS", ())) if n_saved and not
+                      element_names=tuple(getattr(m, "ELEMENTS", ())) if n_saved and not
                       constrained else (),
-                      constraint_names=tuple(module.CONSTRAINTS) if constrained else ())
+                      constraint_names=tuple(m.CONSTRAINTS) if constrained else ())
+    message = energy_warning(m, task.method, traj.q, traj.v, traj.t, traj.energy, p, h)
+    if message:
+        traj.warnings.append(message)
+        # stacklevel 3: _trajectory <- simulate <- the user's call
+        warnings.warn(message, EnergyWarning, stacklevel=3)
+    return traj
 
 
 def _constrained_setup(module, q, v, p, t0, settings, compliance, relaxation, baumgarte):
@@ -399,7 +310,7 @@ def _constrained_setup(module, q, v, p, t0, settings, compliance, relaxation, ba
     from .consistent import consistent_initial_state
     from .steppers.constrained import make_constrained_settings
     for name, value, positive in (("compliance", compliance, False), ("relaxation", relaxation, True)):
-        number = isinstance(value, (int, float, np.floating, np.integer)) and math.isfinite(value)
+        number = run_checks.is_number(value) and math.isfinite(value)
         if not number or value < 0 or (positive and value == 0):
             raise SimulationError(f"{name} must be a finite number {'> 0' if positive else '>= 0'}, "
                                   f"got {value!r}")

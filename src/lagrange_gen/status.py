@@ -1,10 +1,13 @@
 """Status codes returned by jitted kernels and steppers (turned into exceptions by simulate)."""
 
 OK = 0
-SINGULAR_MASS = 1
+SINGULAR_MASS = 1     # H(q) (or, in a constrained method, J H^-1 J^T) is not positive definite
 NEWTON_DIVERGED = 2
-NON_FINITE = 3
-UNSTABLE = 4      # state grew past the blow-up bound (e.g. Verlet at h*omega > 2)
+NON_FINITE = 3        # NaN/inf in the state, the energy or a Newton matrix
+UNSTABLE = 4          # state grew past the blow-up bound (e.g. Verlet at h*omega > 2)
+SINGULAR_NEWTON = 5   # a Newton matrix (step Jacobian, KKT matrix) is singular; H may be regular
 
-NAMES = {OK: "ok", SINGULAR_MASS: "singular mass matrix", NEWTON_DIVERGED: "Newton did not converge",
-         NON_FINITE: "non-finite state", UNSTABLE: "unstable (state grew past the blow-up bound)"}
+NAMES = {OK: "ok", SINGULAR_MASS: "singular mass matrix",
+         NEWTON_DIVERGED: "Newton did not converge",
+         NON_FINITE: "non-finite state", UNSTABLE: "unstable (state grew past the blow-up bound)",
+         SINGULAR_NEWTON: "singular Newton matrix"}

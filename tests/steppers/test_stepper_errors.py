@@ -2,10 +2,13 @@
 residual); bad inputs are one-line errors."""
 
 import math
+import re
+import shlex
 
 import numpy as np
 import pytest
 
+from lagrange_gen.cli import main
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.errors import BlowUp, NewtonDivergence, SimulationError, SingularMass
 from lagrange_gen.loader import import_generated
@@ -63,7 +66,7 @@ def test_overflow_is_reported_as_non_finite(model):
 
 
 def test_singular_mass_matrix_is_an_error_not_nan(model):
-    with pytest.raises(SingularMass, match=r"step 1 of .*q1=0"):
+    with pytest.raises(SingularMass, match=r"step 1 of .*singular mass matrix H\(q\) at q1=0"):
         simulate(model("spherical"), "rk4", [0.0, 0.0], [0.1, 0.2], t_end=1, h=1e-2)
 
 
@@ -94,9 +97,20 @@ def test_missing_required_parameter_is_named(model):
         simulate(model("oscillator"), "rk4", [1.0], [0.0], t_end=1.0, h=1e-2)
 
 
-def test_method_not_generated_says_which_command_to_run(tmp_path):
-    result = generate_model(MODEL_FILES["pendulum"], tmp_path, methods=["rk4"])
+def test_method_not_generated_says_which_command_to_run(tmp_path, monkeypatch):
+    """The hint names the module's own directory (-o) and options; following it regenerates
+    that very file with the method added (it used to drop -o and write generated/ instead)."""
+    out = tmp_path / "gen dir"
+    result = generate_model(MODEL_FILES["pendulum"], out, methods=["rk4"])
     mod = import_generated(result.path)
-    with pytest.raises(SimulationError, match=r"without method 'midpoint'.*lagrange-gen --methods "
-                                              r"midpoint,rk4 .*pendulum\.py"):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SimulationError, match=r"without method 'midpoint'") as info:
         simulate(mod, "midpoint", [0.1], [0.0], t_end=1.0, h=1e-2)
+    command = re.search(r"run `([^`]*)`", str(info.value)).group(1)
+    argv = shlex.split(command)
+    assert argv[0] == "lagrange-gen" and argv[argv.index("-o") + 1] == "gen dir"
+    assert argv[argv.index("--methods") + 1] == "midpoint,rk4"
+    assert main(argv[1:]) == 0
+    text = result.path.read_text()
+    assert "def run_midpoint(" in text and "def run_rk4(" in text
+    assert not (tmp_path / "generated").exists()

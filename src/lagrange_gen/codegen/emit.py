@@ -103,8 +103,10 @@ def _load_lines(used, order):
 
 
 def render_kernel(spec: KernelSpec, inputs) -> KernelText:
-    """One ``@njit(cache=True, _nrt=False)`` kernel (no allocation; reference counting would
-    cost every call from a stepper).
+    """One ``@njit(cache=True, _nrt=False, error_model="numpy")`` kernel (no allocation;
+    reference counting would cost every call from a stepper; with numpy's error model a division
+    by zero gives inf/NaN, which the steppers report as NON_FINITE, instead of raising
+    ZeroDivisionError inside the jitted loop).
 
     inputs: codegen.printer.Inputs of the model (symbol -> placeholder and load statement).
     """
@@ -130,7 +132,8 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
     views = [f"    {o.name}_f = {o.name}.reshape({o.matrix.shape[0] * o.matrix.shape[1]})"
              for o in spec.outputs if not o.is_vector and o.matrix.shape[0] * o.matrix.shape[1]]
     args = ", ".join(spec.signature)
-    lines = ["@njit(cache=True, _nrt=False)", f"def {spec.name}({args}):", f'    """{_doc(spec, zeros, entries)}"""']
+    lines = ['@njit(cache=True, _nrt=False, error_model="numpy")', f"def {spec.name}({args}):",
+             f'    """{_doc(spec, zeros, entries)}"""']
     lines += [f"    {line}" for line in spec.prologue]
     lines += _load_lines(used, inputs.loads(spec.args)) + body + views + stores + zero_lines
     if spec.result is not None:

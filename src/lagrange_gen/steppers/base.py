@@ -42,14 +42,19 @@ Shapes: n coordinates; q, v, mom (n,); p (n_params,); work (N_WORK, n); mats (N_
 piv (n,) int64; extra (n_extra,) per-step method output (empty for unconstrained methods).
 """
 
+import math
+
 import numpy as np
 from numba import njit
 
 from .. import linalg
-from ..status import NON_FINITE, OK, SINGULAR_MASS, UNSTABLE
+from ..status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
 
 #: numba options of every function on the per-step path (see the module docstring).
-FAST = dict(_nrt=False)
+#: error_model="numpy": a division by zero gives inf/NaN (caught as NON_FINITE by check_state or
+#: failed_solve_status) instead of raising ZeroDivisionError from inside the jitted loop, and
+#: numba drops its zero-divisor checks on every division.
+FAST = dict(_nrt=False, error_model="numpy")
 
 # Layout of the float64 ``settings`` array shared by every method.
 S_TOL = 0          # Newton tolerance, relative to max(1, |unknown|) (see newton_converged)
@@ -163,13 +168,27 @@ def mass_solve(H, b):
     return True
 
 
+@njit(cache=True, **FAST)
+def failed_solve_status(A):
+    """Status of a Newton matrix A (N, N) whose factorization just failed: NON_FINITE when A
+    holds NaN or inf (non-finite arithmetic in the kernels, e.g. 1/x at x = 0), else
+    SINGULAR_NEWTON. The factorizations return before touching A when its scale is not finite,
+    and eliminating a NaN or inf leaves NaN behind, so A still shows which case it was."""
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            if not math.isfinite(A[i, j]):
+                return NON_FINITE
+    return SINGULAR_NEWTON
+
+
 @njit(**FAST)
-def lu_solve(A, piv, b, scratch):
-    """Overwrite b by A^-1 b (general A, factored in place by LU). False if singular."""
+def newton_solve(A, piv, b, scratch):
+    """Overwrite b by A^-1 b for a Newton matrix A (general, factored in place by LU).
+    Returns OK, SINGULAR_NEWTON, or NON_FINITE (see failed_solve_status)."""
     if not _lu(A, piv):
-        return False
+        return failed_solve_status(A)
     _lu_solve(A, piv, b, scratch)
-    return True
+    return OK
 
 
 @njit(**FAST)
@@ -246,8 +265,10 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     out_last (2n + 3 [+ n_total],) receives [t, q, v, Newton
     iterations since the last save, Newton residual, extra data] of the final state, or on failure: of the
     state the failing step started from (Newton failure, singular mass) or of the offending state
-    after it (NON_FINITE, UNSTABLE).
-    Returns (status, steps_done): steps_done = index of the failing step on failure.
+    after it (NON_FINITE, UNSTABLE; also a non-finite energy at a saved state).
+    Returns (status, steps_done): steps_done = index of the failing step on failure, -1 when the
+    initial state itself is refused (non-finite or past the bound, its energy non-finite, or the
+    method's prepare failed).
     """
     n = q0.shape[0]
     q = q0.copy()
@@ -268,11 +289,13 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     status = check_state(q, v, bound)
     if status == OK:
         status = method.prepare(kern, q, v, mom, t0, p, settings, work, mats, piv)
+    energy = kern.energy(q, v, t0, p)
+    if status == OK and not math.isfinite(energy):
+        status = NON_FINITE
     _last(out_last, t0, q, v, 0.0, 0.0, extra)
     if status != OK:
-        return status, 0
-    _save(0, t0, q, v, kern.energy(q, v, t0, p), 0.0, 0.0, out_t, out_q, out_v, out_stats,
-          extra, out_extra)
+        return status, -1
+    _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
     iters_acc = 0.0
     resid_max = 0.0
     since = 0
@@ -293,7 +316,11 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
         since += 1
         if since == save_every:
             since = 0
-            _save((i + 1) // save_every, t_new, q, v, kern.energy(q, v, t_new, p), iters_acc,
+            energy = kern.energy(q, v, t_new, p)
+            if not math.isfinite(energy):      # e.g. log(x) at x <= 0: outside the model
+                _last(out_last, t_new, q, v, iters_acc, resid, extra)
+                return NON_FINITE, i
+            _save((i + 1) // save_every, t_new, q, v, energy, iters_acc,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
             iters_acc = 0.0
             resid_max = 0.0

@@ -31,9 +31,9 @@ import sys
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import (FAST, S_MAX_ITER, S_TOL, increment_converged, max_abs, momentum_from_velocity,
-                   run_loop)
+from ..status import NEWTON_DIVERGED, OK
+from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_converged, max_abs,
+                   momentum_from_velocity, run_loop)
 from .constrained import (check_buffers, gauss_solve, record, schur_block,
                           velocity_projection, views)
 
@@ -103,7 +103,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
         if not gauss_solve(K, b):
-            return SINGULAR_MASS, it, resid
+            return failed_solve_status(K), it, resid
         xmax = 0.0
         for i in range(n):
             vb[i] += b[i]

@@ -17,8 +17,8 @@ import sys
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, S_MAX_ITER, S_TOL, lu_solve, max_abs, newton_converged, run_loop
+from ..status import NEWTON_DIVERGED, OK
+from .base import FAST, S_MAX_ITER, S_TOL, max_abs, newton_converged, newton_solve, run_loop
 
 _V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4           # mats
@@ -57,8 +57,9 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
         resid = max_abs(R)
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
-        if not lu_solve(A, piv, R, scratch):
-            return SINGULAR_MASS, it, resid
+        status = newton_solve(A, piv, R, scratch)
+        if status != OK:
+            return status, it, resid
         for i in range(n):
             v1[i] += R[i]
         done, prev = newton_converged(R, v1, prev, tol)

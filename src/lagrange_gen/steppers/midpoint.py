@@ -22,9 +22,9 @@ import sys
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import (FAST, S_MAX_ITER, S_TOL, lu_solve, max_abs, momentum_from_velocity,
-                   newton_converged, run_loop, velocity_from_momentum)
+from ..status import NEWTON_DIVERGED, OK
+from .base import (FAST, S_MAX_ITER, S_TOL, max_abs, momentum_from_velocity, newton_converged,
+                   newton_solve, run_loop, velocity_from_momentum)
 
 _VB, _QB, _R, _F, _S, _QN, _VN, _PN = 0, 1, 2, 3, 4, 5, 6, 7    # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4                         # mats
@@ -59,8 +59,9 @@ def _solve(kern, q, mom, tm, h, p, tol, max_iter, vb, qb, R, f, scratch, H, A, J
         resid = max_abs(R)
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
-        if not lu_solve(A, piv, R, scratch):
-            return SINGULAR_MASS, it, resid
+        status = newton_solve(A, piv, R, scratch)
+        if status != OK:
+            return status, it, resid
         for i in range(n):
             vb[i] += R[i]
         done, prev = newton_converged(R, vb, prev, tol)

@@ -30,8 +30,9 @@ from numba import njit
 
 from ..linalg import lu_inplace, lu_solve_inplace
 from ..nonsmooth.play import return_map
-from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, S_MAX_ITER, S_TOL, increment_small, max_abs, run_loop
+from ..status import NEWTON_DIVERGED, OK
+from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_small, max_abs,
+                   run_loop)
 
 _V1, _Q1, _DV, _RHS, _R, _S, _X = 0, 1, 2, 3, 4, 5, 6     # work rows (n,)
 _H, _A, _JQ, _JQD, _DHW, _HW = 0, 1, 2, 3, 4, 5          # mats (n, n)
@@ -166,7 +167,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
         if not lu_inplace(A, piv):
-            return SINGULAR_MASS, it, resid
+            return failed_solve_status(A), it, resid
         for i in range(n):
             X[i] = R[i]
         lu_solve_inplace(A, piv, X, scratch)

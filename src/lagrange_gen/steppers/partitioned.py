@@ -19,8 +19,8 @@ Newton uses exact Jacobians: d f/d v from ``momentum_rate_jacobian`` and d(H(q) 
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import FAST, lu_solve, max_abs, newton_converged
+from ..status import NEWTON_DIVERGED, OK
+from .base import FAST, max_abs, newton_converged, newton_solve
 
 
 @njit(**FAST)
@@ -45,8 +45,9 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
         resid = max_abs(R)
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
-        if not lu_solve(A, piv, R, scratch):
-            return SINGULAR_MASS, it, resid
+        status = newton_solve(A, piv, R, scratch)
+        if status != OK:
+            return status, it, resid
         for i in range(n):
             u[i] += R[i]
         done, prev = newton_converged(R, u, prev, tol)
@@ -79,8 +80,9 @@ def solve_drift(kern, q, u, mom, hd, p, tol, max_iter, H, A, dHw, piv, w, R, q_n
         resid = max_abs(R)
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
-        if not lu_solve(A, piv, R, scratch):
-            return SINGULAR_MASS, it, resid
+        status = newton_solve(A, piv, R, scratch)
+        if status != OK:
+            return status, it, resid
         for i in range(n):
             w[i] += R[i]
         done, prev = newton_converged(R, w, prev, tol)

@@ -33,7 +33,9 @@ stage (u, w, nu = h/2 lam), size 2n + m, with the exact Jacobian
      [J(q+)/2,                 J(q+)/2,            0       ]]
 
 for the residuals (kick, drift, Phi(q+)/h), solved by Gaussian elimination with partial
-pivoting (constrained.gauss_solve). Singular systems (redundant constraints) are SINGULAR_MASS.
+pivoting (constrained.gauss_solve). A singular Newton matrix is SINGULAR_NEWTON (NON_FINITE when
+it holds NaN or inf); a singular J M^-1 J^T on the explicit path (redundant constraints) is
+SINGULAR_MASS.
 """
 
 import sys
@@ -42,8 +44,8 @@ from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
-from .base import (FAST, increment_converged, S_MAX_ITER, S_TOL, W_ACC, explicit_path, max_abs,
-                   momentum_from_velocity, run_loop)
+from .base import (FAST, increment_converged, S_MAX_ITER, S_TOL, W_ACC, explicit_path,
+                   failed_solve_status, max_abs, momentum_from_velocity, run_loop)
 from .constrained import (check_buffers, flag_index, gauss_solve, phi_small,
                           project, record, schur_block, solve_rows, velocity_projection, views)
 
@@ -199,7 +201,7 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, work, mats, extra):
         if resid != resid:
             return NEWTON_DIVERGED, it, resid
         if not gauss_solve(K, b):
-            return SINGULAR_MASS, it, resid
+            return failed_solve_status(K), it, resid
         xmax = 0.0
         for i in range(n):
             u[i] += b[i]

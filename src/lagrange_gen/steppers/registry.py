@@ -27,7 +27,11 @@ Glue signature (identical for every method)::
                                  residual, the method's extra buffer] at the end, or at the
                                  failure; n_total >= n_extra sizes that buffer (scratch after
                                  the saved entries; see base.run_loop)
-    status     lagrange_gen.status code; steps_done = index of the failing step on failure
+    status     lagrange_gen.status code; steps_done = index of the failing step on failure, -1
+               when the initial state is refused (see base.run_loop)
+
+The glue is compiled with error_model="numpy", like the kernels and the cores: non-finite
+arithmetic gives inf/NaN, which the run loop reports as NON_FINITE, never a Python exception.
 """
 
 from __future__ import annotations
@@ -55,23 +59,33 @@ GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
 
 @dataclass(frozen=True)
 class MethodInfo:
-    """What the tests and reports may rely on for a method."""
+    """What the tests and reports may rely on for a method. ``stable``: the linear stability
+    range in tau = h omega (README's steppers table, reports/stability.md; closed forms in
+    bench.stability), quoted by simulate's energy warning; "" for the constrained methods."""
 
     order: int
     symplectic: bool
     symmetric: bool
     implicit: bool
     summary: str
+    stable: str = ""
 
 
 INFO = {
-    "explicit_euler": MethodInfo(1, False, False, False, "forward Euler (what not to do)"),
-    "symplectic_euler": MethodInfo(1, True, False, True, "symplectic Euler A in (q, p = H v)"),
-    "verlet": MethodInfo(2, True, True, True, "velocity Verlet / generalized leapfrog"),
-    "midpoint": MethodInfo(2, True, True, True, "midpoint variational integrator (A-stable)"),
-    "implicit_euler": MethodInfo(1, False, False, True, "backward Euler (L-stable)"),
-    "rk4": MethodInfo(4, False, False, False, "classical Runge-Kutta 4"),
-    "composition": MethodInfo(4, True, True, True, "Yoshida 4th-order triple jump of verlet"),
+    "explicit_euler": MethodInfo(1, False, False, False, "forward Euler (what not to do)",
+                                 "unstable for every tau > 0 (rho = sqrt(1 + tau^2))"),
+    "symplectic_euler": MethodInfo(1, True, False, True, "symplectic Euler A in (q, p = H v)",
+                                   "stable for tau < 2"),
+    "verlet": MethodInfo(2, True, True, True, "velocity Verlet / generalized leapfrog",
+                         "stable for tau < 2"),
+    "midpoint": MethodInfo(2, True, True, True, "midpoint variational integrator (A-stable)",
+                           "linearly stable for every tau (rho = 1), accurate only for tau << 1"),
+    "implicit_euler": MethodInfo(1, False, False, True, "backward Euler (L-stable)",
+                                 "stable for every tau, damping (rho = 1/sqrt(1 + tau^2))"),
+    "rk4": MethodInfo(4, False, False, False, "classical Runge-Kutta 4",
+                      "stable for tau <= 2.83 (2 sqrt(2))"),
+    "composition": MethodInfo(4, True, True, True, "Yoshida 4th-order triple jump of verlet",
+                              "stable for tau < 1.57"),
     "nonsmooth_euler": MethodInfo(1, False, False, True,
                                   "implicit Euler with Saint-Venant return map and Moreau-Jean friction"),
     "rattle": MethodInfo(2, True, True, True, "constrained Verlet, Newton on the multipliers"),
@@ -94,7 +108,7 @@ from lagrange_gen.steppers import {method} as _stepper_{method}
 _THIS_MODULE = _sys.modules[__name__]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_{method}({wrapped}):
     """Integrate with {method} ({summary}); returns (status, steps_done).
 
