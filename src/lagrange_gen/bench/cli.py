@@ -59,6 +59,11 @@ def _scale(args):
     run_scale_bench(args.models, args.reports, quick=args.quick)
 
 
+def _harness(args):
+    from .harness import run_harness_bench
+    run_harness_bench(args.reports, thorough=not args.quick)
+
+
 SUITES = {
     "pipeline": ("derive/emit/compile/cached-import times vs sympy.physics.mechanics", _pipeline),
     "steppers": ("ns per step of every method vs hand-written numba loops", _steppers),
@@ -69,6 +74,7 @@ SUITES = {
     "report": ("precision + stability + hard, and the method-choice summary", _report),
     "constraints": ("linkage drift per method, rattle vs verlet cost, breaking stiffness", _constraints),
     "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
+    "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 
 

@@ -1,0 +1,212 @@
+"""Generate a drawn model, call every kernel its module emits, compare with the reference.
+
+Two ways to run a module: ``"njit"`` calls the compiled dispatchers; ``"py_func"`` runs the
+printed source as plain Python (pure_kernels), with every kernel a kernel calls (composed
+kernels, forward_dynamics) replaced by its py_func too, so nothing is compiled.
+
+Every comparison is recorded in CHECKED {(kind, mode): count}, kind being a kernel name,
+``<kernel>[composed]``, a forward-dynamics path or ``fd:<kernel>`` (finite differences), so a
+test can assert that the run covered every kernel kind.
+"""
+
+from __future__ import annotations
+
+import inspect
+import types
+from collections import Counter
+from dataclasses import dataclass
+
+import numpy as np
+
+from lagrange_gen.codegen import generate_text
+from lagrange_gen.loader import import_generated
+from lagrange_gen.status import OK
+
+from .strategies import sample_state
+
+RTOL = 1e-9          # kernel vs reference, elementwise relative ...
+FLOOR = 1e-9         # ... plus FLOOR * max(1, max |reference output|) for entries near zero
+CHECKED: Counter = Counter()
+STATS: Counter = Counter()
+
+_QQTP = ("q", "qd", "t", "p")
+#: kernel -> (inputs, outputs as (argument, shape), reference quantities), as documented in
+#: README / codegen.spec; shapes: n coordinates, m constraints, e elements.
+CONTRACT = {
+    "mass_matrix": (("q", "p"), (("H", "nn"),), ("H",)),
+    "dynamics": (_QQTP, (("H", "nn"), ("rhs", "n")), ("H", "rhs")),
+    "rhs": (_QQTP, (("out", "n"),), ("rhs",)),
+    "energy": (_QQTP, (), ("E",)),
+    "momentum_rate": (_QQTP, (("out", "n"),), ("momentum_rate",)),
+    "rhs_jacobian": (_QQTP, (("Jq", "nn"), ("Jqd", "nn")), ("drhs_dq", "drhs_dqd")),
+    "momentum_rate_jacobian": (_QQTP, (("Jq", "nn"), ("Jqd", "nn")), ("dmom_dq", "dmom_dqd")),
+    "mass_matvec_dq": (("q", "w", "p"), (("out_mat", "nn"),), ("dHw_dq",)),
+    "constraints": (("q", "qd", "p"), (("phi", "m"), ("J", "mn"), ("gamma", "m")), ("Phi", "J", "gamma")),
+    "constraint_dq": (("q", "w", "lam", "p"), (("dJw", "mn"), ("dJTlam", "nn")), ("dJw_dq", "dJTlam_dq")),
+    "elements": (("q", "p"), (("s", "e"), ("G", "en"), ("coef", "e3")), ("s", "G", "coef")),
+    "elements_hessian": (("q", "we", "p"), (("out_mat", "nn"),), ("hess_w",)),
+}
+
+
+@dataclass
+class State:
+    """One evaluation point: q, qd, w (n,), t, params {name: value}, p (PARAMS order), lam (m,), we (ne,)."""
+
+    q: np.ndarray
+    qd: np.ndarray
+    t: float
+    params: dict
+    p: np.ndarray
+    w: np.ndarray
+    lam: np.ndarray
+    we: np.ndarray
+
+
+def generate(drawn, out_dir, methods):
+    """Generate and import the module of a DrawnModel (methods: [] for every kernel, symbolic)."""
+    model = drawn.build()
+    model.source_path = str(out_dir / f"{drawn.name}_model.py")    # never written: no staleness check
+    text, _, target = generate_text(model, out_dir, methods=methods)
+    target.write_text(text)
+    return import_generated(target)
+
+
+def pure_kernels(mod):
+    """The module's functions with every numba dispatcher replaced by its py_func, calling each
+    other's py_funcs (a namespace; accelerations included)."""
+    env = dict(vars(mod))
+    for name, obj in vars(mod).items():
+        if hasattr(obj, "py_func"):
+            f = obj.py_func
+            scope = env if f.__module__ == mod.__name__ else f.__globals__
+            env[name] = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
+    acc = mod.accelerations
+    env["accelerations"] = types.FunctionType(acc.__code__, env, "accelerations", acc.__defaults__)
+    return types.SimpleNamespace(**env)
+
+
+def states(drawn, mod, rng, count):
+    """``count`` States; the first at the default parameters, the others with every parameter
+    scaled by a factor in [0.7, 1.4] (passed through p, not frozen into the module)."""
+    n, m, ne = len(drawn.coords), len(drawn.constraints), len(drawn.elements)
+    out = []
+    for i in range(count):
+        q, qd, t = sample_state(drawn, rng)
+        scale = 1.0 if i == 0 else rng.uniform(0.7, 1.4, len(drawn.defaults))
+        params = dict(zip(drawn.defaults, np.asarray(list(drawn.defaults.values())) * scale))
+        p = np.array([params[name] for name in mod.PARAMS], dtype=float)
+        out.append(State(q, qd, t, params, p, rng.uniform(-1, 1, n), rng.uniform(-1, 1, m), rng.uniform(-1, 1, ne)))
+    return out
+
+
+def compare(label, got, expected, rtol=RTOL, floor=FLOOR):
+    """None when |got - expected| <= rtol |expected| + floor max(1, max |expected|) everywhere,
+    else a message with the worst entry."""
+    got, expected = np.asarray(got, dtype=float), np.asarray(expected, dtype=float)
+    if got.shape != expected.shape:
+        return f"{label}: shape {got.shape}, expected {expected.shape}"
+    if got.size == 0:
+        return None
+    allowed = rtol * np.abs(expected) + floor * max(1.0, float(np.max(np.abs(expected))))
+    excess = np.abs(got - expected) - allowed
+    if np.all(excess <= 0):     # NaN (an entry never written) fails here
+        return None
+    worst = np.unravel_index(int(np.argmax(np.where(np.isnan(excess), np.inf, excess))), got.shape)
+    return f"{label}{[int(i) for i in worst]}: got {float(got[worst])!r}, expected {float(expected[worst])!r}"
+
+
+def _shape(key, n, m, ne):
+    return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n), "e3": (ne, 3)}[key]
+
+
+def call_kernel(kern, name, state, sizes):
+    """Run kernel ``name`` of ``kern`` at a state on NaN-filled outputs: {reference name: value}."""
+    inputs, outputs, quantities = CONTRACT[name]
+    arrays = [np.full(_shape(key, *sizes), np.nan) for _, key in outputs]
+    result = getattr(kern, name)(*[getattr(state, a) for a in inputs], *arrays)
+    return dict(zip(quantities, arrays if outputs else [result]))
+
+
+def kind(mod, name):
+    """The kernel kind recorded for coverage: composed kernels say so in their docstring."""
+    doc = getattr(mod, name).py_func.__doc__ or ""
+    return f"{name}[composed]" if "composed" in doc else name
+
+
+def check_kernels(mod, kern, ref, state, mode):
+    """Every kernel of mod.KERNELS, forward_dynamics and accelerations at one state against the
+    reference: a list of mismatches (a kernel that raises is one)."""
+    failures = []
+    for name in (*mod.KERNELS, "forward_dynamics"):
+        try:
+            failures += _check_forward(mod, kern, ref, state, mode) if name == "forward_dynamics" \
+                else _check_kernel(mod, kern, name, ref, state, mode)
+        except Exception as exc:      # noqa: BLE001  e.g. SingularMass, ZeroDivisionError
+            failures.append(f"{name}: raised {type(exc).__name__}: {exc}")
+    return [f for f in failures if f]
+
+
+def _check_kernel(mod, kern, name, ref, state, mode):
+    inputs, outputs, _ = CONTRACT[name]
+    documented = list(inputs) + [o for o, _ in outputs]
+    actual = list(inspect.signature(getattr(mod, name).py_func).parameters)
+    if actual != documented:
+        return [f"{name}: arguments {actual}, documented {documented}"]
+    values = call_kernel(kern, name, state, (ref.n, ref.m, ref.ne))
+    # counted for coverage only where it computes something: constraint and element kernels
+    # of a model without constraints or elements fill empty or zero arrays
+    if all(np.size(v) for v in values.values()) and (ref.m or "lam" not in inputs) and (ref.ne or "we" not in inputs):
+        CHECKED[(kind(mod, name), mode)] += 1
+    return [compare(f"{name}.{quantity}", got, ref.value(quantity, state)) for quantity, got in values.items()]
+
+
+def forward_path(mod, state):
+    if not hasattr(mod, "MASS_FACTOR"):
+        return "forward_dynamics[general]"
+    default = all(state.params[n] == d for n, d in zip(mod.PARAMS, mod.DEFAULTS))
+    return "forward_dynamics[factored]" if default else "forward_dynamics[factored, other parameters]"
+
+
+def _check_forward(mod, kern, ref, state, mode):
+    """forward_dynamics and accelerations: H_ref qdd = rhs_ref to rounding (a backward-error
+    check, independent of the conditioning of H), and the status OK."""
+    n = ref.n
+    H, rhs = ref.value("H", state), ref.value("rhs", state)
+    work, qdd = np.full((n, n), np.nan), np.full(n, np.nan)
+    status = kern.forward_dynamics(state.q, state.qd, state.t, state.p, work, qdd)
+    acc = kern.accelerations(state.q, state.qd, state.t, params=dict(zip(mod.PARAMS, state.p)))
+    CHECKED[(forward_path(mod, state), mode)] += 1
+    CHECKED[("accelerations", mode)] += 1
+    out = [None if status == OK else f"forward_dynamics: status {status}"]
+    return out + [_residual("forward_dynamics.qdd", qdd, H, rhs), _residual("accelerations", acc, H, rhs)]
+
+
+def _residual(label, qdd, H, rhs):
+    """None when |H qdd - rhs| <= RTOL (|H| |qdd| + |rhs|) + FLOOR max(1, ...) everywhere."""
+    residual = H @ qdd - rhs
+    scale = np.abs(H) @ np.abs(qdd) + np.abs(rhs)
+    if np.all(np.abs(residual) <= RTOL * scale + FLOOR * max(1.0, float(np.max(scale)))):
+        return None
+    worst = int(np.argmax(np.where(np.isnan(residual), np.inf, np.abs(residual))))
+    return f"{label}[{worst}]: H qdd - rhs = {residual[worst]!r} (qdd = {qdd.tolist()}, rhs = {rhs.tolist()})"
+
+
+def check_model(drawn, methods, out_dir, modes, seed, n_states):
+    """Generate a DrawnModel for ``methods``, then at ``n_states`` random states check every
+    kernel against the reference and every Jacobian kernel against finite differences, in each
+    of ``modes`` ("py_func", "njit"). Returns the list of mismatches (empty when all agree)."""
+    from .fd import check_derivatives
+    from .reference import Reference
+    mod = generate(drawn, out_dir, methods)
+    ref = Reference(drawn)
+    failures = []
+    for mode in modes:
+        kern = mod if mode == "njit" else pure_kernels(mod)
+        for state in states(drawn, mod, np.random.default_rng(seed), n_states):
+            failures += [f"{mode}: {f}" for f in check_kernels(mod, kern, ref, state, mode)]
+            try:
+                fd = check_derivatives(mod, kern, state, (ref.n, ref.m, ref.ne), mode)
+            except Exception as exc:      # noqa: BLE001  a kernel raising near the state
+                fd = [f"finite differences: raised {type(exc).__name__}: {exc}"]
+            failures += [f"{mode}: {f}" for f in fd]
+    return failures

@@ -1,0 +1,38 @@
+"""Profiles of the differential harness: how many models each test draws.
+
+``ci`` (default) keeps the harness near a minute on 2 cores; ``thorough`` (pytest option
+``--thorough``, or ``lagrange-gen bench harness``) draws hundreds of models. Both are
+derandomized with no example database, so a run is reproducible. Compiling a random module with
+numba costs ~2 s (the rest of an example ~0.2 s), so most examples run the printed source as
+Python (py_func) and a few per model class compile every kernel as well. No shrinking: with an
+example costing about a second, hypothesis spent its five-minute shrinking budget without
+progress; a failure prints the drawn model (DrawnModel) as it is.
+"""
+
+from __future__ import annotations
+
+from hypothesis import HealthCheck, Phase, settings
+
+PROFILES = {
+    # examples per model class: run as py_func / compiled (njit and py_func); states per model
+    "ci": {"py_func": 6, "njit": 1, "states": 3},
+    "thorough": {"py_func": 60, "njit": 8, "states": 4},
+}
+_current = {"name": "ci", "count_only": False}
+
+
+def select(name, count_only=False):
+    """Use profile ``name``; count_only: record failing examples instead of failing (--printer-bug)."""
+    _current.update(name=name, count_only=count_only)
+
+
+def current():
+    return dict(PROFILES[_current["name"]], name=_current["name"], count_only=_current["count_only"])
+
+
+def hypothesis_settings(mode):
+    """Hypothesis settings of the tests running kernels in ``mode`` ("py_func" or "njit")."""
+    return settings(max_examples=current()[mode], derandomize=True, database=None, deadline=None,
+                    phases=(Phase.explicit, Phase.generate), print_blob=False,
+                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                           HealthCheck.filter_too_much])

@@ -1,0 +1,158 @@
+"""The reference: every kernel quantity written from Lagrange's equations directly in plain sympy
+(hessian, diff, jacobian, lambdify), from a DrawnModel's raw ingredients. It never imports
+lagrange_gen.derive or codegen, so a derivation or printing error cannot hide in both.
+
+    d/dt dT/dqd - dT/dq + dV/dq = Q - dD/dqd + J^T lam
+    H = d2T/dqd2,  d/dt dT/dqd = H qdd + (d(dT/dqd)/dq) qd
+    rhs = Q - dD/dqd - ((d(dT/dqd)/dq) qd - dT/dq) - dV/dq,   so that H qdd = rhs
+    momentum_rate = dT/dq - dV/dq + Q - dD/dqd  (dp/dt for p = dT/dqd)
+
+Shapes for n coordinates, m constraints, ne elements: H (n, n), vectors (n,), Jacobians (n, n),
+Phi (m,), J (m, n), gamma (m,), dJw_dq (m, n), s (ne,), G (ne, n), coef (ne, 3).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from lagrange_gen import t
+
+# lambdify's numpy printer knows Abs, sign, atan2, ...; DiracDelta (from d sign/dx) is zero away
+# from the kink, where every sampled state lies.
+_MODULES = [{"DiracDelta": lambda *args: 0.0}, "numpy"]
+_ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
+#: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
+VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "gamma", "s"}
+
+
+def _vector(exprs):
+    return sp.Matrix(list(exprs)) if len(exprs) else sp.zeros(0, 1)
+
+
+class Reference:
+    """Lazily built, lambdified reference quantities of one DrawnModel.
+
+    ``value(name, state)``: the quantity ``name`` (see _build) at a State (q, qd, t, params by
+    name, w, lam, we) as a float array (vectors 1-D)."""
+
+    def __init__(self, drawn):
+        self.drawn = drawn
+        self.q = sp.Matrix(drawn.coords)
+        self.qd = sp.Matrix([c.d for c in drawn.coords])
+        n, m, ne = len(drawn.coords), len(drawn.constraints), len(drawn.elements)
+        self.n, self.m, self.ne = n, m, ne
+        self.params = list(drawn.params)
+        self.w = sp.Matrix(sp.symbols(f"ref_w0:{n}", real=True))
+        self.lam = _vector(sp.symbols(f"ref_lam0:{m}", real=True)) if m else sp.zeros(0, 1)
+        self.we = _vector(sp.symbols(f"ref_we0:{ne}", real=True)) if ne else sp.zeros(0, 1)
+        self.args = [*self.q, *self.qd, t, *self.params, *self.w, *self.lam, *self.we]
+        self._exprs, self._functions = {}, {}
+
+    # -- symbolic quantities ------------------------------------------------------------------
+    def expr(self, name):
+        if name not in self._exprs:
+            self._exprs[name] = getattr(self, f"_{name}")()
+        return self._exprs[name]
+
+    def _generalized_forces(self):
+        """Q (n, 1) from the given forces or by virtual work of the point forces."""
+        Q = sp.zeros(self.n, 1)
+        if self.drawn.forces:
+            Q += _vector(self.drawn.forces)
+        for point, force in self.drawn.point_forces:
+            Q += sp.Matrix(point).jacobian(self.q).T * sp.Matrix(force)
+        return Q
+
+    def _H(self):
+        return sp.hessian(self.drawn.T, self.qd)
+
+    def _dT_dqd(self):
+        return sp.Matrix([self.drawn.T]).jacobian(self.qd).T
+
+    def _forces(self):
+        """Q - dD/dqd - dV/dq + dT/dq (n, 1): everything in the equations but d/dt dT/dqd."""
+        d = self.drawn
+        grad = lambda f, x: sp.Matrix([f]).jacobian(x).T   # noqa: E731
+        return self._generalized_forces() - grad(d.dissipation, self.qd) - grad(d.V, self.q) + grad(d.T, self.q)
+
+    def _rhs(self):
+        return self.expr("forces") - self.expr("dT_dqd").jacobian(self.q) * self.qd
+
+    def _momentum_rate(self):
+        return self.expr("forces")
+
+    def _E(self):
+        return self.drawn.T + self.drawn.V
+
+    def _drhs_dq(self):
+        return self.expr("rhs").jacobian(self.q)
+
+    def _drhs_dqd(self):
+        return self.expr("rhs").jacobian(self.qd)
+
+    def _dmom_dq(self):
+        return self.expr("momentum_rate").jacobian(self.q)
+
+    def _dmom_dqd(self):
+        return self.expr("momentum_rate").jacobian(self.qd)
+
+    def _dHw_dq(self):
+        return (self.expr("H") * self.w).jacobian(self.q)
+
+    def _Phi(self):
+        return _vector(self.drawn.constraints)
+
+    def _J(self):
+        return self.expr("Phi").jacobian(self.q)
+
+    def _gamma(self):
+        """gamma = -(dJ/dt) qd, so that J qdd = gamma on the constraint manifold."""
+        return -(self.expr("J") * self.qd).jacobian(self.q) * self.qd
+
+    def _dJw_dq(self):
+        return (self.expr("J") * self.w).jacobian(self.q)
+
+    def _dJTlam_dq(self):
+        return (self.expr("J").T * self.lam).jacobian(self.q)
+
+    def _s(self):
+        return _vector([e[1] for e in self.drawn.elements])
+
+    def _G(self):
+        return self.expr("s").jacobian(self.q)
+
+    def _coef(self):
+        """Rows (stiffness, threshold, 0) for Saint-Venant (threshold = yield force / stiffness
+        when given so), (bound, 0, 1) for dry friction."""
+        rows = []
+        for kind, _, coef, threshold, yield_force in self.drawn.elements:
+            if kind == "dry_friction":
+                rows.append([coef, 0, _ELEMENT_KIND[kind]])
+            else:
+                rows.append([coef, threshold if threshold is not None else yield_force / coef, _ELEMENT_KIND[kind]])
+        return sp.Matrix(rows) if rows else sp.zeros(0, 3)
+
+    def _hess_w(self):
+        out = sp.zeros(self.n, self.n)
+        for e in range(self.ne):
+            out += self.we[e] * sp.hessian(self.expr("s")[e], self.q)
+        return out
+
+    # -- numbers --------------------------------------------------------------------------------
+    def value(self, name, state):
+        """The quantity at a state: float, or array (column vectors flattened)."""
+        if name not in self._functions:
+            self._functions[name] = sp.lambdify(self.args, self.expr(name), modules=_MODULES)
+        expr = self.expr(name)
+        p = [state.params[s.name] for s in self.params]
+        values = [*state.q, *state.qd, state.t, *p, *state.w, *state.lam, *state.we]
+        out = np.asarray(self._functions[name](*values), dtype=float)
+        if isinstance(expr, sp.MatrixBase):
+            out = out.reshape(expr.shape)
+            return out[:, 0] if name in VECTORS else out
+        return float(out)
+
+    def accelerations(self, state):
+        """qdd (n,) solving H qdd = rhs numerically (numpy)."""
+        return np.linalg.solve(self.value("H", state), self.value("rhs", state))
