@@ -11,19 +11,20 @@ imports lagrange_gen for its runtime helpers) stays fast.
 
 from importlib import import_module
 
-from .errors import (BlowUp, GenerationError, LagrangeGenError, ModelError, NewtonDivergence,
-                     SimulationError, SingularMass, StaleModuleError)
+from .errors import (BlowUp, EnergyWarning, GenerationError, LagrangeGenError, ModelError,
+                     NewtonDivergence, SimulationError, SingularMass, SingularNewtonMatrix,
+                     StaleModuleError)
 
 _LAZY = {
     "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
     "t": "model", "load_model": "model_file", "SaintVenant": "model", "DryFriction": "model",
     "import_generated": "loader", "load": "loader",
-    "simulate": "simulation", "Trajectory": "simulation",
+    "simulate": "simulation", "Trajectory": "trajectory",
 }
 
 __all__ = sorted(_LAZY) + [
     "LagrangeGenError", "ModelError", "GenerationError", "StaleModuleError", "SimulationError",
-    "NewtonDivergence", "SingularMass", "BlowUp",
+    "NewtonDivergence", "SingularNewtonMatrix", "SingularMass", "BlowUp", "EnergyWarning",
 ]
 
 

@@ -63,6 +63,9 @@ def add_parser(subparsers):
                    help="spook: relaxation d > 0 in steps (default 2)")
     p.add_argument("--baumgarte", type=float, nargs=2, default=(0.0, 0.0), metavar=("ALPHA", "BETA"),
                    help="index1: Baumgarte stabilization gains (default 0 0)")
+    p.add_argument("--force", action="store_true",
+                   help="regenerate the module even when the one on disk comes from another model "
+                        "file or was generated with another freeze or build options")
     return p
 
 
@@ -121,7 +124,8 @@ def run(args) -> int:
                             save_every=args.save_every, newton_tol=args.newton_tol,
                             max_iter=args.max_iter, t0=args.t0, progress=args.progress,
                             out_dir=args.gen_dir, compliance=args.compliance,
-                            relaxation=args.relaxation, baumgarte=tuple(args.baumgarte))
+                            relaxation=args.relaxation, baumgarte=tuple(args.baumgarte),
+                            force=args.force)
         finally:
             for warning in caught:      # one line each, also when the run then failed
                 print(f"lagrange-gen: warning: {warning.message}", file=sys.stderr)

@@ -15,8 +15,6 @@ Newton) the residual (failures.py), and warns when a conservative run lost its e
 from __future__ import annotations
 
 import math
-import os
-import shlex
 import sys
 import time
 import types
@@ -31,6 +29,7 @@ from . import status as st
 from .energy_check import energy_warning
 from .errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
+from .keys import regeneration_command_for
 from .params import resolve_params
 from .steppers import registry
 from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, make_settings
@@ -43,13 +42,16 @@ __all__ = ["simulate", "Trajectory", "load_module"]
 CHUNK_STEPS = 200_000
 
 
-def load_module(module_or_path, out_dir="generated"):
+def load_module(module_or_path, out_dir="generated", method=None, force=False):
     """A generated module from: the module itself, a generated .py, or a model file (generated
-    into ``out_dir`` first when missing or stale)."""
+    into ``out_dir`` first when missing or stale, or regenerated with ``method`` added to its
+    own when it lacks it; its freeze and build options are kept, see loader.load; ``force``
+    overwrites a module generated from another model file or with another freeze)."""
     if isinstance(module_or_path, types.ModuleType):
         return module_or_path
     from .loader import load
-    return load(Path(module_or_path), out_dir=out_dir)
+    methods = [method] if method in registry.METHODS else None
+    return load(Path(module_or_path), out_dir=out_dir, methods=methods, force=force)
 
 
 def _n_steps(t0, t_end, h):
@@ -69,35 +71,8 @@ def _runner(module, method):
         have = ", ".join(getattr(module, "METHODS", ())) or "none"
         raise SimulationError(
             f"{module.NAME}: module {module.__file__} was generated without method {method!r} "
-            f"(it has: {have}); run `{regenerate_command(module, method)}`")
+            f"(it has: {have}); run `{regeneration_command_for(module, methods=[method])}`")
     return run
-
-
-def regenerate_command(module, method):
-    """The command that regenerates ``module`` in place with ``method`` added: its model file,
-    its directory (-o), and the options recorded in OPTIONS (--set, --methods, --freeze),
-    shell-quoted. (codegen.generate._command builds the same for the stale-module message.)"""
-    here = Path(module.__file__).resolve().parent
-    model = getattr(module, "MODEL_PATH", None)
-    options = getattr(module, "OPTIONS", {}) or {}
-    methods = set(options.get("methods", getattr(module, "METHODS", ()))) | {method}
-    words = ["lagrange-gen", _shown(here / model) if model else "MODEL.py", "-o", _shown(here)]
-    for key, value in sorted((options.get("build") or {}).items()):
-        words += ["--set", f"{key}={value}"]
-    if set(registry.METHODS) - methods:
-        words += ["--methods", ",".join(m for m in registry.METHODS if m in methods)]
-    if options.get("freeze"):
-        words += ["--freeze", ",".join(f"{k}={v!r}" for k, v in sorted(options["freeze"].items()))]
-    return " ".join(shlex.quote(w) for w in words)
-
-
-def _shown(path):
-    """path relative to the working directory when it lies below it, else absolute."""
-    path = Path(os.path.normpath(path))
-    try:
-        return str(path.relative_to(Path.cwd()))
-    except ValueError:
-        return str(path)
 
 
 def _element_method(module, method):
@@ -138,11 +113,11 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
              save_every=1, newton_tol=1e-12, max_iter=50, t0=0.0, progress=False,
              blowup_bound=1e150, newton_always=False, out_dir="generated",
              element_state0=None, compliance=0.0, relaxation=2.0,
-             baumgarte=(0.0, 0.0)) -> Trajectory:
+             baumgarte=(0.0, 0.0), force=False) -> Trajectory:
     """Integrate a generated model from t0 to t_end with fixed step h.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
-        into out_dir when missing or stale).
+        into out_dir when missing or stale; see load_module, and ``force`` there).
     method: one of steppers.registry.METHODS.
     q0, v0: initial coordinates and velocities (n,), default zeros.
     params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
@@ -167,7 +142,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     blowup_bound). A conservative run whose energy error passes energy_check.ENERGY_FRACTION of
     its energy scale warns (EnergyWarning, the line also in Trajectory.warnings).
     """
-    module = load_module(module_or_path, out_dir)
+    module = load_module(module_or_path, out_dir, method, force)
     method = _element_method(module, method)
     from .consistent import check_method
     check_method(module, method, registry.CONSTRAINED_METHODS)
