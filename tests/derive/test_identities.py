@@ -10,7 +10,11 @@ STEMS = [f.stem for f in MODEL_FILES]
 
 
 def random_state(rng, n):
-    return rng.uniform(-1.2, 1.2, n) + 0.3, rng.uniform(-1.5, 1.5, n)
+    """q with every |q_i| in [0.3, 1.5] (either sign), qd in [-1.5, 1.5]. The models' coordinate
+    singularities sit at q_i = 0 (Kepler's and the central field's r = 0, the top's theta = 0,
+    where H is singular) and none lies within 1.5 of the origin otherwise."""
+    sign = rng.choice([-1.0, 1.0], n)
+    return sign * rng.uniform(0.3, 1.5, n), rng.uniform(-1.5, 1.5, n)
 
 
 @pytest.mark.parametrize("stem", STEMS)
