@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from .backend import jacobian
+from .backend import backend_for, jacobian
 
 KIND_CODES = {"saint_venant": 0, "dry_friction": 1}
 
@@ -23,8 +23,10 @@ def derive_elements(model, aux_we):
         return dict(elem_s=sp.zeros(0, 1), elem_grad=sp.zeros(0, n), elem_coef=sp.zeros(0, 3),
                     elem_hess_w=sp.zeros(n, n))
     s = sp.Matrix([e.strain for e in model.elements])
-    grad = jacobian(s, q)
+    # symengine leaves d/du Abs(u) (sign, Min, Piecewise) unevaluated: such strains need sympy.
+    backend = backend_for(list(s))
+    grad = jacobian(s, q, backend)
     weighted = sp.Matrix([sum((aux_we[e] * grad[e, j] for e in range(ne)), sp.S.Zero) for j in range(n)])
-    hess_w = jacobian(weighted, q)
+    hess_w = jacobian(weighted, q, backend)
     coef = sp.Matrix([[*e.coefficients(), KIND_CODES[e.kind]] for e in model.elements])
     return dict(elem_s=s, elem_grad=grad, elem_coef=coef, elem_hess_w=hess_w)
