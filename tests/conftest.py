@@ -14,6 +14,16 @@ MODELS_DIR = ROOT / "models"
 MODEL_FILES = sorted(MODELS_DIR.glob("*.py"))
 
 
+def pytest_addoption(parser):
+    """Options of the differential harness (tests/harness/conftest.py says what they do); here,
+    in the root conftest, so that ``pytest --thorough`` works from the repository root too."""
+    group = parser.getgroup("harness", "differential harness (tests/harness)")
+    group.addoption("--thorough", action="store_true", help="draw hundreds of models (thorough profile)")
+    group.addoption("--printer-bug", action="store_true",
+                    help="put the old a/x**2 -> a/x*x printer bug back and count failing examples")
+    group.addoption("--harness-summary", metavar="PATH", help="write the harness counts as JSON here")
+
+
 @pytest.fixture(scope="session")
 def gen_dir(tmp_path_factory):
     return tmp_path_factory.mktemp("generated")

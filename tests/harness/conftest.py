@@ -1,5 +1,5 @@
-"""Options of the differential harness (initial conftest only when pytest is given tests/harness
-or a file in it: ``python -m pytest tests/harness --thorough``).
+"""What the differential harness's options do (the options themselves are registered in
+tests/conftest.py, so they work from the repository root: ``python -m pytest --thorough``).
 
 --thorough          the thorough profile (profiles.py)
 --printer-bug       put the issue-10 printer bug back for the whole run and count the failing
@@ -12,14 +12,6 @@ import json
 from . import profiles
 from .check import CHECKED, STATS
 from .printer_bug import put_back
-
-
-def pytest_addoption(parser):
-    group = parser.getgroup("harness", "differential harness (tests/harness)")
-    group.addoption("--thorough", action="store_true", help="draw hundreds of models (thorough profile)")
-    group.addoption("--printer-bug", action="store_true",
-                    help="put the old a/x**2 -> a/x*x printer bug back and count failing examples")
-    group.addoption("--harness-summary", metavar="PATH", help="write the harness counts as JSON here")
 
 
 def pytest_configure(config):
