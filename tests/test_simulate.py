@@ -166,3 +166,20 @@ def test_failed_plot_after_the_run_names_the_written_trajectory(cart, capsys, tm
     assert code != 0 and "Traceback" not in err and "renderer crashed" in err
     assert f"the trajectory is in {tmp_path / 't.npz'}" in err
     assert np.load(tmp_path / "t.npz")["q"].shape == (101, 2)
+
+
+def test_model_file_with_elements_runs_implicit_euler_in_a_fresh_directory(tmp_path):
+    """implicit_euler on a model with elements runs nonsmooth_euler: loading the model file for
+    it must give a module that has the method that actually runs."""
+    model = MODELS_DIR / "prandtl.py"
+    traj = simulate(model, "implicit_euler", t_end=0.01, h=1e-3, out_dir=tmp_path)
+    assert traj.method == "nonsmooth_euler" and len(traj.t) == 11
+
+
+def test_module_generated_without_the_method_gets_it_added(tmp_path, capsys):
+    model = MODELS_DIR / "damped_oscillator.py"
+    assert main([str(model), "-o", str(tmp_path), "--methods", "rk4"]) == 0
+    traj = simulate(model, "verlet", q0=[1.0], t_end=0.01, h=1e-3, out_dir=tmp_path)
+    assert len(traj.t) == 11
+    text = (tmp_path / "damped_oscillator.py").read_text()
+    assert "def run_verlet" in text and "def run_rk4" in text

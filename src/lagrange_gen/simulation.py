@@ -44,14 +44,21 @@ CHUNK_STEPS = 200_000
 
 def load_module(module_or_path, out_dir="generated", method=None, force=False):
     """A generated module from: the module itself, a generated .py, or a model file (generated
-    into ``out_dir`` first when missing or stale, or regenerated with ``method`` added to its
-    own when it lacks it; its freeze and build options are kept, see loader.load; ``force``
-    overwrites a module generated from another model file or with another freeze)."""
+    into ``out_dir`` first when missing or stale, keeping the freeze, build options and methods
+    of the module on disk, see loader.load). When the module lacks the glue of the method that
+    runs ``method`` on it (e.g. nonsmooth_euler for implicit_euler on a model with elements), it
+    is regenerated with that method added. ``force`` overwrites a module generated from another
+    model file or with another freeze."""
     if isinstance(module_or_path, types.ModuleType):
         return module_or_path
     from .loader import load
-    methods = [method] if method in registry.METHODS else None
-    return load(Path(module_or_path), out_dir=out_dir, methods=methods, force=force)
+    module = load(Path(module_or_path), out_dir=out_dir, force=force)
+    if method is None or getattr(module, "KEY", None) is None:
+        return module
+    runs = _element_method(module, method)
+    if runs in registry.METHODS and not hasattr(module, f"run_{runs}"):
+        module = load(Path(module_or_path), out_dir=out_dir, methods=[runs], force=force)
+    return module
 
 
 def _n_steps(t0, t_end, h):
