@@ -1,10 +1,9 @@
 """What a generated module was generated from, the stale check it runs on import, and the one
-command that regenerates it (no sympy import: generated modules call check_fresh)."""
+command that regenerates it (no sympy import: generated modules call check_current)."""
 
 from __future__ import annotations
 
 import hashlib
-import json
 import os
 import shlex
 from importlib import metadata
@@ -13,13 +12,15 @@ from pathlib import Path
 from .errors import StaleModuleError
 
 _PACKAGE = Path(__file__).resolve().parent
-# Sources whose change alters generated text or the compiled code a generated module pulls in.
-# (nonsmooth/play.py only: the return map the steppers compile; experiments.py is a report.)
-_GENERATOR_PARTS = ("model.py", "model_file.py", "linalg.py", "params.py", "status.py", "errors.py", "keys.py", "derive",
-                    "codegen", "steppers", "nonsmooth/play.py")
-# The header line that records the hash of the rest of the file (it cannot hash itself).
+# Sources that shape the text generated from a model (equations, kernels, module layout, glue
+# template): a change is seen by re-deriving (--check, load), not by the KEY. Hashed into the
+# record load() keeps next to a module to skip re-deriving (codegen.generate.module_current).
+_GENERATOR_PARTS = ("model.py", "model_file.py", "params.py", "keys.py", "derive", "codegen",
+                    "steppers/registry.py")
+# The header lines that record hashes of the rest of the file (a hash cannot hash itself).
+KEY_PREFIX = "KEY = "
 TEXT_SHA_PREFIX = "TEXT_SHA = "
-_HEADER_FIELDS = ("KEY", "MODEL_SHA", "GENERATOR_SHA", "TEXT_SHA", "OPTIONS", "MODEL_PATH")
+_HEADER_FIELDS = ("KEY", "SOURCES", "TEXT_SHA", "OPTIONS", "MODEL_PATH")
 
 
 def _version(dist):
@@ -30,10 +31,8 @@ def _version(dist):
 
 
 def generator_hash() -> str:
-    """sha256 of the generator's own sources, its version and the sympy / numba versions."""
-    h = hashlib.sha256()
-    # Versions from package metadata: a generated module checks this at import without sympy.
-    h.update(" ".join(f"{d} {_version(d)}" for d in ("lagrange-gen", "sympy", "numba")).encode())
+    """sha256 of the sources that shape generated text (_GENERATOR_PARTS) and the sympy version."""
+    h = hashlib.sha256(f"sympy {_version('sympy')}".encode())
     for part in _GENERATOR_PARTS:
         path = _PACKAGE / part
         files = sorted(path.rglob("*.py")) if path.is_dir() else [path] if path.exists() else []
@@ -47,6 +46,24 @@ def model_hash(source_text: str) -> str:
     return hashlib.sha256(source_text.encode()).hexdigest()
 
 
+def source_hashes(files) -> dict:
+    """{path relative to lagrange_gen: sha256 of its bytes (16 hex digits), or "missing"}."""
+    hashes = {}
+    for name in files:
+        path = _PACKAGE / name
+        hashes[name] = hashlib.sha256(path.read_bytes()).hexdigest()[:16] if path.is_file() else "missing"
+    return hashes
+
+
+def _without_lines(text, prefixes):
+    """``text`` without its lines that start with one of ``prefixes`` (and without line 1 when
+    it records the KEY)."""
+    lines = text.split("\n")
+    if lines and lines[0].startswith("# lagrange-gen"):
+        lines = lines[1:]
+    return "\n".join(line for line in lines if not line.startswith(prefixes))
+
+
 def text_hash(text: str) -> str:
     """sha256 of a generated module's text without its TEXT_SHA line (which records this hash)."""
     start = text.find("\n" + TEXT_SHA_PREFIX)
@@ -56,40 +73,46 @@ def text_hash(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def make_key(model_sha: str, gen_sha: str, options: dict) -> str:
-    """KEY = sha256(model source hash, generator hash, generation options)."""
-    blob = json.dumps({"model": model_sha, "generator": gen_sha, "options": options}, sort_keys=True)
-    return hashlib.sha256(blob.encode()).hexdigest()
+def key_of_text(text: str) -> str:
+    """KEY of a generated module: sha256 of its text without the KEY and TEXT_SHA lines. The
+    text is the canonical form of what the module uses: its kernels as emitted (the derived
+    equations, not the model file's text), OPTIONS, and SOURCES (hashes of the stepper and
+    shared sources its glue compiles), so the KEY changes exactly when one of those does."""
+    return hashlib.sha256(_without_lines(text, (KEY_PREFIX, TEXT_SHA_PREFIX)).encode()).hexdigest()
 
 
-def check_fresh(module_file, key, model_sha, gen_sha, model_relpath, options, text_sha=None):
-    """Raise StaleModuleError when a generated module no longer matches its sources.
+def check_current(module_file, key, sources, model_relpath, options, text_sha):
+    """Raise StaleModuleError when a generated module no longer matches what it uses.
 
-    Called at import by every generated module: its header (KEY against the hashes and options),
-    the generator, its own text (TEXT_SHA: a hand edit anywhere), and the model file, looked up
-    relative to the generated file (when absent, e.g. a module copied elsewhere, it is skipped).
-    What a model file reads or imports is seen by ``lagrange-gen --check``, which re-derives.
+    Called at import by every generated module (cheap, no sympy): its text against TEXT_SHA
+    and KEY (a hand edit anywhere), and every package source its compiled code is built from
+    against SOURCES (numba's on-disk cache is keyed on the generated file only, so a changed
+    stepper must make the module stale). A changed model file is seen by re-deriving:
+    ``lagrange-gen --check`` and ``lagrange_gen.load``.
     """
-    problem = _staleness(Path(module_file), key, model_sha, gen_sha, model_relpath, options, text_sha)
+    problem = why_stale(Path(module_file), key, sources, text_sha)
     if problem:
         raise StaleModuleError(f"{problem}: run {regeneration_command_from(module_file, model_relpath, options)}")
 
 
-def _staleness(here, key, model_sha, gen_sha, model_relpath, options, text_sha):
-    """Why the generated module ``here`` is stale (one phrase naming it), or None."""
-    if make_key(model_sha, gen_sha, options) != key:
-        return f"{here}: KEY does not match its header (file edited by hand?)"
-    if gen_sha != generator_hash():
-        return f"{here} was generated by another lagrange-gen version or source"
+def check_fresh(module_file, key, model_sha, gen_sha, model_relpath, options, text_sha=None):
+    """The check of modules written by lagrange-gen before SOURCES existed: always stale."""
+    raise StaleModuleError(f"{module_file} was generated by an older lagrange-gen: run "
+                           f"{regeneration_command_from(module_file, model_relpath, options)}")
+
+
+def why_stale(here, key, sources, text_sha):
+    """Why the generated module ``here`` is stale as far as the import-time check sees (one
+    phrase naming it), or None."""
     try:
         text = here.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         text = None          # e.g. imported from a zip: nothing to compare with
-    if text is not None and text_hash(text) != text_sha:
+    if text is not None and (text_hash(text) != text_sha or key_of_text(text) != key):
         return f"{here} was edited by hand since it was generated"
-    model_path = here.parent / model_relpath
-    if model_path.is_file() and model_hash(model_path.read_text()) != model_sha:
-        return f"{here} is stale ({model_path} changed since generation)"
+    changed = [name for name, sha in source_hashes(sources).items() if sha != sources[name]]
+    if changed:
+        return f"{here} is stale ({', '.join(changed)} changed since generation)"
     return None
 
 
@@ -100,12 +123,12 @@ def read_key(path) -> str | None:
             first = fh.readline()
     except (OSError, UnicodeDecodeError):
         return None
-    marker = "KEY = "
+    marker = KEY_PREFIX
     return first.split(marker, 1)[1].strip() if first.startswith("# lagrange-gen") and marker in first else None
 
 
 def read_header(path) -> dict | None:
-    """{KEY, MODEL_SHA, GENERATOR_SHA, TEXT_SHA, OPTIONS, MODEL_PATH: value} of a generated file
+    """{KEY, SOURCES, TEXT_SHA, OPTIONS, MODEL_PATH: value} of a generated file
     (fields it lacks are absent), or None when ``path`` is not a readable generated module."""
     import ast
     if read_key(path) is None:
@@ -113,7 +136,7 @@ def read_header(path) -> dict | None:
     header, started = {}, False
     with open(path, encoding="utf-8") as fh:
         for line in fh:
-            if line.startswith("check_fresh("):
+            if line.startswith(("check_current(", "check_fresh(")):
                 break
             started = started or line.startswith("# fmt: off")   # the docstring is above this
             name, sep, value = line.partition(" = ")
@@ -127,15 +150,16 @@ def read_header(path) -> dict | None:
 
 def regeneration_command(model_path, out_dir="generated", build=None, methods=None, freeze=None) -> str:
     """The shell command that generates ``model_path`` into ``out_dir`` with these options
-    (paths quoted; -o omitted for generated/, --methods for all methods): the one source of
-    every "run lagrange-gen ..." hint."""
-    from .steppers.registry import METHODS
+    (paths quoted; -o omitted for generated/, --methods for the methods that apply to the
+    model, the default): the one source of every "run lagrange-gen ..." hint."""
+    from .steppers.registry import METHODS, applicable_methods
+    defaults = [set(applicable_methods(*counts)) for counts in ((0, 0), (1, 0), (0, 1))]
     args = ["lagrange-gen", str(model_path)]
     if os.path.normpath(str(out_dir)) != "generated":
         args += ["-o", str(out_dir)]
     for name, value in sorted((build or {}).items()):
         args += ["--set", f"{name}={value}"]
-    if methods is not None and set(methods) != set(METHODS):
+    if methods is not None and set(methods) not in defaults:
         args += ["--methods", ",".join(m for m in METHODS if m in set(methods))]
     if freeze:
         args += ["--freeze", ",".join(f"{k}={v!r}" for k, v in sorted(freeze.items()))]

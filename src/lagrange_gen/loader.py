@@ -64,10 +64,13 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True,
 
 def _plan(path, out_dir, methods, options, freeze, force):
     """(target, None) when the module on disk serves the request of load(), else (target,
-    (why, build, methods, freeze, command)) to generate with."""
+    (why, build, methods, freeze, command)) to generate with. Requested methods that do not
+    apply to the model are not added (simulate refuses them, naming why); whether the module
+    on disk is current is codegen.generate.module_current (re-derives only when the model file
+    or the generator changed since that was last decided)."""
     from .codegen.generate import (other_source, refuse_overwrite, describe_options, generation_options,
-                                   output_path, resolve_methods)
-    from .keys import generator_hash, make_key, model_hash, read_header, regeneration_command
+                                   module_current, output_path, resolve_methods)
+    from .keys import read_header, regeneration_command
     from .model_file import load_model
     model = load_model(path, **(options or {}))
     target = output_path(model.name, out_dir)
@@ -75,16 +78,20 @@ def _plan(path, out_dir, methods, options, freeze, force):
     if not force:
         refuse_overwrite(path, target, model.name)
     disk = header.get("OPTIONS") if other_source(path, target, header) is None else None
+    asked = resolve_methods(methods, model, drop_inapplicable=True) if methods else None
     if not isinstance(disk, dict):          # missing (or forced over another model's module)
-        build, methods, freeze = dict(options or {}), resolve_methods(methods), dict(freeze or {})
+        build, freeze = dict(options or {}), dict(freeze or {})
+        methods = resolve_methods(asked or None, model)
         return target, ("missing", build, methods, freeze, regeneration_command(path, out_dir, build, methods, freeze))
     have = list(disk.get("methods", ()))
     build = dict(disk.get("build", {}) if options is None else options)
     freeze = dict(disk.get("freeze", {}) if freeze is None else freeze)
-    methods = resolve_methods(have + list(methods or ()))
+    if disk.get("build", {}) != model.build_options:
+        model = load_model(path, **disk.get("build", {}))   # the module's own build, to compare
+    methods = resolve_methods(have + list(asked or ()), model, drop_inapplicable=True)
     wanted = generation_options(build, methods, freeze)
     command = regeneration_command(path, out_dir, build, methods, freeze)
-    if header.get("KEY") != make_key(model_hash(model.source_text), generator_hash(), disk):
+    if not module_current(model, target, header):
         return target, ("stale", build, methods, freeze, command)
     if (wanted["build"], wanted.get("freeze")) != (disk.get("build"), disk.get("freeze")) and not force:
         have_options = {"build": disk.get("build"), "freeze": disk.get("freeze")}

@@ -7,6 +7,8 @@ for a request or must be generated (plan_load).
 
 from __future__ import annotations
 
+import ast
+import json
 import os
 import sys
 import threading
@@ -18,13 +20,13 @@ from pathlib import Path
 from ..derive import derive
 from ..errors import GenerationError
 from ..model_file import load_model
-from ..keys import (generator_hash, make_key, model_hash, read_header, read_key, regeneration_command,
-                    text_hash)
+from ..keys import (generator_hash, key_of_text, model_hash, read_header, regeneration_command,
+                    source_hashes, text_hash, why_stale)
 from .emit import render_kernel
 from .compose import compositions
-from .needs import methods_needs, select_kernels
+from .needs import methods_needs, select_kernels, source_closure
 from .printer import Inputs
-from .render import render_module
+from .render import COMPILED_IMPORTS, render_module
 from .spec import make_kernels
 from .write import write_if_changed
 
@@ -89,15 +91,32 @@ def generation_options(build, methods, freeze):
     return options
 
 
-def resolve_methods(requested):
-    """Requested methods in registry order (all for None); GenerationError for unknown ones."""
-    from ..steppers.registry import METHODS
+def model_counts(model):
+    """(number of constraints, number of nonsmooth elements): what decides the methods that apply."""
+    return len(model.constraints), len(model.elements)
+
+
+def resolve_methods(requested, model, drop_inapplicable=False):
+    """Methods to emit glue for, in registry order: for None those that apply to ``model``
+    (steppers.registry.applicable_methods), else the requested ones, implicit_euler becoming
+    nonsmooth_euler on a model with elements as in simulate. GenerationError for an unknown
+    method, and for one that does not apply (one line naming it and why) unless
+    ``drop_inapplicable`` (load(): simulate then refuses it with its own message)."""
+    from ..steppers.registry import METHODS, applicable_methods, inapplicable, runs_as
+    n_constraints, n_elements = model_counts(model)
     if requested is None:
-        return list(METHODS)
+        return list(applicable_methods(n_constraints, n_elements))
     unknown = [m for m in requested if m not in METHODS]
     if unknown:
         raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
-    return [m for m in METHODS if m in requested]
+    wanted = {runs_as(m, n_elements) for m in requested}
+    for method in (m for m in METHODS if m in wanted):
+        why = inapplicable(method, n_constraints, n_elements)
+        if why and not drop_inapplicable:
+            raise GenerationError(f"method {method} does not apply to model {model.name!r}: {why}")
+        if why:
+            wanted.discard(method)
+    return [m for m in METHODS if m in wanted]
 
 
 @dataclass
@@ -120,10 +139,8 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None, progre
     """Derive and emit a loaded Model (nothing is written); see generate_text."""
     from ..steppers.registry import glue_source
     progress = progress or Progress(model.source_path or model.name)
-    methods, freeze = resolve_methods(methods), dict(sorted((freeze or {}).items()))
+    methods, freeze = resolve_methods(methods, model), dict(sorted((freeze or {}).items()))
     options = generation_options(model.build_options, methods, freeze)
-    model_sha, gen_sha = model_hash(model.source_text), generator_hash()
-    key = make_key(model_sha, gen_sha, options)
     start = time.perf_counter()
     with progress.stage("derive"):
         dyn = derive(model, freeze=freeze)
@@ -140,18 +157,24 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None, progre
             texts.append(render_kernel(spec, inputs))
         target = output_path(model.name, out_dir)
         source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
-        text = render_module(dyn, texts, key=key, model_sha=model_sha, gen_sha=gen_sha,
-                             options=options, source_rel=source_rel, methods=methods,
+        text = render_module(dyn, texts, sources=module_sources(methods), options=options,
+                             source_rel=source_rel, methods=methods,
                              glue="\n\n".join(glue_source(m) for m in methods), why=selected)
     seconds = {"derive": derived - start, "emit": time.perf_counter() - derived}
-    return GenerationParts(text, key, target, dyn, texts, seconds)
+    return GenerationParts(text, key_of_text(text), target, dyn, texts, seconds)
+
+
+def module_sources(methods) -> dict:
+    """{package file: hash} of what a module gluing ``methods`` compiles: the stepper modules,
+    the package modules they import and the compiled imports of every module (linalg, status)."""
+    return source_hashes(source_closure([f"steppers.{m}" for m in methods] + list(COMPILED_IMPORTS)))
 
 
 def generate_text(model, out_dir="generated", methods=None, freeze=None):
     """Return (module text, KEY, target path) for a loaded Model; nothing is written.
 
-    methods: stepper methods to emit glue for (default all); only the kernels they reach are
-    derived and emitted (codegen.needs). freeze: {parameter: value} folded into the kernels.
+    methods: stepper methods to emit glue for (default: those that apply to the model); only the
+    kernels they reach are derived and emitted (codegen.needs). freeze: {parameter: value} folded into the kernels.
     """
     parts = generate_parts(model, out_dir, methods, freeze)
     return parts.text, parts.key, parts.target
@@ -176,6 +199,7 @@ def generate_model(model_path, out_dir="generated", methods=None, options=None,
     parts = generate_parts(model, out_dir, methods, freeze, progress)
     with progress.stage("write"):
         written = write_if_changed(target, parts.text)
+    remember_current(target, model, parts.key, read_header(target)["OPTIONS"])
     return GenerationResult(target, written, parts.key)
 
 
@@ -206,19 +230,65 @@ def refuse_overwrite(model_path, target, name):
                               f"{name!r}): not overwritten (rename one model, use another -o DIR, or pass --force)")
 
 
-def expected_key(model_path, out_dir="generated", methods=None, options=None, freeze=None):
-    """(target path, KEY the model would get now) without deriving."""
-    model = load_model(model_path, **(options or {}))
-    opts = generation_options(model.build_options, resolve_methods(methods), dict(sorted((freeze or {}).items())))
-    key = make_key(model_hash(model.source_text), generator_hash(), opts)
-    return output_path(model.name, out_dir), key
+def _record_path(target) -> Path:
+    """Where load() remembers that ``target`` is current (next to numba's cache, not in git)."""
+    return target.parent / "__pycache__" / f"{target.stem}.lagrange-gen.json"
+
+
+def _record(model, key, options) -> dict:
+    """What makes re-deriving needless: the same model text, generator sources, options and KEY."""
+    return {"model": model_hash(model.source_text), "generator": generator_hash(), "options": options, "key": key}
+
+
+def remember_current(target, model, key, options):
+    """Record that ``target`` (KEY ``key``) is what ``model`` generates with ``options`` now; the
+    model text's hash goes here, never into the generated file (a comment edit must not change it).
+    Best effort: an unwritable directory only means load() re-derives next time."""
+    path = _record_path(target)
+    try:
+        path.parent.mkdir(exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(_record(model, key, options), sort_keys=True))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+
+
+def module_current(model, target, header) -> bool:
+    """True when ``target`` (its ``header``: keys.read_header) is what generating ``model`` with
+    the header's OPTIONS writes now. Cheap when the record of remember_current matches (model
+    text, generator sources, options, KEY); otherwise re-derives and compares the text (about
+    50 ms for the models in models/), recording the answer when current."""
+    options = header.get("OPTIONS")
+    if "SOURCES" not in header or not isinstance(options, dict):
+        return False                      # not a module of this lagrange-gen
+    if why_stale(target, header.get("KEY"), header["SOURCES"], header.get("TEXT_SHA")):
+        return False
+    try:
+        if json.loads(_record_path(target).read_text()) == _record(model, header["KEY"], options):
+            return True
+    except (OSError, ValueError):
+        pass
+    try:
+        text, key, _ = generate_text(model, target.parent, options.get("methods"), options.get("freeze"))
+    except GenerationError:
+        return False                      # e.g. methods that no longer apply
+    if text != target.read_text(encoding="utf-8"):
+        return False
+    remember_current(target, model, key, options)
+    return True
 
 
 def is_current(model_path, out_dir="generated", methods=None, options=None, freeze=None):
-    """(target, True when target exists and carries the KEY the model would get now): the cheap
-    check (model source, generator, options); check_generated compares the whole text."""
-    target, key = expected_key(model_path, out_dir, methods, options, freeze)
-    return target, read_key(target) == key
+    """(target, True when target is what generating the model with these arguments writes now):
+    the decision of load(), re-deriving only when the model file or the generator changed since
+    the last time it was made (module_current); check_generated always re-derives."""
+    model = load_model(model_path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    header = read_header(target)
+    freeze = dict(sorted((freeze or {}).items()))
+    wanted = generation_options(model.build_options, resolve_methods(methods, model), freeze)
+    return target, header is not None and header.get("OPTIONS") == wanted and module_current(model, target, header)
 
 
 def check_generated(model_path, out_dir="generated", methods=None, options=None, freeze=None):
@@ -233,29 +303,33 @@ def check_generated(model_path, out_dir="generated", methods=None, options=None,
     other = other_source(model_path, target, header)
     if other is not None:
         return target, f"stale (generated from {other}, not {model_path})"
-    text, key, _ = generate_text(model, out_dir, methods, freeze)
+    parts = generate_parts(model, out_dir, methods, freeze)
     try:
         on_disk = target.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         return target, f"stale (unreadable: {exc})"
-    if on_disk == text:
+    if on_disk == parts.text:
+        remember_current(target, model, parts.key, header.get("OPTIONS"))
         return target, None
-    if header.get("KEY") != key:
-        why = _key_difference(header, model, methods, freeze)
-    elif text_hash(on_disk) != header.get("TEXT_SHA"):
-        why = "edited by hand since it was generated"
-    else:
-        why = "its equations changed: a file the model reads or imports changed"
-    return target, f"stale ({why})"
+    return target, f"stale ({_difference(header, on_disk, parts.text)})"
 
 
-def _key_difference(header, model, methods, freeze):
-    wanted = generation_options(model.build_options, resolve_methods(methods), dict(sorted((freeze or {}).items())))
-    if header.get("OPTIONS") != wanted:
+def _difference(header, on_disk, text):
+    """Why the generated text ``on_disk`` (its ``header``) differs from ``text``, the text
+    generating writes now: a phrase."""
+    if text_hash(on_disk) != header.get("TEXT_SHA") or key_of_text(on_disk) != header.get("KEY"):
+        return "edited by hand since it was generated"
+    new = {}
+    for line in text.split("\n"):
+        name, sep, value = line.partition(" = ")
+        if sep and name in ("OPTIONS", "SOURCES") and name not in new:
+            new[name] = ast.literal_eval(value)
+    if header.get("OPTIONS") != new.get("OPTIONS"):
         return f"generated with other options: {describe_options(header.get('OPTIONS') or {})}"
-    if header.get("MODEL_SHA") != model_hash(model.source_text):
-        return "the model file changed"
-    return "the generator changed"
+    if header.get("SOURCES") != new.get("SOURCES"):
+        changed = sorted(set((header.get("SOURCES") or {}).items()) ^ set(new["SOURCES"].items()))
+        return f"stepper sources changed: {', '.join(sorted({name for name, _ in changed}))}"
+    return "its equations changed: the model, a file it reads or imports, or the generator changed"
 
 
 def describe_options(options) -> str:

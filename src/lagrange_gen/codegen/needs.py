@@ -150,3 +150,41 @@ def select_kernels(dyn, methods) -> dict:
                                       f"generate (kernels: {', '.join(table)})")
             why.setdefault(name, []).append(method)
     return {name: why[name] for name in table if name in why}
+
+
+def source_closure(roots) -> tuple:
+    """Package files (paths relative to lagrange_gen, sorted) of the modules ``roots`` (dotted,
+    relative to lagrange_gen: "steppers.rattle", "linalg") and of every package module they
+    import, transitively, at any level of the file (a function-level import counts too).
+
+    This is what compiled code of a generated module is built from, so what its KEY hashes.
+    Package ``__init__`` files are not followed: they run at import, numba compiles nothing
+    from them."""
+    seen, files, todo = set(), [], list(roots)
+    while todo:
+        dotted = todo.pop()
+        path = _path(dotted)
+        if dotted in seen or path is None or path.name == "__init__.py":
+            continue
+        seen.add(dotted)
+        files.append(path.relative_to(_PACKAGE).as_posix())
+        todo += _imported_modules(dotted, ast.parse(path.read_text(), str(path)))
+    return tuple(sorted(files))
+
+
+def _imported_modules(dotted, tree):
+    """Dotted names (relative to lagrange_gen) of the package modules ``tree`` imports."""
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = _relative(dotted, node.level, node.module)
+            elif (node.module or "").split(".")[0] == _PACKAGE.name:
+                base = node.module.partition(".")[2]
+            else:
+                continue
+            found.append(base)
+            found += [f"{base}.{a.name}" if base else a.name for a in node.names]
+        elif isinstance(node, ast.Import):
+            found += [a.name.partition(".")[2] for a in node.names if a.name.split(".")[0] == _PACKAGE.name]
+    return [name for name in found if name and _path(name) is not None]

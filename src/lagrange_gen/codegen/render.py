@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..derive.elements import KIND_CODES
-from ..keys import TEXT_SHA_PREFIX, text_hash
+from ..keys import KEY_PREFIX, TEXT_SHA_PREFIX, key_of_text, text_hash
 from .forward import factor_at_import, forward_source
 from .spec import default_kernels
 
@@ -61,13 +61,16 @@ _IMPORTS = [
     "",
     "import numpy as np",
     "",
-    "from lagrange_gen.keys import check_fresh",
+    "from lagrange_gen.keys import check_current",
     "from lagrange_gen.loader import njit, register_module  # numba.njit; a bad cache entry is a miss",
     "from lagrange_gen.errors import SingularMass",
     "from lagrange_gen.linalg import cholesky_inplace, cholesky_solve_inplace",
     "from lagrange_gen.params import resolve_params",
     "from lagrange_gen.status import OK, SINGULAR_MASS",
 ]
+#: The modules of _IMPORTS whose functions or constants numba compiles into the kernels (the
+#: others run in Python): with the glued steppers, the roots of the module's SOURCES.
+COMPILED_IMPORTS = ("linalg", "status")
 
 
 def _model_constants(dyn, methods, texts):
@@ -97,27 +100,27 @@ def _model_constants(dyn, methods, texts):
     ]
 
 
-def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel,
-                  methods, glue, why=None) -> str:
+def render_module(dyn, texts, *, sources, options, source_rel, methods, glue, why=None) -> str:
     """The whole generated module as text. ``glue`` is the per-stepper source to append;
     ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
     ``texts`` are the rendered kernels (emit.render_kernel), in module order.
 
     The header records TEXT_SHA, the hash of the whole text but that line (keys.text_hash),
-    which the module checks on import. Nothing in the text depends on the working directory or
-    on how the model path was spelled, so ``--check`` can compare texts."""
+    which the module checks on import, and the KEY (keys.key_of_text: the text without those
+    two lines, so the kernels, OPTIONS and ``sources`` {file: hash}, never the model file's
+    text). Nothing in the text depends on the working directory or on how the model path was
+    spelled, so ``--check`` can compare texts."""
     parts = [
-        f"# lagrange-gen generated module. DO NOT EDIT. KEY = {key}",
+        "# lagrange-gen generated module. DO NOT EDIT. KEY = ",
         f'"""{module_docstring(dyn, source_rel, methods, why, texts)}\n"""',
         "# fmt: off",
-        f'KEY = "{key}"',
-        f'MODEL_SHA = "{model_sha}"',
-        f'GENERATOR_SHA = "{gen_sha}"',
+        f'{KEY_PREFIX}""',
+        f"SOURCES = {sources!r}",
         f'{TEXT_SHA_PREFIX}""',
         f"OPTIONS = {options!r}",
         f"MODEL_PATH = {source_rel!r}",
         "", *_IMPORTS, "",
-        "check_fresh(__file__, KEY, MODEL_SHA, GENERATOR_SHA, MODEL_PATH, OPTIONS, TEXT_SHA)",
+        "check_current(__file__, KEY, SOURCES, MODEL_PATH, OPTIONS, TEXT_SHA)",
         "register_module(globals())  # the stepper glue finds this module in sys.modules",
         "", *_model_constants(dyn, methods, texts), "",
     ]
@@ -131,4 +134,7 @@ def render_module(dyn, texts, *, key, model_sha, gen_sha, options, source_rel,
     if glue:
         parts += ["", glue]
     text = "\n".join(parts).rstrip() + "\n"
+    key = key_of_text(text)
+    text = text.replace(KEY_PREFIX, KEY_PREFIX + key, 1)          # line 1, then the KEY line
+    text = text.replace(f'\n{KEY_PREFIX}""\n', f'\n{KEY_PREFIX}"{key}"\n', 1)
     return text.replace(f'\n{TEXT_SHA_PREFIX}""\n', f'\n{TEXT_SHA_PREFIX}"{text_hash(text)}"\n', 1)

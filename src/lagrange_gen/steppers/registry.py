@@ -6,8 +6,9 @@ module itself as their first argument (``kern``; see base.py for why a module an
 dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` lives in the
 generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
 and its compiled code, cores included, is loaded from numba's cache by the next process. The
-KEY of a generated module hashes ``steppers/``, so a change here regenerates the module and
-thereby invalidates that cache.
+KEY of a generated module hashes the sources of the steppers it glues and of the package
+modules they import (codegen.needs.source_closure), so a change there regenerates the module
+and thereby invalidates that cache.
 
 Glue signature (identical for every method)::
 
@@ -52,6 +53,40 @@ CONSTRAINED_METHODS = ("rattle", "constrained_midpoint", "constrained_implicit_e
 #: Methods that treat nonsmooth elements (SaintVenant, DryFriction); simulate() routes
 #: implicit_euler to nonsmooth_euler on models that have elements.
 NONSMOOTH_METHODS = ("nonsmooth_euler",)
+
+#: Which models each method applies to, as data (what simulate() accepts; it reads the two
+#: tuples above): ``constraints`` True = only models with holonomic constraints, False = only
+#: models without; ``elements`` True = only models with nonsmooth elements, False = only models
+#: without. The generator emits glue for the methods that apply (codegen.generate).
+APPLIES = {m: {"constraints": m in CONSTRAINED_METHODS, "elements": m in NONSMOOTH_METHODS} for m in METHODS}
+
+#: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
+ON_ELEMENTS = {"implicit_euler": "nonsmooth_euler"}
+
+
+def runs_as(method: str, n_elements: int) -> str:
+    """The method whose glue runs ``method`` on a model with ``n_elements`` nonsmooth elements."""
+    return ON_ELEMENTS.get(method, method) if n_elements else method
+
+
+def inapplicable(method: str, n_constraints: int, n_elements: int) -> str:
+    """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
+    flags = APPLIES[method]
+    if n_constraints and n_elements:
+        return "constraints together with nonsmooth elements are not supported by any method"
+    if bool(n_constraints) != flags["constraints"]:
+        return ("it ignores the model's constraints" if n_constraints
+                else "it is for models with constraints and this model has none")
+    if bool(n_elements) != flags["elements"]:
+        return ("it cannot treat the model's nonsmooth elements (implicit_euler runs nonsmooth_euler)"
+                if n_elements else "it is for models with nonsmooth elements and this model has none")
+    return ""
+
+
+def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
+    """The methods that apply to a model with these counts, in METHODS order."""
+    return tuple(m for m in METHODS if not inapplicable(m, n_constraints, n_elements))
+
 
 GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
              "out_t, out_q, out_v, out_stats, out_extra, out_last")
