@@ -19,11 +19,12 @@ from lagrange_gen import keys
 from lagrange_gen.cli import main
 from lagrange_gen.codegen import generate_model, needs
 from lagrange_gen.codegen.generate import check_generated
-from lagrange_gen.errors import StaleModuleError
+from lagrange_gen.errors import SimulationError, StaleModuleError
 from lagrange_gen.loader import import_generated
 from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, METHODS
 
-UNCONSTRAINED = [m for m in METHODS if m not in CONSTRAINED_METHODS and m != "nonsmooth_euler"]
+# nonsmooth_euler is implicit Euler on a model without elements: simulate accepts it there.
+UNCONSTRAINED = [m for m in METHODS if m not in CONSTRAINED_METHODS]
 
 # A fresh process loads the module from the model file (load() decides it is current), runs
 # explicit_euler a few steps and prints numba's cache statistics of the glue it ran.
@@ -65,6 +66,9 @@ def test_default_glue_is_the_methods_that_apply(cart, tmp_path):
     assert list(four_bar.METHODS) == list(CONSTRAINED_METHODS)
     prandtl = import_generated(generate_model(MODELS_DIR / "prandtl.py", tmp_path).path)
     assert list(prandtl.METHODS) == ["nonsmooth_euler"]
+    # as in simulate, implicit_euler runs as nonsmooth_euler on a model with elements
+    routed = generate_model(MODELS_DIR / "prandtl.py", tmp_path / "r", methods=["implicit_euler"])
+    assert "METHODS = ('nonsmooth_euler',)" in routed.path.read_text()
 
 
 def test_an_inapplicable_method_is_refused_in_one_line(cart, tmp_path, capsys):
@@ -73,6 +77,10 @@ def test_an_inapplicable_method_is_refused_in_one_line(cart, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "rattle" in err and "models with constraints" in err, err
     assert not (tmp_path / "cart_pendulum.py").exists()
+    # simulate (through load) does not add it either: it refuses it with its own message
+    with pytest.raises(SimulationError, match="'rattle' is for models with constraints"):
+        lagrange_gen.simulate(model, "rattle", [0.1, 0.3], t_end=0.01, h=0.001, out_dir=tmp_path)
+    assert "rattle" not in import_generated(tmp_path / "cart_pendulum.py").METHODS
 
 
 def test_comment_in_the_model_file_changes_nothing_and_nothing_recompiles(cart):

@@ -56,8 +56,9 @@ NONSMOOTH_METHODS = ("nonsmooth_euler",)
 
 #: Which models each method applies to, as data (what simulate() accepts; it reads the two
 #: tuples above): ``constraints`` True = only models with holonomic constraints, False = only
-#: models without; ``elements`` True = only models with nonsmooth elements, False = only models
-#: without. The generator emits glue for the methods that apply (codegen.generate).
+#: models without; ``elements`` True = treats nonsmooth elements (the only methods for models
+#: with elements; on a model without them nonsmooth_euler is implicit Euler, and simulate and
+#: the convergence tests run it there). The generator emits glue for the methods that apply.
 APPLIES = {m: {"constraints": m in CONSTRAINED_METHODS, "elements": m in NONSMOOTH_METHODS} for m in METHODS}
 
 #: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
@@ -77,9 +78,8 @@ def inapplicable(method: str, n_constraints: int, n_elements: int) -> str:
     if bool(n_constraints) != flags["constraints"]:
         return ("it ignores the model's constraints" if n_constraints
                 else "it is for models with constraints and this model has none")
-    if bool(n_elements) != flags["elements"]:
-        return ("it cannot treat the model's nonsmooth elements (implicit_euler runs nonsmooth_euler)"
-                if n_elements else "it is for models with nonsmooth elements and this model has none")
+    if n_elements and not flags["elements"]:
+        return "it cannot treat the model's nonsmooth elements (implicit_euler runs nonsmooth_euler)"
     return ""
 
 
