@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from lagrange_gen.bench import harness
+from lagrange_gen.analysis import harness
 from lagrange_gen.errors import LagrangeGenError
 
 SUMMARY = {"profile": "thorough", "models": 340, "failed_models": 0, "kernel_checks": 31000,

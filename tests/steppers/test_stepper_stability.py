@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from stepper_util import model, one_step, params  # model is a fixture
-from lagrange_gen.bench.stability import CLOSED_FORMS, spectral_radius  # closed forms of case 3
+from lagrange_gen.analysis.stability import CLOSED_FORMS, spectral_radius  # closed forms of case 3
 from lagrange_gen.steppers.base import make_settings
 
 TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)

@@ -27,7 +27,9 @@ from ..errors import SimulationError
 from ..simulation import simulate
 from ..steppers.base import N_STATS, make_settings
 from ..steppers.constrained import extra_size, make_constrained_settings
-from .common import ROOT, _best_of, fmt, md_table, new_figure, save_figure, write_report
+from ..analysis.runs import fmt, md_table
+from .common import ROOT, new_figure, save_figure, write_report
+from .steppers import _best_of
 
 LINKAGE_H = 1e-3
 STIFF_H, STIFF_T, STIFF_THETA0 = 1e-3, 2.0, 1.0

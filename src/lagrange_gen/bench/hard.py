@@ -1,7 +1,8 @@
 """`lagrange-gen bench hard`: the hard cases 3-8 of HARD_CASES.md, each with a verdict against its
 reference, a table and (cases 4 and 5) a figure; writes reports/hard.md.
 
-The cases themselves are in hard_cases.py (3-6) and hard_constrained.py (7-8).
+The cases and their verdicts are lagrange_gen.analysis.hard_cases (3-6) and
+analysis.hard_constrained (7-8); this module runs them, draws the figures and writes the report.
 """
 
 from __future__ import annotations
@@ -10,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import common, hard_cases, hard_constrained, scenes, stability
+from ..analysis import hard_cases, hard_constrained, reference, runs, scenes, stability
+from . import common
 
 
 #: Models of each case, for precompile: [(stem, build options)].
@@ -26,8 +28,7 @@ def run_cases(models_dir, gen_dir, methods=None, quick=False, cases=None, progre
     progress = progress or common.Progress(1, "", enabled=False)
     wanted = cases or (3, 4, 5, 6, 7, 8)
     runners = {
-        3: lambda: hard_cases.case3_tau(stability.oscillator(models_dir, gen_dir),
-                                        hard_cases._methods(methods)),
+        3: lambda: hard_cases.case3_tau(stability.oscillator(models_dir, gen_dir), methods),
         4: lambda: hard_cases.case4_damped(models_dir, gen_dir, methods),
         5: lambda: hard_cases.case5_fpu(models_dir, gen_dir, methods),
         6: lambda: hard_cases.case6_separatrix(models_dir, gen_dir, methods),
@@ -51,8 +52,8 @@ def fpu_figure(result, path):
         return None
     fig, axes = common.new_figure(1, len(shown), figsize=(4.2 * len(shown), 3.8), sharey=True,
                                   squeeze=False)
-    ref_t = list(scenes.FPU_REFERENCE)
-    ref_i = np.array(list(scenes.FPU_REFERENCE.values()))
+    ref_t = list(reference.FPU_REFERENCE)
+    ref_i = np.array(list(reference.FPU_REFERENCE.values()))
     for ax, method in zip(axes[0], shown):
         t, I = series[method]
         for j in range(3):
@@ -84,7 +85,7 @@ def damped_figure(result, path, compliance=1e-6):
                         label=f"{method}: failed (blow-up) at t = {run:.3g}")
     sc = scenes.oscillator_scene(compliance)
     t = np.linspace(0, sc.t_end, 2001)
-    x, v = scenes.oscillator_exact(t, 1.0, compliance, sc.params["b"])
+    x, v = reference.oscillator_exact(t, 1.0, compliance, sc.params["b"])
     ax.semilogy(t, (0.5 * v**2 + 0.5 * x**2 / compliance) * 2 * compliance, "k:", lw=1.5,
                 label="exact")
     ax.set_ylim(1e-12, top)
@@ -100,7 +101,7 @@ def case_markdown(result):
     lines = [f"## Case {result.number}: {result.title} — **{result.verdict}**", ""]
     lines += result.notes + ([""] if result.notes else [])
     if result.rows:
-        lines += common.md_table(result.headers, result.rows) + [""]
+        lines += runs.md_table(result.headers, result.rows) + [""]
     lines += [f"![case {result.number}]({name})" for name in result.figures]
     return lines + ([""] if result.figures else [])
 
@@ -111,7 +112,7 @@ def markdown(results, quick):
              f"HARD_CASES.md 3-8, each judged against its reference (closed form, published "
              f"values, elliptic functions, the exact rigid pendulum). A case passes when every "
              f"expectation it states holds; rows without an expectation are reported only.", ""]
-    lines += common.md_table(["case", "verdict"],
+    lines += runs.md_table(["case", "verdict"],
                              [[f"{r.number}: {r.title}", r.verdict] for r in results]) + [""]
     for r in results:
         lines += case_markdown(r)
@@ -130,7 +131,7 @@ def run_hard(models_dir="models", gen_dir="generated", reports_dir="reports", qu
     figures = {4: ("hard_damped_oscillator.png", damped_figure),
                5: ("hard_fpu.png", fpu_figure)}
     for r in results:
-        if r.number in figures and r.verdict != common.NOT_AVAILABLE:
+        if r.number in figures and r.verdict != runs.NOT_AVAILABLE:
             name, draw = figures[r.number]
             if draw(r, Path(reports_dir) / name) is not None:
                 r.figures.append(name)

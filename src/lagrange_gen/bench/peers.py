@@ -1,7 +1,7 @@
 """The peers a user would pick instead of our steppers, measured in the same run:
 
 * scipy solve_ivp DOP853 and Radau (with the exact generated Jacobian) on our generated
-  right-hand side (bench.reference.ode_rhs, or the index-1 KKT form of a constrained model);
+  right-hand side (analysis.reference.ode_rhs, or the index-1 KKT form of a constrained model);
 * sympy.physics.mechanics: LagrangesMethod on the model's own L = T - V, its mass_matrix_full and
   forcing_full lambdified to numpy, y' = M^-1 F per call, integrated by DOP853 (what PyDy's
   default "lambdify" generator does);
@@ -17,6 +17,8 @@ import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
+
+from ..analysis import mechanics
 
 
 def solver_run(f, y0, t_end, t_grid, method, rtol, jac=None, repeats=1):
@@ -41,63 +43,13 @@ def solver_run(f, y0, t_end, t_grid, method, rtol, jac=None, repeats=1):
     return best, sol.y, sol.y[:, -1], sol.nfev, ""
 
 
-def _symbols_for(model):
-    """The model's coordinates as dynamicsymbols, and the substitution Coordinate -> q(t),
-    Velocity -> q(t)'."""
-    from sympy.physics import mechanics as me
-    qs = me.dynamicsymbols(" ".join(c.name for c in model.coords))
-    qs = list(qs) if isinstance(qs, (list, tuple)) else [qs]
-    subs = {c.d: q.diff() for c, q in zip(model.coords, qs)}
-    subs.update({c: q for c, q in zip(model.coords, qs)})
-    return qs, subs
-
-
-def mechanics_equations(model_file):
-    """sympy.physics.mechanics LagrangesMethod on L = T - V of a conservative, unconstrained
-    model file: returns (mass_matrix_full (2n, 2n), forcing_full (2n,), q(t) list, parameter
-    symbols in the model's order). Raises ValueError for a model this peer does not cover."""
-    from sympy.physics import mechanics as me
-
-    from ..model_file import load_model
-    model = load_model(model_file)
-    if model.constraints or model.elements or any(f != 0 for f in model.forces) \
-            or model.dissipation != 0:
-        raise ValueError(f"{model.name}: the sympy.mechanics peer covers conservative "
-                         f"unconstrained models only")
-    qs, subs = _symbols_for(model)
-    lm = me.LagrangesMethod((model.T - model.V).xreplace(subs), qs)
-    lm.form_lagranges_equations()
-    return lm.mass_matrix_full, lm.forcing_full, qs, list(model.params)
-
-
-def _plain_symbols(exprs, qs):
-    """Replace q(t)' and q(t) by plain symbols (for lambdify); returns (exprs, states)."""
-    import sympy as sp
-    qd = [sp.Symbol(f"{q.func.__name__}_d") for q in qs]
-    qq = [sp.Symbol(f"{q.func.__name__}_q") for q in qs]
-    rep = {q.diff(): s for q, s in zip(qs, qd)}
-    out = [e.xreplace(rep).xreplace(dict(zip(qs, qq))) for e in exprs]
-    return out, qq + qd
-
-
 def mechanics_rhs(model_file, param_names, p):
-    """rhs(t, y) of the sympy.mechanics peer, parameters p (in param_names order), and the
-    seconds spent deriving and lambdifying (reported, not part of the timed runs)."""
-    import sympy as sp
+    """rhs(t, y) of the sympy.mechanics peer (analysis.mechanics), parameters p (in param_names
+    order), and the seconds spent deriving and lambdifying (reported, not part of the timed
+    runs)."""
     start = time.perf_counter()
-    M, F, qs, params = mechanics_equations(model_file)
-    (M, F), states = _plain_symbols([M, F], qs)
-    by_name = {s.name: s for s in params}
-    psyms = [by_name[name] for name in param_names]
-    fM = sp.lambdify([states, psyms], M, "numpy")
-    fF = sp.lambdify([states, psyms], F, "numpy")
-    setup = time.perf_counter() - start
-    pv = list(p)
-
-    def f(t, y):
-        return np.linalg.solve(np.asarray(fM(y, pv), dtype=float),
-                               np.asarray(fF(y, pv), dtype=float).ravel())
-    return f, setup
+    f = mechanics.mechanics_rhs(model_file, param_names, p)
+    return f, time.perf_counter() - start
 
 
 def pydy_rhs(model_file, param_names, p):
@@ -110,7 +62,7 @@ def pydy_rhs(model_file, param_names, p):
         return None
     from sympy.physics import mechanics as me
     start = time.perf_counter()
-    M, F, qs, params = mechanics_equations(model_file)
+    M, F, qs, params = mechanics.mechanics_equations(model_file)
     n = len(qs)
     us = list(me.dynamicsymbols(" ".join(f"u{i}" for i in range(n)))) if n > 1 else \
         [me.dynamicsymbols("u0")]

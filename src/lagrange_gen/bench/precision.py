@@ -3,7 +3,7 @@
 For each model of the suite and each stepper, h = h0 / 2^k (k = 0, 1, ...) until the final error
 reaches round-off, the run gets too long, or k_max; for each peer a sweep of tolerances. Every
 run is compared with a DOP853 reference at rtol 1e-13 that a second solver has confirmed
-(bench.reference). Errors (max norm over q and v): the final state, the maximum over S sample
+(analysis.reference). Errors (max norm over q and v): the final state, the maximum over S sample
 times, max |E - E0| over the samples and, for constrained models, max |Phi|. Time: integration
 wall time, minimum over repeats, after a warm-up (simulate compiles or loads the glue before its
 clock starts; the peers' right-hand sides are called once before timing).
@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis import reference as ref
+from ..analysis import runs
 from . import common, peers
-from . import reference as ref
 
 TARGET = 1e-8          # the headline's final-state error
 
@@ -115,7 +116,7 @@ def sweep_ours(mod, method, case, p, reference, settings, progress):
     for k in range(settings.k_max + 1):
         n_steps = case.n0 * 2**k
         h = case.t_end / n_steps
-        run = common.guarded_run(mod, method, q0, v0, h, case.t_end, p,
+        run = runs.guarded_run(mod, method, q0, v0, h, case.t_end, p,
                                  save_every=n_steps // case.samples, repeats=settings.repeats)
         progress.step(f"{case.stem} {method} h={h:.2g}")
         if not run.ok:
@@ -200,10 +201,10 @@ def _reference(mod, case, p, settings):
 def run_case(case, models_dir, gen_dir, settings, methods=None, progress=None):
     """All runs of one case -> dict(case, reference, points, methods, missing)."""
     progress = progress or common.Progress(1, "", enabled=False)
-    mod = common.load_module(models_dir, case.stem, gen_dir)
-    p = common.params_of(mod)
+    mod = runs.load_module(models_dir, case.stem, gen_dir)
+    p = runs.params_of(mod)
     reference = _reference(mod, case, p, settings)
-    wanted = common.constrained_methods() if case.constrained else common.unconstrained_methods()
+    wanted = runs.constrained_methods() if case.constrained else runs.unconstrained_methods()
     wanted = [m for m in wanted if methods is None or m in methods]
     points = []
     for method in wanted:
@@ -212,7 +213,7 @@ def run_case(case, models_dir, gen_dir, settings, methods=None, progress=None):
                                                   Path(models_dir) / f"{case.stem}.py", settings):
         points += sweep_peer(name, f, jac, solver, rtols, mod, case, p, reference, settings,
                              progress)
-    missing = common.NOT_AVAILABLE if case.constrained and not wanted else ""
+    missing = runs.NOT_AVAILABLE if case.constrained and not wanted else ""
     return {"case": case, "reference": reference, "points": points, "methods": wanted,
             "missing": missing, "model": mod.NAME}
 
@@ -237,8 +238,8 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
                           enabled=progress)
     results, lines = [], _intro(settings, quick)
     for case in cases:
-        if not common.model_available(models_dir, case.stem):
-            lines += [f"## {case.stem}", "", f"Model file missing: {common.NOT_AVAILABLE}.", ""]
+        if not runs.model_available(models_dir, case.stem):
+            lines += [f"## {case.stem}", "", f"Model file missing: {runs.NOT_AVAILABLE}.", ""]
             continue
         result = run_case(case, models_dir, gen_dir, settings, methods, bar)
         results.append(result)
@@ -259,7 +260,7 @@ def _has_pydy():
 
 def _n_runs(case, settings, methods):
     """Runs of a case for the progress bar (sweeps that stop early count what they skip)."""
-    pool = common.constrained_methods() if case.constrained else common.unconstrained_methods()
+    pool = runs.constrained_methods() if case.constrained else runs.unconstrained_methods()
     ours = sum(1 for m in pool if methods is None or m in methods) * (settings.k_max + 1)
     dop, radau = len(settings.dop_rtols), len(settings.radau_rtols)
     return ours + (dop if case.constrained else (3 if _has_pydy() else 2) * dop + radau)

@@ -4,6 +4,7 @@ headline (best of ours against each peer at final error 1e-8)."""
 
 from __future__ import annotations
 
+from ..analysis import runs
 from . import common
 from .precision import TARGET, _by_method, time_at
 
@@ -66,7 +67,7 @@ def summary_rows(result, targets=(1e-4, 1e-6, TARGET)):
     for method, pts in _by_method(result["points"]).items():
         good = [pt.final for pt in pts if not pt.failed]
         rows.append([method, pts[0].kind, *(_ms(time_at(pts, t)) for t in targets),
-                     common.fmt(min(good)) if good else "-",
+                     runs.fmt(min(good)) if good else "-",
                      f"{sum(1 for pt in pts if pt.failed)} / {len(pts)}"])
     return rows
 
@@ -83,10 +84,10 @@ def headline(result, target=TARGET):
 
 
 def _full_table(points):
-    rows = [[pt.method, f"{pt.param:.3g}", _ms(pt.wall), common.fmt(pt.final),
-             common.fmt(pt.traj_max), common.fmt(pt.energy), common.fmt(pt.phi),
-             common.short_error(pt.failed) if pt.failed else "ok"] for pt in points]
-    return common.md_table(["method", "h or rtol", "wall", "final error", "max error",
+    rows = [[pt.method, f"{pt.param:.3g}", _ms(pt.wall), runs.fmt(pt.final),
+             runs.fmt(pt.traj_max), runs.fmt(pt.energy), runs.fmt(pt.phi),
+             runs.short_error(pt.failed) if pt.failed else "ok"] for pt in points]
+    return runs.md_table(["method", "h or rtol", "wall", "final error", "max error",
                             "max abs(E - E0)", "max abs(Phi)", "status"], rows)
 
 
@@ -99,7 +100,7 @@ def case_markdown(result, figure_name):
              f"second solver ({refr.second}) agrees to {refr.agreement:.1e}.", ""]
     if result["missing"]:
         lines += [f"Constrained steppers: **{result['missing']}** (only the peers ran).", ""]
-    lines += common.md_table(["method", "kind", "time to final error 1e-4", "1e-6", "1e-8",
+    lines += runs.md_table(["method", "kind", "time to final error 1e-4", "1e-6", "1e-8",
                               "smallest final error", "failed runs"], summary_rows(result))
     lines += ["", f"![{result['model']}]({figure_name})", "", "<details><summary>every run"
               "</summary>", "", *_full_table(result["points"]), "", "</details>", ""]
@@ -119,4 +120,4 @@ def headline_lines(result):
         rows.append(["PyDy + DOP853", "pydy not installed", "-"])
     return [f"{result['model']} to T = {result['case'].t_end:g}, wall time to reach final-state "
             f"error {hl['target']:g} (interpolated on the work-precision curves below):", "",
-            *common.md_table(["method", "time", "ratio"], rows), ""]
+            *runs.md_table(["method", "time", "ratio"], rows), ""]

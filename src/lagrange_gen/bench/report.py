@@ -19,8 +19,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from . import common, hard, precision, precision_report, stability
+from ..analysis import hard_constrained, runs
 from ..steppers import registry
+from . import common, hard, precision, precision_report, stability
 
 ENERGY_TARGET = 1e-6
 
@@ -48,7 +49,7 @@ def _ms(t):
 
 def energy_row(prec):
     cart = _result(prec, "cart_pendulum")
-    symplectic = [m for m in common.unconstrained_methods() if registry.INFO[m].symplectic]
+    symplectic = [m for m in runs.unconstrained_methods() if registry.INFO[m].symplectic]
     method, t = _fastest(cart, symplectic, "energy", ENERGY_TARGET) if cart else (None, None)
     why = "no symplectic method reached it" if method is None else \
         f"fastest symplectic method to max abs(E - E0) <= {ENERGY_TARGET:g} on the cart " \
@@ -59,7 +60,7 @@ def energy_row(prec):
 
 def accuracy_row(prec):
     cart = _result(prec, "cart_pendulum")
-    method, t = _fastest(cart, common.unconstrained_methods(), "final", precision.TARGET) \
+    method, t = _fastest(cart, runs.unconstrained_methods(), "final", precision.TARGET) \
         if cart else (None, None)
     why = "-" if method is None else \
         f"fastest to final-state error {precision.TARGET:g} on the cart pendulum: {_ms(t)} " \
@@ -107,18 +108,18 @@ def no_damping_row(stab, hard_results):
 
 def constraints_row(prec, hard_results):
     cart = _result(prec, "cartesian_pendulum")
-    projected = [m for m in hard.hard_constrained.PROJECTED if common.has_method(m)]
+    projected = [m for m in hard_constrained.PROJECTED if runs.has_method(m)]
     if cart is None or not projected:
-        return ["constraints", "-", common.NOT_AVAILABLE]
+        return ["constraints", "-", runs.NOT_AVAILABLE]
 
     def on_manifold(pts):
-        return all(pt.phi <= hard.hard_constrained.DRIFT_TOL for pt in pts if not pt.failed)
+        return all(pt.phi <= hard_constrained.DRIFT_TOL for pt in pts if not pt.failed)
     method, t = _fastest(cart, projected, "final", 1e-6, on_manifold)
     case8 = _case(hard_results, 8)
     drift = f"; linkage drift (hard case 8): {case8.verdict}" if case8 else ""
     why = "no projected method reached final error 1e-6" if method is None else \
         f"fastest projected method to final error 1e-6 on the Cartesian pendulum with max " \
-        f"abs(Phi) <= {hard.hard_constrained.DRIFT_TOL:g}: {_ms(t)}{drift}"
+        f"abs(Phi) <= {hard_constrained.DRIFT_TOL:g}: {_ms(t)}{drift}"
     return ["constraints", method or "-", why]
 
 
@@ -130,7 +131,7 @@ def choice_rows(prec, stab, hard_results):
 
 def choice_table(prec, stab, hard_results):
     """Markdown lines of the method-choice table."""
-    return common.md_table(["scene", "pick", "why (measured in this run)"],
+    return runs.md_table(["scene", "pick", "why (measured in this run)"],
                            choice_rows(prec, stab, hard_results))
 
 
@@ -155,7 +156,7 @@ def run_report(models_dir="models", gen_dir="generated", reports_dir="reports", 
     lines += ["## Which method for which scene", "",
               *choice_table(prec["results"], stab, hrd["results"]), "",
               "## Hard cases", "",
-              *common.md_table(["case", "verdict"], [[f"{r.number}: {r.title}", r.verdict]
+              *runs.md_table(["case", "verdict"], [[f"{r.number}: {r.title}", r.verdict]
                                                      for r in hrd["results"]])]
     path = common.write_report(Path(reports_dir) / "summary.md", lines)
     return {"precision": prec, "stability": stab, "hard": hrd, "report": path}

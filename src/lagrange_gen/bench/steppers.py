@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from ..steppers.base import N_STATS, make_settings
-from .common import unconstrained_methods
+from ..analysis.runs import unconstrained_methods
 
 ROOT = Path(__file__).resolve().parents[3]
 Q0, V0, H_STEP = (0.1, 0.5), (0.0, 0.0), 1e-3

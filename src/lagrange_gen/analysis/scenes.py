@@ -1,6 +1,7 @@
 """The hard cases of HARD_CASES.md (4-8) as scenes: a model, a start, an end time, the fixed h of
 the hard suite, and what "stable" means for the scene (used by the stability suite's search for
-the largest stable h). Closed-form solutions and invariants the hard suite checks live here too.
+the largest stable h); consistent starts of the constrained models. Their closed-form solutions
+are in reference.py.
 """
 
 from __future__ import annotations
@@ -9,13 +10,9 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import ellipj, ellipk
+from scipy.special import ellipk
 
-FPU_OMEGA = 50.0
-#: HARD_CASES case 5 (Hairer-Lubich-Wanner, DOP853 at 1e-13): I_j at t = 50, 100, 200.
-FPU_REFERENCE = {50.0: (0.559, 0.367, 0.070), 100.0: (0.106, 0.421, 0.476),
-                 200.0: (0.010, 0.160, 0.835)}
-SEPARATRIX_K = 0.999
+from .reference import FPU_OMEGA, SEPARATRIX_K
 
 
 @dataclass(frozen=True)
@@ -59,33 +56,6 @@ def separatrix_scene(periods=4, h=0.01):
                  "n_link_pendulum", {"m": 1.0, "l": 1.0, "g": 1.0}, (0.0,),
                  (2 * SEPARATRIX_K,), periods * period, h, 1.0, "libration",
                  options={"n": 1})
-
-
-def separatrix_exact(t, k=SEPARATRIX_K):
-    """theta(t), theta'(t) (each (S,)): sin(theta/2) = k sn(t, k^2), theta' = 2 k cn(t, k^2)."""
-    sn, cn, _, _ = ellipj(np.asarray(t, dtype=float), k**2)
-    return 2 * np.arcsin(k * sn), 2 * k * cn
-
-
-def oscillator_exact(t, m, c, b, x0=1.0, v0=0.0):
-    """Underdamped m x'' + b x' + x / c = 0: x(t), v(t) (each (S,))."""
-    t = np.asarray(t, dtype=float)
-    beta = b / (2 * m)
-    wd = math.sqrt(1 / (m * c) - beta**2)
-    A, B = x0, (v0 + beta * x0) / wd
-    e = np.exp(-beta * t)
-    x = e * (A * np.cos(wd * t) + B * np.sin(wd * t))
-    v = -beta * x + e * wd * (-A * np.sin(wd * t) + B * np.cos(wd * t))
-    return x, v
-
-
-def fpu_oscillatory_energies(q, v, omega=FPU_OMEGA):
-    """I_j = (xdot_j^2 + omega^2 x_j^2) / 2 with x_j = (q_2j - q_2j-1) / sqrt 2 for q, v (S, 6):
-    returns (S, 3)."""
-    r = math.sqrt(2.0)
-    x = (q[:, 1::2] - q[:, 0::2]) / r
-    xd = (v[:, 1::2] - v[:, 0::2]) / r
-    return 0.5 * (xd**2 + omega**2 * x**2)
 
 
 # ---------------------------------------------------------------- what "stable" means per scene

@@ -8,19 +8,27 @@ what a user of solve_ivp integrates and which drifts off Phi = 0.
 
 A reference is DOP853 at rtol = atol = 1e-13 and is only trusted after a second, different solver
 agrees with it (``check_reference``): Radau with the exact Jacobian, or for the Cartesian
-pendulum the same motion integrated in one angle.
+pendulum the same motion integrated in one angle. The closed-form solutions of the hard cases
+(damped oscillator, pendulum near the separatrix, FPU energies) are at the end.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.special import ellipj
 
 from ..status import OK
 
 REF_TOL = 1e-13
+FPU_OMEGA = 50.0
+#: HARD_CASES case 5 (Hairer-Lubich-Wanner, DOP853 at 1e-13): I_j at t = 50, 100, 200.
+FPU_REFERENCE = {50.0: (0.559, 0.367, 0.070), 100.0: (0.106, 0.421, 0.476),
+                 200.0: (0.010, 0.160, 0.835)}
+SEPARATRIX_K = 0.999
 
 
 def ode_rhs(mod, p):
@@ -150,3 +158,32 @@ def pendulum_angle_reference(mod, p, q0, v0, t_end, t_check):
     diff = max(np.max(np.abs(cart(t_check) - other.sol(t_check))),
                np.max(np.abs(cart(t_end) - other.y[:, -1])))
     return Reference(cart, cart(t_end), float(diff), "index-1 Cartesian form, DOP853")
+
+
+# ---------------------------------------------------------------- closed forms of the hard cases
+
+def separatrix_exact(t, k=SEPARATRIX_K):
+    """theta(t), theta'(t) (each (S,)): sin(theta/2) = k sn(t, k^2), theta' = 2 k cn(t, k^2)."""
+    sn, cn, _, _ = ellipj(np.asarray(t, dtype=float), k**2)
+    return 2 * np.arcsin(k * sn), 2 * k * cn
+
+
+def oscillator_exact(t, m, c, b, x0=1.0, v0=0.0):
+    """Underdamped m x'' + b x' + x / c = 0: x(t), v(t) (each (S,))."""
+    t = np.asarray(t, dtype=float)
+    beta = b / (2 * m)
+    wd = math.sqrt(1 / (m * c) - beta**2)
+    A, B = x0, (v0 + beta * x0) / wd
+    e = np.exp(-beta * t)
+    x = e * (A * np.cos(wd * t) + B * np.sin(wd * t))
+    v = -beta * x + e * wd * (-A * np.sin(wd * t) + B * np.cos(wd * t))
+    return x, v
+
+
+def fpu_oscillatory_energies(q, v, omega=FPU_OMEGA):
+    """I_j = (xdot_j^2 + omega^2 x_j^2) / 2 with x_j = (q_2j - q_2j-1) / sqrt 2 for q, v (S, 6):
+    returns (S, 3)."""
+    r = math.sqrt(2.0)
+    x = (q[:, 1::2] - q[:, 0::2]) / r
+    xd = (v[:, 1::2] - v[:, 0::2]) / r
+    return 0.5 * (xd**2 + omega**2 * x**2)

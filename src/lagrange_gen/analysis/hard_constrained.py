@@ -9,7 +9,9 @@ import math
 
 import numpy as np
 
-from . import common, reference, scenes
+from . import reference, scenes
+from .runs import NOT_AVAILABLE, constrained_methods, guarded_run, has_method, load_module, \
+    model_available, params_of, short_error
 from .hard_cases import FAIL, PASS, CaseResult, _methods, _verdict
 
 STIFFNESSES = (1e2, 1e4, 1e6, 1e8)
@@ -21,14 +23,14 @@ DRIFT_TOL = 1e-10
 
 
 def _unavailable(number, title, what):
-    return CaseResult(number, title, common.NOT_AVAILABLE, [], [],
-                      [f"Needs {what}: {common.NOT_AVAILABLE}."])
+    return CaseResult(number, title, NOT_AVAILABLE, [], [],
+                      [f"Needs {what}: {NOT_AVAILABLE}."])
 
 
 def _rigid_reference(models_dir, gen_dir, h, t_end):
     """Bob position (2,) at t_end of the rigid pendulum, from the angle form (DOP853 1e-13)."""
-    mod = common.load_module(models_dir, "cartesian_pendulum", gen_dir)
-    p = common.params_of(mod)
+    mod = load_module(models_dir, "cartesian_pendulum", gen_dir)
+    p = params_of(mod)
     q0 = np.array([math.sin(THETA0), -math.cos(THETA0)])
     ref = reference.pendulum_angle_reference(mod, p, q0, np.zeros(2), t_end,
                                              np.array([t_end]))
@@ -36,10 +38,10 @@ def _rigid_reference(models_dir, gen_dir, h, t_end):
 
 
 def _stretch_row(mod, method, k, q0, h, t_end, rigid_end):
-    p = common.params_of(mod, k=k)
-    run = common.guarded_run(mod, method, q0, np.zeros(2), h, t_end, p)
+    p = params_of(mod, k=k)
+    run = guarded_run(mod, method, q0, np.zeros(2), h, t_end, p)
     if not run.ok:
-        return None, "blow-up, " + common.short_error(run.error)
+        return None, "blow-up, " + short_error(run.error)
     dist = float(np.max(np.abs(run.traj.q[-1] - rigid_end)))
     return dist, f"{dist:.2e}"
 
@@ -48,9 +50,9 @@ def case7_stretchable(models_dir, gen_dir, methods, h=0.01, t_end=5.0):
     """Stiffness k = 1e2..1e8 at fixed h: implicit methods never blow up and approach the rigid
     pendulum as k grows; verlet blows up once h omega > 2 (omega = sqrt(k/m)) and says so."""
     title = "stretchable pendulum, k -> inf"
-    if not common.model_available(models_dir, "stretchable_pendulum"):
+    if not model_available(models_dir, "stretchable_pendulum"):
         return _unavailable(7, title, "models/stretchable_pendulum.py")
-    mod = common.load_module(models_dir, "stretchable_pendulum", gen_dir)
+    mod = load_module(models_dir, "stretchable_pendulum", gen_dir)
     rigid_mod, rigid_p, q0, rigid_end = _rigid_reference(models_dir, gen_dir, h, t_end)
     rows, oks = [], []
     for method in _methods(methods):
@@ -60,8 +62,8 @@ def case7_stretchable(models_dir, gen_dir, methods, h=0.01, t_end=5.0):
         if expect:
             oks.append(ok)
         rows.append([method, *cells, expect or "-", (PASS if ok else FAIL) if expect else "-"])
-    if common.has_method("rattle"):
-        run = common.guarded_run(rigid_mod, "rattle", q0, np.zeros(2), h, t_end, rigid_p)
+    if has_method("rattle"):
+        run = guarded_run(rigid_mod, "rattle", q0, np.zeros(2), h, t_end, rigid_p)
         dist = float(np.max(np.abs(run.traj.q[-1] - rigid_end))) if run.ok else math.inf
         ok = dist <= 1e-2
         oks.append(ok)
@@ -92,19 +94,19 @@ def case8_linkage(models_dir, gen_dir, methods, h=1e-3, n_steps=100_000):
     """Closed-loop drift over n_steps: projected methods keep max |Phi| and |J v| at Newton
     tolerance (<= DRIFT_TOL); the index-1 formulation drifts past it."""
     title = f"four-bar linkage: constraint drift over {n_steps:g} steps"
-    have = [m for m in common.constrained_methods() if methods is None or m in methods]
-    if not common.model_available(models_dir, "four_bar") or not have:
+    have = [m for m in constrained_methods() if methods is None or m in methods]
+    if not model_available(models_dir, "four_bar") or not have:
         return _unavailable(8, title, "models/four_bar.py and the constrained steppers")
-    mod = common.load_module(models_dir, "four_bar", gen_dir)
-    p = common.params_of(mod)
+    mod = load_module(models_dir, "four_bar", gen_dir)
+    p = params_of(mod)
     q0 = scenes.four_bar_start(mod, p)
     v0 = np.zeros(mod.N_COORDS)
     rows, oks = [], []
     for method in have:
-        run = common.guarded_run(mod, method, q0, v0, h, n_steps * h, p,
+        run = guarded_run(mod, method, q0, v0, h, n_steps * h, p,
                                  save_every=max(1, n_steps // 1000))
         if not run.ok:
-            rows.append([method, common.short_error(run.error), "-", "-", "-", FAIL])
+            rows.append([method, short_error(run.error), "-", "-", "-", FAIL])
             oks.append(False)
             continue
         phi, jv = reference.constraint_residuals(mod, p, run.traj.q, run.traj.v)

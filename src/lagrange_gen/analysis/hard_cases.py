@@ -13,14 +13,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import common, scenes, stability
+from . import reference, scenes, stability
+from .runs import fmt, guarded_run, load_module, params_of, short_error, \
+    unconstrained_methods
 
 PASS, FAIL = "PASS", "FAIL"
 
 
 @dataclass
 class CaseResult:
-    """One hard case: number and title, verdict (PASS, FAIL or common.NOT_AVAILABLE), a table
+    """One hard case: number and title, verdict (PASS, FAIL or NOT_AVAILABLE), a table
     (headers, rows of formatted cells), notes (markdown lines) and figure file names."""
 
     number: int
@@ -39,19 +41,20 @@ def _verdict(oks):
 
 # ---------------------------------------------------------------- case 3: tau table
 
-def case3_tau(osc, methods):
-    """rho of the measured step matrix against the closed forms at HARD_CASES' taus; Verlet
-    stable below tau = 2 and unstable above; midpoint's phase 2 atan(tau / 2)."""
+def case3_tau(osc, methods=None):
+    """rho of the measured step matrix of the oscillator module ``osc`` against the closed forms
+    at HARD_CASES' taus; Verlet stable below tau = 2 and unstable above; midpoint's phase
+    2 atan(tau / 2). ``methods`` restricts the unconstrained methods (None: all)."""
     rows, oks = [], []
-    for method, tau, rho, closed in stability.tau_table(osc, methods):
+    for method, tau, rho, closed in stability.tau_table(osc, _methods(methods)):
         ok = closed is None or abs(rho - closed) <= 1e-10 * max(1.0, closed)
         if method == "verlet":
             ok = ok and ((abs(rho - 1) < 1e-10) if tau < 2 else (rho > 1 + 1e-3))
         if method == "midpoint":
             phase = stability.phase_per_step(stability.step_matrix(osc, method, tau))
-            ok = ok and abs(phase - 2 * math.atan(tau / 2)) <= 1e-10
+            ok = ok and abs(phase - stability.midpoint_phase(tau)) <= 1e-10
         oks.append(ok)
-        rows.append([method, f"{tau:g}", f"{rho:.10g}", common.fmt(closed, ".10g"),
+        rows.append([method, f"{tau:g}", f"{rho:.10g}", fmt(closed, ".10g"),
                      PASS if ok else FAIL])
     notes = ["Closed forms: explicit Euler sqrt(1 + tau^2), implicit Euler 1/sqrt(1 + tau^2), "
              "midpoint 1 (phase 2 atan(tau/2) checked), Verlet and symplectic Euler 1 for "
@@ -100,12 +103,12 @@ def case4_damped(models_dir, gen_dir, methods):
     rows, oks, energies, outcomes = [], [], {}, {}
     for c in COMPLIANCES:
         sc = scenes.oscillator_scene(c)
-        mod = common.load_module(models_dir, sc.stem, gen_dir)
-        p = common.params_of(mod, **sc.params)
-        x, v = scenes.oscillator_exact([0.0, sc.t_end], 1.0, c, sc.params["b"])
+        mod = load_module(models_dir, sc.stem, gen_dir)
+        p = params_of(mod, **sc.params)
+        x, v = reference.oscillator_exact([0.0, sc.t_end], 1.0, c, sc.params["b"])
         e0, e_exact = 0.5 * x[0] ** 2 / c, 0.5 * v[1] ** 2 + 0.5 * x[1] ** 2 / c
         for method in _methods(methods):
-            run = common.guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), sc.h,
+            run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), sc.h,
                                      sc.t_end, p)
             got = classify_damped(run, e_exact, e0)
             allowed = EXPECT4[c].get(method)
@@ -115,7 +118,7 @@ def case4_damped(models_dir, gen_dir, methods):
                 run.fail_time
             outcomes[(c, method)] = got
             e_end = f"{run.traj.energy[-1] / e0:.3g}" if run.ok else \
-                common.short_error(run.error)
+                short_error(run.error)
             rows.append([f"{c:g}", f"{sc.h / math.sqrt(c):.3g}", method, e_end,
                          f"{e_exact / e0:.3g}", got,
                          "-" if allowed is None else " or ".join(sorted(allowed)),
@@ -127,7 +130,8 @@ def case4_damped(models_dir, gen_dir, methods):
 
 
 def _methods(methods):
-    return [m for m in common.unconstrained_methods() if methods is None or m in methods]
+    """The unconstrained methods of this build, restricted to ``methods`` when given."""
+    return [m for m in unconstrained_methods() if methods is None or m in methods]
 
 
 # ---------------------------------------------------------------- case 5: FPU
@@ -137,15 +141,15 @@ FPU_SUM_TOL = 5.0      # |sum_j I_j - 1| <= 5 / omega (the exact solution reache
 FPU_H_TOL = 0.01       # max |H - H0| / H0: "H bounded"
 
 
-def fpu_row(run, omega=scenes.FPU_OMEGA, dt=0.5):
+def fpu_row(run, omega=reference.FPU_OMEGA, dt=0.5):
     """(I_j at the reference times (3, 3), max |sum I - 1|, max |H - H0| / H0, ok) of a run
     saved every dt; None entries for a failed run."""
     if not run.ok:
         return None, None, None, False
     tr = run.traj
-    I = scenes.fpu_oscillatory_energies(tr.q, tr.v, omega)
-    at = np.array([I[int(round(t / dt))] for t in scenes.FPU_REFERENCE])
-    ref = np.array(list(scenes.FPU_REFERENCE.values()))
+    I = reference.fpu_oscillatory_energies(tr.q, tr.v, omega)
+    at = np.array([I[int(round(t / dt))] for t in reference.FPU_REFERENCE])
+    ref = np.array(list(reference.FPU_REFERENCE.values()))
     dev = float(np.max(np.abs(I.sum(axis=1) - 1.0)))
     drift = tr.max_energy_error / abs(tr.energy[0])
     ok = (np.max(np.abs(at - ref)) <= FPU_I_TOL and dev <= FPU_SUM_TOL / omega
@@ -157,28 +161,28 @@ def case5_fpu(models_dir, gen_dir, methods, h=0.01):
     """FPU to t = 200 at h omega = 0.5 against the published I_j; explicit Euler must fail.
     The case passes when some method reproduces the reference and explicit Euler does not."""
     sc = scenes.fpu_scene(h=h)
-    mod = common.load_module(models_dir, sc.stem, gen_dir)
-    p = common.params_of(mod, **sc.params)
+    mod = load_module(models_dir, sc.stem, gen_dir)
+    p = params_of(mod, **sc.params)
     rows, series, good, euler_ok = [], {}, [], None
     for method in _methods(methods):
-        run = common.guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end,
+        run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end,
                                  p, save_every=round(0.5 / h))
         at, dev, drift, ok = fpu_row(run)
         if run.ok:
-            series[method] = (run.traj.t, scenes.fpu_oscillatory_energies(run.traj.q,
+            series[method] = (run.traj.t, reference.fpu_oscillatory_energies(run.traj.q,
                                                                           run.traj.v))
-        cells = [common.short_error(run.error), "-", "-"] if at is None else \
+        cells = [short_error(run.error), "-", "-"] if at is None else \
             [", ".join(f"{x:.3f}" for x in row) for row in at]
-        rows.append([method, *cells, common.fmt(dev, ".3f"), common.fmt(drift, ".1e"),
+        rows.append([method, *cells, fmt(dev, ".3f"), fmt(drift, ".1e"),
                      PASS if ok else FAIL])
         good.append(ok)
         if method == "explicit_euler":
             euler_ok = ok
     rows.append(["reference (HARD_CASES)",
-                 *(", ".join(f"{x:.3f}" for x in v) for v in scenes.FPU_REFERENCE.values()),
+                 *(", ".join(f"{x:.3f}" for x in v) for v in reference.FPU_REFERENCE.values()),
                  "-", "-", "-"])
     verdict = _verdict([any(good), euler_ok is not True])
-    notes = [f"h = {h:g} (h omega = {h * scenes.FPU_OMEGA:g}), T = {sc.t_end:g}. A method "
+    notes = [f"h = {h:g} (h omega = {h * reference.FPU_OMEGA:g}), T = {sc.t_end:g}. A method "
              f"passes when every I_j is within {FPU_I_TOL} of the reference at t = 50, 100, "
              f"200, max |sum I_j - 1| <= {FPU_SUM_TOL:g}/omega and max |H - H0| <= "
              f"{FPU_H_TOL:g} H0. The case passes when at least one method reproduces the "
@@ -200,17 +204,17 @@ def case6_separatrix(models_dir, gen_dir, methods, h=0.01):
     sin(theta/2) = k sn(t, k^2). Passes when some method follows the exact solution within
     SEPARATRIX_TOL and explicit Euler (energy growth) is seen going over the top."""
     sc = scenes.separatrix_scene(h=h)
-    mod = common.load_module(models_dir, sc.stem, gen_dir, **sc.options)
-    p = common.params_of(mod, **sc.params)
+    mod = load_module(models_dir, sc.stem, gen_dir, **sc.options)
+    p = params_of(mod, **sc.params)
     rows, good, euler_over = [], [], None
     for method in _methods(methods):
-        run = common.guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end, p)
+        run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end, p)
         if not run.ok:
-            rows.append([method, common.short_error(run.error), "-", "-", "-", FAIL])
+            rows.append([method, short_error(run.error), "-", "-", FAIL])
             good.append(False)
             continue
         tr = run.traj
-        th, w = scenes.separatrix_exact(tr.t)
+        th, w = reference.separatrix_exact(tr.t)
         err = float(np.max(np.maximum(np.abs(tr.q[:, 0] - th), np.abs(tr.v[:, 0] - w))))
         over = bool(np.max(np.abs(tr.q[:, 0])) >= math.pi)
         ok = err <= SEPARATRIX_TOL and not over
@@ -218,13 +222,12 @@ def case6_separatrix(models_dir, gen_dir, methods, h=0.01):
         if method == "explicit_euler":
             euler_over = over
         rows.append([method, f"{err:.2e}", "yes" if over else "no",
-                     f"{tr.max_energy_error:.1e}", f"{run.wall * 1e3:.2g} ms",
-                     PASS if ok else FAIL])
+                     f"{tr.max_energy_error:.1e}", PASS if ok else FAIL])
     verdict = _verdict([any(good), euler_over is not False])
     notes = [f"h = {h:g}, T = 4 periods = {sc.t_end:.4g}, theta_max = 2 asin(k) = "
-             f"{2 * math.asin(scenes.SEPARATRIX_K):.4f}. Error: max over every step of "
+             f"{2 * math.asin(reference.SEPARATRIX_K):.4f}. Error: max over every step of "
              f"|theta - exact| and |theta' - exact|; a method passes below {SEPARATRIX_TOL:g} "
              f"without going over the top."]
     return CaseResult(6, "pendulum near the separatrix, k = 0.999", verdict,
                       ["method", "max error vs elliptic solution", "over the top",
-                       "max abs(E - E0)", "wall", "verdict"], rows, notes)
+                       "max abs(E - E0)", "verdict"], rows, notes)
