@@ -3,13 +3,15 @@
 No conftest.py here on purpose (pytest would import it under the same module name as the
 top-level one); test modules import from this module instead.
 
-Generated modules go to one directory per user under the system temp dir and are reused across
-test sessions: generate_model rewrites a module only when its KEY changes (model, generator or
+Generated modules go to one directory per user and checkout under the system temp dir (per
+checkout: two clones' model files define the same model names, and lagrange-gen refuses to
+overwrite a module generated from another model file) and are reused across test sessions: generate_model rewrites a module only when its KEY changes (model, generator or
 stepper sources), so numba's on-disk cache of the run_<method> glue stays valid and a re-run
 skips about a minute of compilation; a changed stepper regenerates the module and recompiles.
 """
 
 import getpass
+import hashlib
 import tempfile
 from pathlib import Path
 
@@ -21,7 +23,8 @@ from lagrange_gen.loader import import_generated
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
-GEN_DIR = Path(tempfile.gettempdir()) / f"lagrange_gen_constraint_tests_{getpass.getuser()}"
+_CHECKOUT = hashlib.sha256(str(ROOT).encode()).hexdigest()[:10]
+GEN_DIR = Path(tempfile.gettempdir()) / f"lagrange_gen_constraint_tests_{getpass.getuser()}_{_CHECKOUT}"
 _MODULES = {}
 
 
