@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from .errors import GenerationError, StaleModuleError
+from .keys import read_key
 
 
 def import_generated(path):
@@ -21,8 +22,10 @@ def import_generated(path):
         raise GenerationError(f"{path}: no generated module here (run lagrange-gen on its model)")
     # The name must be the same in every process: numba's cache refers to globals by module name.
     name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
-    if name in sys.modules:
-        return sys.modules[name]
+    cached = sys.modules.get(name)
+    # The file may have been regenerated since this process imported it: then import it again.
+    if cached is not None and getattr(cached, "KEY", None) == read_key(path):
+        return cached
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
@@ -49,7 +52,6 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True,
     ``regenerate=False`` raises StaleModuleError instead of generating.
     """
     from .codegen.generate import generate_model
-    from .keys import read_key
     path = Path(path)
     if read_key(path) is not None:
         return import_generated(path)

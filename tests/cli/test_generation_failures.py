@@ -153,3 +153,15 @@ def test_corrupt_numba_cache_is_a_miss(oscillator):
     assert final and final[0] in second.stdout.splitlines(), (first.stdout, second.stdout)
     third = run(*simulate)                                   # rebuilt: no warning any more
     assert third.returncode == 0 and third.stderr == "", third.stderr
+
+
+def test_import_after_regeneration_in_the_same_process_gives_the_new_module(tmp_path):
+    """import_generated caches modules by path: after the file is regenerated (here with another
+    method), the same process must get the new text, not the module object imported before."""
+    from lagrange_gen.codegen import generate_model
+    from lagrange_gen.loader import import_generated
+    model = ROOT / "models" / "damped_oscillator.py"
+    first = import_generated(generate_model(model, tmp_path, methods=["rk4"]).path)
+    assert not hasattr(first, "run_verlet")
+    second = import_generated(generate_model(model, tmp_path, methods=["rk4", "verlet"]).path)
+    assert hasattr(second, "run_verlet") and second.KEY != first.KEY
