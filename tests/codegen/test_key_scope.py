@@ -153,3 +153,12 @@ def test_a_real_change_of_the_equations_is_seen(tmp_path, capsys):
     mod = lagrange_gen.load(model, out_dir=out)
     assert mod.KEY != first.key
     assert main(["--check", str(model), "-o", str(out)]) == 0
+
+
+def test_a_module_of_the_older_format_is_stale_with_the_default_command(tmp_path):
+    """Modules written before SOURCES call keys.check_fresh: stale, and the command does not
+    repeat their 13 methods (most do not apply any more)."""
+    everything = {"build": {}, "methods": list(METHODS)}
+    with pytest.raises(StaleModuleError, match=r"older lagrange-gen: run lagrange-gen \S*cart_pendulum\.py -o \S+$"):
+        keys.check_fresh(tmp_path / "out" / "cart_pendulum.py", "0", "0", "0", "../cart_pendulum.py",
+                         everything, "0")
