@@ -18,7 +18,7 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..analysis import mechanics
+from ..analysis import reference
 
 
 def solver_run(f, y0, t_end, t_grid, method, rtol, jac=None, repeats=1):
@@ -44,11 +44,11 @@ def solver_run(f, y0, t_end, t_grid, method, rtol, jac=None, repeats=1):
 
 
 def mechanics_rhs(model_file, param_names, p):
-    """rhs(t, y) of the sympy.mechanics peer (analysis.mechanics), parameters p (in param_names
+    """rhs(t, y) of the sympy.mechanics peer (analysis.reference), parameters p (in param_names
     order), and the seconds spent deriving and lambdifying (reported, not part of the timed
     runs)."""
     start = time.perf_counter()
-    f = mechanics.mechanics_rhs(model_file, param_names, p)
+    f = reference.mechanics_rhs(model_file, param_names, p)
     return f, time.perf_counter() - start
 
 
@@ -62,7 +62,7 @@ def pydy_rhs(model_file, param_names, p):
         return None
     from sympy.physics import mechanics as me
     start = time.perf_counter()
-    M, F, qs, params = mechanics.mechanics_equations(model_file)
+    M, F, qs, params = reference.mechanics_equations(model_file)
     n = len(qs)
     us = list(me.dynamicsymbols(" ".join(f"u{i}" for i in range(n)))) if n > 1 else \
         [me.dynamicsymbols("u0")]
