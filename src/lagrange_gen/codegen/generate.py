@@ -174,7 +174,8 @@ def generate_text(model, out_dir="generated", methods=None, freeze=None):
     """Return (module text, KEY, target path) for a loaded Model; nothing is written.
 
     methods: stepper methods to emit glue for (default: those that apply to the model); only the
-    kernels they reach are derived and emitted (codegen.needs). freeze: {parameter: value} folded into the kernels.
+    kernels they reach are derived and emitted (codegen.needs). freeze: {parameter: value}
+    folded into the kernels.
     """
     parts = generate_parts(model, out_dir, methods, freeze)
     return parts.text, parts.key, parts.target
@@ -237,7 +238,8 @@ def _record_path(target) -> Path:
 
 def _record(model, key, options) -> dict:
     """What makes re-deriving needless: the same model text, generator sources, options and KEY."""
-    return {"model": model_hash(model.source_text), "generator": generator_hash(), "options": options, "key": key}
+    return {"model": model_hash(model.source_text), "generator": generator_hash(), "options": options,
+            "key": key}
 
 
 def remember_current(target, model, key, options):
