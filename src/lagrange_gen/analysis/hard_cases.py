@@ -83,9 +83,9 @@ EXPECT4 = {
 
 def classify_damped(run, e_exact, e0):
     """Outcome class of a damped-oscillator run from its energy: GREW (failed, or E ever above
-    1.5 E0: a damped system never gains energy), accurate (|E(T) - E_exact(T)| <= 0.05 E0), stiff mode kept (E(T) >= 0.9 E0
-    while the exact system lost most of it), over-damped (E(T) <= 1e-3 E_exact(T)),
-    else inaccurate."""
+    1.5 E0: a damped system never gains energy), accurate (|E(T) - E_exact(T)| <= 0.05 E0),
+    stiff mode kept (E(T) >= 0.9 E0 while the exact system lost most of it), over-damped
+    (E(T) <= 1e-3 E_exact(T)), else inaccurate."""
     if not run.ok or float(np.max(run.traj.energy)) > 1.5 * e0:
         return GREW
     e_end = float(run.traj.energy[-1])
@@ -109,7 +109,7 @@ def case4_damped(models_dir, gen_dir, methods):
         e0, e_exact = 0.5 * x[0] ** 2 / c, 0.5 * v[1] ** 2 + 0.5 * x[1] ** 2 / c
         for method in _methods(methods):
             run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), sc.h,
-                                     sc.t_end, p)
+                              sc.t_end, p)
             got = classify_damped(run, e_exact, e0)
             allowed = EXPECT4[c].get(method)
             ok = allowed is None or got in allowed
@@ -166,11 +166,11 @@ def case5_fpu(models_dir, gen_dir, methods, h=0.01):
     rows, series, good, euler_ok = [], {}, [], None
     for method in _methods(methods):
         run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end,
-                                 p, save_every=round(0.5 / h))
+                          p, save_every=round(0.5 / h))
         at, dev, drift, ok = fpu_row(run)
         if run.ok:
-            series[method] = (run.traj.t, reference.fpu_oscillatory_energies(run.traj.q,
-                                                                          run.traj.v))
+            energies = reference.fpu_oscillatory_energies(run.traj.q, run.traj.v)
+            series[method] = (run.traj.t, energies)
         cells = [short_error(run.error), "-", "-"] if at is None else \
             [", ".join(f"{x:.3f}" for x in row) for row in at]
         rows.append([method, *cells, fmt(dev, ".3f"), fmt(drift, ".1e"),

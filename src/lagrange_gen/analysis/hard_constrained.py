@@ -104,7 +104,7 @@ def case8_linkage(models_dir, gen_dir, methods, h=1e-3, n_steps=100_000):
     rows, oks = [], []
     for method in have:
         run = guarded_run(mod, method, q0, v0, h, n_steps * h, p,
-                                 save_every=max(1, n_steps // 1000))
+                          save_every=max(1, n_steps // 1000))
         if not run.ok:
             rows.append([method, short_error(run.error), "-", "-", "-", FAIL])
             oks.append(False)

@@ -70,12 +70,12 @@ def fpu_figure(result, path):
 def damped_figure(result, path, compliance=1e-6):
     """E(t)/E0 of every method at the stiffest compliance, log scale, against the exact one;
     a run that failed is a cross at its failure time on the top edge."""
-    runs = {m: v for (c, m), v in result.data["energies"].items() if c == compliance}
-    if not runs:
+    by_method = {m: v for (c, m), v in result.data["energies"].items() if c == compliance}
+    if not by_method:
         return None
     fig, ax = common.new_figure(figsize=(7, 4.5))
     top = 1e3
-    for i, (method, run) in enumerate(runs.items()):
+    for i, (method, run) in enumerate(by_method.items()):
         style = dict(color=f"C{i}", ls="-" if i % 2 == 0 else "--")
         if isinstance(run, tuple):
             t, e = run
@@ -113,7 +113,7 @@ def markdown(results, quick):
              f"values, elliptic functions, the exact rigid pendulum). A case passes when every "
              f"expectation it states holds; rows without an expectation are reported only.", ""]
     lines += runs.md_table(["case", "verdict"],
-                             [[f"{r.number}: {r.title}", r.verdict] for r in results]) + [""]
+                           [[f"{r.number}: {r.title}", r.verdict] for r in results]) + [""]
     for r in results:
         lines += case_markdown(r)
     return lines

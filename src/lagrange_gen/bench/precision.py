@@ -117,7 +117,7 @@ def sweep_ours(mod, method, case, p, reference, settings, progress):
         n_steps = case.n0 * 2**k
         h = case.t_end / n_steps
         run = runs.guarded_run(mod, method, q0, v0, h, case.t_end, p,
-                                 save_every=n_steps // case.samples, repeats=settings.repeats)
+                               save_every=n_steps // case.samples, repeats=settings.repeats)
         progress.step(f"{case.stem} {method} h={h:.2g}")
         if not run.ok:
             points.append(Point(method, "ours", h, run.wall, failed=run.error))

@@ -88,7 +88,7 @@ def _full_table(points):
              runs.fmt(pt.traj_max), runs.fmt(pt.energy), runs.fmt(pt.phi),
              runs.short_error(pt.failed) if pt.failed else "ok"] for pt in points]
     return runs.md_table(["method", "h or rtol", "wall", "final error", "max error",
-                            "max abs(E - E0)", "max abs(Phi)", "status"], rows)
+                          "max abs(E - E0)", "max abs(Phi)", "status"], rows)
 
 
 def case_markdown(result, figure_name):
@@ -101,7 +101,7 @@ def case_markdown(result, figure_name):
     if result["missing"]:
         lines += [f"Constrained steppers: **{result['missing']}** (only the peers ran).", ""]
     lines += runs.md_table(["method", "kind", "time to final error 1e-4", "1e-6", "1e-8",
-                              "smallest final error", "failed runs"], summary_rows(result))
+                            "smallest final error", "failed runs"], summary_rows(result))
     lines += ["", f"![{result['model']}]({figure_name})", "", "<details><summary>every run"
               "</summary>", "", *_full_table(result["points"]), "", "</details>", ""]
     return lines

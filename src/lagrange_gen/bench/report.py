@@ -132,7 +132,7 @@ def choice_rows(prec, stab, hard_results):
 def choice_table(prec, stab, hard_results):
     """Markdown lines of the method-choice table."""
     return runs.md_table(["scene", "pick", "why (measured in this run)"],
-                           choice_rows(prec, stab, hard_results))
+                         choice_rows(prec, stab, hard_results))
 
 
 def run_report(models_dir="models", gen_dir="generated", reports_dir="reports", quick=False,
@@ -157,6 +157,6 @@ def run_report(models_dir="models", gen_dir="generated", reports_dir="reports", 
               *choice_table(prec["results"], stab, hrd["results"]), "",
               "## Hard cases", "",
               *runs.md_table(["case", "verdict"], [[f"{r.number}: {r.title}", r.verdict]
-                                                     for r in hrd["results"]])]
+                                                   for r in hrd["results"]])]
     path = common.write_report(Path(reports_dir) / "summary.md", lines)
     return {"precision": prec, "stability": stab, "hard": hrd, "report": path}

@@ -49,7 +49,7 @@ def largest_stable_h(mod, scene, method, p, max_halvings=24, max_steps=2_000_000
         if n_steps > max_steps:
             return None, j
         run = runs.guarded_run(mod, method, q0, v0, h, scene.t_end, p,
-                                 save_every=max(1, n_steps // 20_000))
+                               save_every=max(1, n_steps // 20_000))
         if run.ok and scenes.is_stable(run.traj, scene):
             return h, j + 1
     return None, 2 * max_halvings + 1
@@ -129,9 +129,9 @@ def markdown(taus, curves, table, stable_h, scene_list_, max_steps, quick):
     lines += runs.md_table(["method", "rho <= 1 for", f"rho at tau = {taus[-1]:g}"], rows)
     lines += ["", "## HARD_CASES case 3: rho at the listed tau, measured vs closed form", ""]
     lines += runs.md_table(["method", "tau", "measured rho", "closed form", "abs diff"],
-                             [[m, f"{t:g}", f"{r:.12g}", runs.fmt(c, ".12g"),
-                               runs.fmt(None if c is None else abs(r - c), ".1e")]
-                              for m, t, r, c in table])
+                           [[m, f"{t:g}", f"{r:.12g}", runs.fmt(c, ".12g"),
+                             runs.fmt(None if c is None else abs(r - c), ".1e")]
+                            for m, t, r, c in table])
     lines += ["", "## Largest stable h per hard case", "",
               f"h = h_max / 2^(j/2) downwards until the run passes the scene's test "
               f"(runs of at most {max_steps:g} steps; '< h' when none was, '>= h_max' when the "
