@@ -4,6 +4,7 @@ command that regenerates it (no sympy import: generated modules call check_curre
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import shlex
 from importlib import metadata
@@ -88,11 +89,35 @@ def check_current(module_file, key, sources, model_relpath, options, text_sha):
     and KEY (a hand edit anywhere), and every package source its compiled code is built from
     against SOURCES (numba's on-disk cache is keyed on the generated file only, so a changed
     stepper must make the module stale). A changed model file is seen by re-deriving:
-    ``lagrange-gen --check`` and ``lagrange_gen.load``.
+    ``lagrange-gen --check`` and ``lagrange_gen.load``; at import, a model text that differs
+    from the one recorded when the module was last generated or checked (derivation_record) is
+    stale too, so a direct import never runs old kernels silently.
     """
-    problem = why_stale(Path(module_file), key, sources, text_sha)
+    problem = why_stale(Path(module_file), key, sources, text_sha) or _model_changed(
+        Path(module_file), model_relpath, key)
     if problem:
         raise StaleModuleError(f"{problem}: run {regeneration_command_from(module_file, model_relpath, options)}")
+
+
+def derivation_record_path(target) -> Path:
+    """Where generation records which model text, generator and options gave ``target`` (JSON,
+    next to numba's cache, not in git): the model text must not enter the generated file."""
+    target = Path(target)
+    return target.parent / "__pycache__" / f"{target.stem}.lagrange-gen.json"
+
+
+def _model_changed(here, model_relpath, key):
+    """A phrase when the model file's text differs from the recorded one for this KEY, else None
+    (also None without a record, e.g. a fresh clone: --check re-derives to tell)."""
+    try:
+        record = json.loads(derivation_record_path(here).read_text())
+        text = (here.parent / model_relpath).read_text()
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+    if not isinstance(record, dict) or record.get("key") != key or record.get("model") == model_hash(text):
+        return None
+    return (f"{_shown(here.parent / model_relpath)} changed since {here} was generated (if only "
+            "comments changed, regenerating leaves the module as it is)")
 
 
 def check_fresh(module_file, key, model_sha, gen_sha, model_relpath, options, text_sha=None):

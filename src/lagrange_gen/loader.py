@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from .errors import GenerationError, StaleModuleError
-from .keys import read_key
+from .keys import check_current, read_key
 
 
 def import_generated(path):
@@ -23,8 +23,12 @@ def import_generated(path):
     # The name must be the same in every process: numba's cache refers to globals by module name.
     name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
     cached = sys.modules.get(name)
-    # The file may have been regenerated since this process imported it: then import it again.
+    # The file may have been regenerated since this process imported it: then import it again;
+    # otherwise the module's own import-time check runs again (its model may have changed).
     if cached is not None and getattr(cached, "KEY", None) == read_key(path):
+        if hasattr(cached, "SOURCES"):
+            check_current(cached.__file__, cached.KEY, cached.SOURCES, cached.MODEL_PATH,
+                          cached.OPTIONS, cached.TEXT_SHA)
         return cached
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)

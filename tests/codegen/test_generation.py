@@ -44,7 +44,7 @@ def test_changed_model_changes_key_and_stale_module_is_refused(tmp_path):
 
 def test_hand_edited_file_is_refused(tmp_path):
     result = generate_model(MODELS_DIR / "cart_pendulum.py", tmp_path)
-    text = result.path.read_text().replace('MODEL_SHA = "', 'MODEL_SHA = "0', 1)
+    text = result.path.read_text().replace('KEY = "', 'KEY = "0', 1)
     result.path.write_text(text)
     with pytest.raises(StaleModuleError, match="run lagrange-gen"):
         import_generated(result.path)

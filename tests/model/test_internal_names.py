@@ -30,7 +30,7 @@ model = Model("NAME", coords=[A, B, C], T=T, V=V, dissipation=P5 * A.d**2 / 2EXT
 EXTRA = """,
               constraints=[A**2 + P8 * B**2 + C - 1],
               elements=[SaintVenant(strain=A * C, stiffness=P2, threshold=P3)]"""
-METHODS = {"free": ["midpoint"], "full": ["constrained_implicit_euler", "nonsmooth_euler"]}
+METHODS = {"free": ["midpoint"], "full": []}
 
 
 def _source(which, model_name, kind):
@@ -43,7 +43,8 @@ def _source(which, model_name, kind):
 @pytest.fixture(scope="module")
 def modules(tmp_path_factory):
     """{(kind, "internal" | "plain"): generated module}; kind "free" (no constraint, no element)
-    has midpoint's glue, "full" the kernels with lam and we inputs."""
+    has midpoint's glue, "full" (constraints and elements: no method applies to both) every
+    kernel, including those with lam and we inputs, and no glue."""
     out = tmp_path_factory.mktemp("names")
     found = {}
     for kind, methods in METHODS.items():

@@ -20,7 +20,7 @@ from pathlib import Path
 from ..derive import derive
 from ..errors import GenerationError
 from ..model_file import load_model
-from ..keys import (generator_hash, key_of_text, model_hash, read_header, regeneration_command,
+from ..keys import (derivation_record_path, generator_hash, key_of_text, model_hash, read_header, regeneration_command,
                     source_hashes, text_hash, why_stale)
 from .emit import render_kernel
 from .compose import compositions
@@ -231,11 +231,6 @@ def refuse_overwrite(model_path, target, name):
                               f"{name!r}): not overwritten (rename one model, use another -o DIR, or pass --force)")
 
 
-def _record_path(target) -> Path:
-    """Where load() remembers that ``target`` is current (next to numba's cache, not in git)."""
-    return target.parent / "__pycache__" / f"{target.stem}.lagrange-gen.json"
-
-
 def _record(model, key, options) -> dict:
     """What makes re-deriving needless: the same model text, generator sources, options and KEY."""
     return {"model": model_hash(model.source_text), "generator": generator_hash(), "options": options,
@@ -246,7 +241,7 @@ def remember_current(target, model, key, options):
     """Record that ``target`` (KEY ``key``) is what ``model`` generates with ``options`` now; the
     model text's hash goes here, never into the generated file (a comment edit must not change it).
     Best effort: an unwritable directory only means load() re-derives next time."""
-    path = _record_path(target)
+    path = derivation_record_path(target)
     try:
         path.parent.mkdir(exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
@@ -267,7 +262,7 @@ def module_current(model, target, header) -> bool:
     if why_stale(target, header.get("KEY"), header["SOURCES"], header.get("TEXT_SHA")):
         return False
     try:
-        if json.loads(_record_path(target).read_text()) == _record(model, header["KEY"], options):
+        if json.loads(derivation_record_path(target).read_text()) == _record(model, header["KEY"], options):
             return True
     except (OSError, ValueError):
         pass
