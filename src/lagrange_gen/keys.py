@@ -16,8 +16,8 @@ _PACKAGE = Path(__file__).resolve().parent
 # Sources that shape the text generated from a model (equations, kernels, module layout, glue
 # template): a change is seen by re-deriving (--check, load), not by the KEY. Hashed into the
 # record load() keeps next to a module to skip re-deriving (codegen.generate.module_current).
-_GENERATOR_PARTS = ("model.py", "model_file.py", "params.py", "keys.py", "derive", "codegen",
-                    "steppers/registry.py")
+_GENERATOR_PARTS = ("model.py", "model_file.py", "symbols.py", "loads.py", "model_input.py",
+                    "params.py", "keys.py", "derive", "codegen", "steppers/registry.py")
 # The header lines that record hashes of the rest of the file (a hash cannot hash itself).
 KEY_PREFIX = "KEY = "
 TEXT_SHA_PREFIX = "TEXT_SHA = "

@@ -1,0 +1,108 @@
+"""Turning what a model file gives into checked scalar sympy expressions: dynamicsymbols
+converted to Coordinates, sympify with one-line errors, and the Rayleigh-function check."""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .errors import ModelError
+from .symbols import Coordinate, t
+
+
+def _convert_dynamicsymbols(coords):
+    """Turn sympy.physics.mechanics dynamicsymbols q(t) into Coordinates.
+
+    Returns (coordinates, replacement map) where the map sends q(t)' -> q.d, q(t) -> q and the
+    mechanics time symbol to our t.
+    """
+    replace = {}
+    out = []
+    for c in coords:
+        if isinstance(c, Coordinate):
+            out.append(c)
+            continue
+        if isinstance(c, sp.core.function.AppliedUndef) and len(c.args) == 1 and isinstance(c.args[0], sp.Symbol):
+            time_sym = c.args[0]
+            coord = Coordinate(str(c.func))
+            replace[sp.Derivative(c, time_sym)] = coord.d
+            replace[c] = coord
+            replace[time_sym] = t
+            out.append(coord)
+            continue
+        raise ModelError(f"coordinate {c!r} is neither a Coordinate nor a dynamicsymbol q(t)")
+    if replace:
+        # Derivatives must be replaced before the functions they contain.
+        derivs = {k: v for k, v in replace.items() if isinstance(k, sp.Derivative)}
+        rest = {k: v for k, v in replace.items() if not isinstance(k, sp.Derivative)}
+        return out, _ChainedReplace(derivs, rest)
+    return out, {}
+
+
+class _ChainedReplace(dict):
+    """A replacement applied in two passes (derivatives, then functions and time)."""
+
+    def __init__(self, first, second):
+        super().__init__({**first, **second})
+        self.first, self.second = first, second
+
+
+def _apply(expr, replace):
+    if isinstance(replace, _ChainedReplace):
+        return expr.xreplace(replace.first).xreplace(replace.second)
+    return expr.xreplace(replace)
+
+
+def _sympify(expr, what, replace):
+    """``expr`` as a scalar sympy Expr with ``replace`` applied; ModelError naming ``what``."""
+    try:
+        expr = sp.sympify(expr)
+    except (sp.SympifyError, TypeError) as exc:
+        raise ModelError(f"{what} is not a SymPy expression: {exc}") from None
+    if getattr(expr, "is_Matrix", False):       # sympy matrices are Expr too
+        rows, cols = expr.shape
+        raise ModelError(f"{what} is a {rows} x {cols} matrix, not a scalar expression "
+                         "(take its entry, e.g. T[0], or sum the terms)")
+    if not isinstance(expr, sp.Expr):
+        raise ModelError(f"{what} is not a scalar SymPy expression: {expr!r}")
+    return _apply(expr, replace) if replace else expr
+
+
+def _check_rayleigh(name, D, velocities):
+    """ModelError naming the first term of the dissipation function D that gives a wrong or no
+    force: D and its velocity gradient must vanish at rest (D quadratic in the velocities, or of
+    higher degree such as c |v|^3 / 3). A velocity-free term gives no force -dD/dqdot at all; a
+    term linear near rest (c x v, c |v|, sin v) gives a force that does not vanish at rest."""
+    if D == 0 or _rayleigh_problem(D, velocities) is None:
+        return
+    for terms in (sp.Add.make_args(D), sp.Add.make_args(sp.expand(D))):
+        for term in terms:
+            why = _rayleigh_problem(term, velocities)
+            if why:
+                raise ModelError(f"model {name}: dissipation term {term} {why}")
+    raise ModelError(f"model {name}: dissipation {D} {_rayleigh_problem(D, velocities)}")
+
+
+def _rayleigh_problem(D, velocities):
+    """Why D is not a Rayleigh function (a phrase), or None. With every velocity scaled by
+    s > 0, D and its velocity gradient must vanish as s -> 0 (s positive lets sign(s v) and
+    |s v| simplify, so that c |v| is seen as linear although its gradient is 0 at v = 0)."""
+    if not (D.free_symbols & set(velocities)):
+        return ("does not depend on any velocity: it gives no force -dD/dqdot (a potential "
+                "belongs in V)")
+    s = sp.Dummy("s", positive=True)
+    scaled = {v: s * v for v in velocities}
+    if not _vanishes_at_rest(D.xreplace(scaled), s):
+        return ("is not zero at rest (a Rayleigh function is quadratic in the velocities, "
+                "e.g. c*x.d**2/2)")
+    if not all(_vanishes_at_rest(D.diff(v).xreplace(scaled), s) for v in velocities):
+        return ("is linear in the velocities near rest, so its force -dD/dqdot does not vanish at "
+                "rest: a Rayleigh function is quadratic in the velocities (e.g. c*x.d**2/2); dry "
+                "friction is DryFriction, other forces go in forces=")
+    return None
+
+
+def _vanishes_at_rest(expr, s):
+    value = expr.subs(s, 0)
+    if value.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+        value = sp.limit(expr, s, 0, "+")
+    return value == 0 or sp.simplify(value) == 0
