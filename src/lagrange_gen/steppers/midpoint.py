@@ -22,9 +22,9 @@ import sys
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK
-from .base import (FAST, S_MAX_ITER, S_TOL, max_abs, momentum_from_velocity, newton_converged,
-                   newton_solve, run_loop, velocity_from_momentum)
+from ..status import OK
+from . import newton
+from .base import FAST, S_MAX_ITER, S_TOL, momentum_from_velocity, run_loop, velocity_from_momentum
 
 _VB, _QB, _R, _F, _S, _QN, _VN, _PN = 0, 1, 2, 3, 4, 5, 6, 7    # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4                         # mats
@@ -38,36 +38,22 @@ def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
 
 
 @njit(**FAST)
-def _solve(kern, q, mom, tm, h, p, tol, max_iter, vb, qb, R, f, scratch, H, A, Jq, Jqd, dHw, piv):
-    """Newton on R(vb) = 0; vb (n,) holds the initial guess. Returns (status, iters, residual)."""
+def assemble(kern, args, vb, R, A):
+    """Newton system of the step (newton.solve): R (n,) <- R(vb), A (n, n) <- dR/dvb."""
+    q, mom, tm, hh, p, qb, f, H, Jq, Jqd, dHw = args
     n = q.shape[0]
-    hh = 0.5 * h
-    resid = prev = 0.0
-    for it in range(1, max_iter + 1):
-        for i in range(n):
-            qb[i] = q[i] + hh * vb[i]
-        kern.mass_matrix(qb, p, H)
-        kern.mass_matvec_dq(qb, vb, p, dHw)
-        kern.momentum_rate(qb, vb, tm, p, f)
-        kern.momentum_rate_jacobian(qb, vb, tm, p, Jq, Jqd)
-        for i in range(n):
-            s = -mom[i] - hh * f[i]
-            for j in range(n):
-                s += H[i, j] * vb[j]
-                A[i, j] = H[i, j] + hh * dHw[i, j] - hh * hh * Jq[i, j] - hh * Jqd[i, j]
-            R[i] = -s
-        resid = max_abs(R)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        status = newton_solve(A, piv, R, scratch)
-        if status != OK:
-            return status, it, resid
-        for i in range(n):
-            vb[i] += R[i]
-        done, prev = newton_converged(R, vb, prev, tol)
-        if done:
-            return OK, it, resid
-    return NEWTON_DIVERGED, max_iter, resid
+    for i in range(n):
+        qb[i] = q[i] + hh * vb[i]
+    kern.mass_matrix(qb, p, H)
+    kern.mass_matvec_dq(qb, vb, p, dHw)
+    kern.momentum_rate(qb, vb, tm, p, f)
+    kern.momentum_rate_jacobian(qb, vb, tm, p, Jq, Jqd)
+    for i in range(n):
+        s = -mom[i] - hh * f[i]
+        for j in range(n):
+            s += H[i, j] * vb[j]
+            A[i, j] = H[i, j] + hh * dHw[i, j] - hh * hh * Jq[i, j] - hh * Jqd[i, j]
+        R[i] = s
 
 
 @njit(**FAST)
@@ -79,9 +65,9 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     tm = t + 0.5 * h
     for i in range(n):
         vb[i] = v[i]
-    status, iters, resid = _solve(kern, q, mom, tm, h, p, settings[S_TOL],
-                                  int(settings[S_MAX_ITER]), vb, qb, work[_R], f, work[_S],
-                                  mats[_H], mats[_A], mats[_JQ], mats[_JQD], mats[_DHW], piv)
+    args = (q, mom, tm, 0.5 * h, p, qb, f, mats[_H], mats[_JQ], mats[_JQD], mats[_DHW])
+    status, iters, resid = newton.solve(_THIS, kern, args, vb, work[_R], mats[_A], piv,
+                                        work[_S], settings[S_TOL], int(settings[S_MAX_ITER]))
     if status != OK:
         return status, iters, resid
     for i in range(n):

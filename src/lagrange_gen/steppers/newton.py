@@ -1,0 +1,63 @@
+"""The one Newton iteration of every implicit stepper.
+
+A method states its equations as a residual F(x) = 0 in an unknown x (n,) and supplies, in the
+module it passes as ``problem``, the assembly
+
+    problem.assemble(kern, args, x, F, J)        F (N,) <- F(x),  J (N, N) <- dF/dx (exact)
+
+``args`` is a tuple of whatever the assembly reads (the state at the start of the step, h, the
+parameters, its scratch arrays). ``solve`` then owns everything else: the non-finite check of the
+residual, the LU solve of J dx = -F (base.newton_solve: SINGULAR_NEWTON or NON_FINITE when J
+cannot be factored), the update x += dx and the one stopping rule (base.newton_converged),
+counting iterations.
+
+Why a module and not a function value: like ``kern`` and ``run_loop``'s ``method`` (see base.py),
+numba types a module as a compile-time constant, so ``problem.assemble`` is a direct call that
+LLVM can inline into the loop, and the glue of a generated module stays cacheable (a dispatcher
+passed as a value embeds a process-specific address and disables numba's on-disk cache). A
+method with two different systems (partitioned's kick and drift) gives each its own assembly by
+passing a different value of ``which`` to ``solve_which``, which forwards it to
+``problem.assemble_which``.
+"""
+
+from numba import njit
+
+from ..status import NEWTON_DIVERGED, NON_FINITE, OK
+from .base import FAST, max_abs, newton_converged, newton_solve
+
+
+@njit(**FAST)
+def _iterate(x, F, J, piv, scratch, prev, tol):
+    """One Newton update from an assembled F (N,), J (N, N): x += -J^-1 F in place.
+
+    F is overwritten by -dx. Returns (status, converged, max|dx|); status is NON_FINITE when F
+    holds NaN or inf, else that of the linear solve."""
+    if not max_abs(F) < 1.0e308:        # false for NaN and inf
+        return NON_FINITE, False, prev
+    status = newton_solve(J, piv, F, scratch)
+    if status != OK:
+        return status, False, prev
+    for i in range(x.shape[0]):
+        x[i] -= F[i]
+    done, d = newton_converged(F, x, prev, tol)
+    return OK, done, d
+
+
+@njit(**FAST)
+def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
+    """Newton on problem.assemble's F(x) = 0; x (N,) holds the initial guess and on return the
+    last iterate. F, scratch (N,), J (N, N), piv (N,) int64 are workspace.
+
+    Returns (status, iterations, residual): OK when the stopping rule accepted the last update,
+    NON_FINITE (F not finite), SINGULAR_NEWTON or NON_FINITE (J could not be factored), or
+    NEWTON_DIVERGED after max_iter updates; residual = max|F| at the last assembled iterate."""
+    resid = prev = 0.0
+    for it in range(1, max_iter + 1):
+        problem.assemble(kern, args, x, F, J)
+        resid = max_abs(F)
+        status, done, prev = _iterate(x, F, J, piv, scratch, prev, tol)
+        if status != OK:
+            return status, it, resid
+        if done:
+            return OK, it, resid
+    return NEWTON_DIVERGED, max_iter, resid

@@ -1,0 +1,99 @@
+"""The one Newton of the implicit steppers (steppers/newton.py), alone on small systems with
+known solutions: F(x) = x_i^2 - a_i (root sqrt(a), Jacobian diag(2 x)); a singular Jacobian; a
+non-finite residual; the iteration cap. This test module is itself the ``problem`` whose
+``assemble`` newton.solve calls (a module is what the steppers pass)."""
+
+import math
+import sys
+
+import numpy as np
+from numba import njit
+
+from lagrange_gen.status import NEWTON_DIVERGED, NON_FINITE, OK, SINGULAR_NEWTON
+from lagrange_gen.steppers import newton
+from lagrange_gen.steppers.base import FAST
+
+_THIS = sys.modules[__name__]
+ROOTS, SINGULAR, NAN_RESIDUAL, INF_JACOBIAN = 0, 1, 2, 3
+
+
+@njit(**FAST)
+def assemble(kern, args, x, F, J):
+    """args = (kind, a (n,)); kind selects the system (see the module docstring)."""
+    kind, a = args
+    n = x.shape[0]
+    for i in range(n):
+        F[i] = x[i] * x[i] - a[i]
+        for j in range(n):
+            J[i, j] = 0.0
+        J[i, i] = 2.0 * x[i]
+    if kind == SINGULAR:
+        for j in range(n):
+            J[n - 1, j] = J[0, j]          # two equal rows
+    elif kind == NAN_RESIDUAL:
+        F[n - 1] = math.nan
+    elif kind == INF_JACOBIAN:
+        J[0, 0] = math.inf
+
+
+@njit
+def _solve(kind, a, x, tol, max_iter):
+    n = x.shape[0]
+    F, scratch = np.zeros(n), np.zeros(n)
+    J, piv = np.zeros((n, n)), np.zeros(n, dtype=np.int64)
+    return newton.solve(_THIS, _THIS, (kind, a), x, F, J, piv, scratch, tol, max_iter)
+
+
+A = np.array([2.0, 3.0, 0.5])
+START = np.array([2.0, 1.0, 1.0])
+
+
+def test_converges_to_the_root_with_its_iteration_count():
+    x = START.copy()
+    status, iters, resid = _solve(ROOTS, A, x, 1e-12, 50)
+    assert status == OK and 3 <= iters <= 8
+    assert np.max(np.abs(x - np.sqrt(A))) < 1e-14
+    # resid is max|F| at the last assembled iterate, before its (accepted) update
+    assert resid < 1e-6
+
+
+def test_quadratic_convergence():
+    """Stopping after k updates (max_iter = k) leaves the k-th iterate in x: its error e_k obeys
+    e_{k+1} <= C e_k^2 with C = max |F''| / (2 min |F'|) ~ 1 / (2 sqrt(a)) near the root."""
+    errors = []
+    for k in range(1, 6):
+        x = START.copy()
+        status, iters, _ = _solve(ROOTS, A, x, 0.0, k)     # tol 0: never stops early
+        assert status == NEWTON_DIVERGED and iters == k
+        errors.append(np.max(np.abs(x - np.sqrt(A))))
+    pairs = [(e0, e1) for e0, e1 in zip(errors, errors[1:]) if e1 > 1e-15]
+    assert len(pairs) >= 2
+    for e0, e1 in pairs:
+        assert e1 / e0 ** 2 < 1.0 / (2.0 * math.sqrt(A.min()) * 0.5)
+    assert errors[-1] < 1e-15 * 10
+
+
+def test_max_iter_reached_is_newton_diverged():
+    x = START.copy()
+    status, iters, resid = _solve(ROOTS, A, x, 1e-12, 2)
+    assert status == NEWTON_DIVERGED and iters == 2 and math.isfinite(resid) and resid > 1e-6
+
+
+def test_singular_jacobian_is_singular_newton():
+    x = START.copy()
+    status, iters, _ = _solve(SINGULAR, A, x, 1e-12, 50)
+    assert status == SINGULAR_NEWTON and iters == 1
+    assert np.array_equal(x, START)          # no update from an unsolvable system
+
+
+def test_non_finite_residual_is_non_finite():
+    x = START.copy()
+    status, iters, resid = _solve(NAN_RESIDUAL, A, x, 1e-12, 50)
+    assert status == NON_FINITE and iters == 1 and math.isnan(resid)
+    assert np.array_equal(x, START)
+
+
+def test_non_finite_jacobian_is_non_finite_not_singular():
+    x = START.copy()
+    status, _, _ = _solve(INF_JACOBIAN, A, x, 1e-12, 50)
+    assert status == NON_FINITE
