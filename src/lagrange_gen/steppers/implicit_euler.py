@@ -17,8 +17,9 @@ import sys
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK
-from .base import FAST, S_MAX_ITER, S_TOL, max_abs, newton_converged, newton_solve, run_loop
+from ..status import OK
+from . import newton
+from .base import FAST, S_MAX_ITER, S_TOL, run_loop
 
 _V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
 _H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4           # mats
@@ -31,44 +32,40 @@ def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
 
 
 @njit(**FAST)
+def assemble(kern, args, v1, R, A):
+    """Newton system of the step (newton.solve): R (n,) <- R(v+), A (n, n) <- dR/dv+."""
+    q, v, t1, h, p, q1, dv, rhs, H, Jq, Jqd, dHw = args
+    n = q.shape[0]
+    for i in range(n):
+        q1[i] = q[i] + h * v1[i]
+        dv[i] = v1[i] - v[i]
+    kern.dynamics(q1, v1, t1, p, H, rhs)
+    kern.rhs_jacobian(q1, v1, t1, p, Jq, Jqd)
+    kern.mass_matvec_dq(q1, dv, p, dHw)
+    for i in range(n):
+        s = -h * rhs[i]
+        for j in range(n):
+            s += H[i, j] * dv[j]
+            A[i, j] = H[i, j] + h * dHw[i, j] - h * h * Jq[i, j] - h * Jqd[i, j]
+        R[i] = s
+
+
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]
-    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
-    v1, q1, dv, rhs, R, scratch = work[_V1], work[_Q1], work[_DV], work[_RHS], work[_R], work[_S]
-    H, A, Jq, Jqd, dHw = mats[_H], mats[_A], mats[_JQ], mats[_JQD], mats[_DHW]
-    t1 = t + h
+    v1 = work[_V1]
     for i in range(n):
         v1[i] = v[i]
-    resid = prev = 0.0
-    for it in range(1, max_iter + 1):
+    args = (q, v, t + h, h, p, work[_Q1], work[_DV], work[_RHS], mats[_H], mats[_JQ],
+            mats[_JQD], mats[_DHW])
+    status, iters, resid = newton.solve(_THIS, kern, args, v1, work[_R], mats[_A], piv,
+                                        work[_S], settings[S_TOL], int(settings[S_MAX_ITER]))
+    if status == OK:
         for i in range(n):
-            q1[i] = q[i] + h * v1[i]
-            dv[i] = v1[i] - v[i]
-        kern.dynamics(q1, v1, t1, p, H, rhs)
-        kern.rhs_jacobian(q1, v1, t1, p, Jq, Jqd)
-        kern.mass_matvec_dq(q1, dv, p, dHw)
-        for i in range(n):
-            s = -h * rhs[i]
-            for j in range(n):
-                s += H[i, j] * dv[j]
-                A[i, j] = H[i, j] + h * dHw[i, j] - h * h * Jq[i, j] - h * Jqd[i, j]
-            R[i] = -s
-        resid = max_abs(R)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        status = newton_solve(A, piv, R, scratch)
-        if status != OK:
-            return status, it, resid
-        for i in range(n):
-            v1[i] += R[i]
-        done, prev = newton_converged(R, v1, prev, tol)
-        if done:
-            for i in range(n):
-                q[i] += h * v1[i]
-                v[i] = v1[i]
-            return OK, it, resid
-    return NEWTON_DIVERGED, max_iter, resid
+            q[i] += h * v1[i]
+            v[i] = v1[i]
+    return status, iters, resid
 
 
 @njit(inline="always")
