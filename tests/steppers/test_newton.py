@@ -1,10 +1,8 @@
 """The one Newton of the implicit steppers (steppers/newton.py), alone on small systems with
 known solutions: F(x) = x_i^2 - a_i (root sqrt(a), Jacobian diag(2 x)); a singular Jacobian; a
-non-finite residual; the iteration cap. This test module is itself the ``problem`` whose
-``assemble`` newton.solve calls (a module is what the steppers pass)."""
+non-finite residual; the iteration cap."""
 
 import math
-import sys
 
 import numpy as np
 from numba import njit
@@ -13,7 +11,6 @@ from lagrange_gen.status import NEWTON_DIVERGED, NON_FINITE, OK, SINGULAR_NEWTON
 from lagrange_gen.steppers import newton
 from lagrange_gen.steppers.base import FAST
 
-_THIS = sys.modules[__name__]
 ROOTS, SINGULAR, NAN_RESIDUAL, INF_JACOBIAN = 0, 1, 2, 3
 
 
@@ -36,12 +33,15 @@ def assemble(kern, args, x, F, J):
         J[0, 0] = math.inf
 
 
+_PROBLEM = newton.problem(__name__ + "._problem", assemble)
+
+
 @njit
 def _solve(kind, a, x, tol, max_iter):
     n = x.shape[0]
     F, scratch = np.zeros(n), np.zeros(n)
     J, piv = np.zeros((n, n)), np.zeros(n, dtype=np.int64)
-    return newton.solve(_THIS, _THIS, (kind, a), x, F, J, piv, scratch, tol, max_iter)
+    return newton.solve(_PROBLEM, None, (kind, a), x, F, J, piv, scratch, tol, max_iter)
 
 
 A = np.array([2.0, 3.0, 0.5])

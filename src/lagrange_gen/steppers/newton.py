@@ -1,7 +1,7 @@
 """The one Newton iteration of every implicit stepper.
 
-A method states its equations as a residual F(x) = 0 in an unknown x (n,) and supplies, in the
-module it passes as ``problem``, the assembly
+A method states its equations as a residual F(x) = 0 in an unknown x (N,) and supplies, as the
+attribute ``assemble`` of the module it passes as ``problem``, the jitted assembly
 
     problem.assemble(kern, args, x, F, J)        F (N,) <- F(x),  J (N, N) <- dF/dx (exact)
 
@@ -11,19 +11,32 @@ residual, the LU solve of J dx = -F (base.newton_solve: SINGULAR_NEWTON or NON_F
 cannot be factored), the update x += dx and the one stopping rule (base.newton_converged),
 counting iterations.
 
-Why a module and not a function value: like ``kern`` and ``run_loop``'s ``method`` (see base.py),
-numba types a module as a compile-time constant, so ``problem.assemble`` is a direct call that
-LLVM can inline into the loop, and the glue of a generated module stays cacheable (a dispatcher
-passed as a value embeds a process-specific address and disables numba's on-disk cache). A
-method with two different systems (partitioned's kick and drift) gives each its own assembly by
-passing a different value of ``which`` to ``solve_which``, which forwards it to
-``problem.assemble_which``.
+Why a module and not the assembly function itself: like ``kern`` and ``run_loop``'s ``method``
+(see base.py), numba types a module as a compile-time constant with no runtime value, so
+``problem.assemble`` is a direct call and the glue of a generated module stays cacheable. A
+dispatcher passed as a value, even between jitted functions, is lowered as a process-specific
+address: numba then refuses to cache the glue ("uses dynamic globals"; measured on the cart
+pendulum's run_midpoint, tests/steppers/test_stepper_cache.py). A method module with one system
+passes itself; one with several (partitioned: kick and drift) wraps each assembly with
+``problem``.
 """
+
+import sys
+import types
 
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, NON_FINITE, OK
 from .base import FAST, max_abs, newton_converged, newton_solve
+
+
+def problem(name, assemble):
+    """A module (registered in sys.modules as ``name``) whose ``assemble`` is the given jitted
+    assembly: what ``solve`` takes as ``problem``."""
+    module = types.ModuleType(name, f"Newton system {assemble.__name__} (steppers/newton.py).")
+    module.assemble = assemble
+    sys.modules[name] = module
+    return module
 
 
 @njit(**FAST)

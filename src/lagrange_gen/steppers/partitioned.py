@@ -19,8 +19,24 @@ Newton uses exact Jacobians: d f/d v from ``momentum_rate_jacobian`` and d(H(q) 
 
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK
-from .base import FAST, max_abs, newton_converged, newton_solve
+from ..status import OK
+from . import newton
+from .base import FAST
+
+
+@njit(**FAST)
+def assemble_kick(kern, args, u, R, A):
+    """Newton system of solve_kick: R = H(q) u - mom - hk f(q, u, t), A = H(q) - hk df/dv."""
+    q, mom, t, hk, p, H, Jq, Jqd, f = args
+    n = q.shape[0]
+    kern.momentum_rate(q, u, t, p, f)
+    kern.momentum_rate_jacobian(q, u, t, p, Jq, Jqd)
+    for i in range(n):
+        s = -mom[i] - hk * f[i]
+        for j in range(n):
+            s += H[i, j] * u[j]
+            A[i, j] = H[i, j] - hk * Jqd[i, j]
+        R[i] = s
 
 
 @njit(**FAST)
@@ -30,30 +46,27 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
     On return H holds H(q) (unfactored) and u the solution.
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
-    n = q.shape[0]
     kern.mass_matrix(q, p, H)
-    resid = prev = 0.0
-    for it in range(1, max_iter + 1):
-        kern.momentum_rate(q, u, t, p, f)
-        kern.momentum_rate_jacobian(q, u, t, p, Jq, Jqd)
-        for i in range(n):
-            s = -mom[i] - hk * f[i]
-            for j in range(n):
-                s += H[i, j] * u[j]
-                A[i, j] = H[i, j] - hk * Jqd[i, j]
-            R[i] = -s
-        resid = max_abs(R)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        status = newton_solve(A, piv, R, scratch)
-        if status != OK:
-            return status, it, resid
-        for i in range(n):
-            u[i] += R[i]
-        done, prev = newton_converged(R, u, prev, tol)
-        if done:
-            return OK, it, resid
-    return NEWTON_DIVERGED, max_iter, resid
+    return newton.solve(_KICK, kern, (q, mom, t, hk, p, H, Jq, Jqd, f), u, R, A, piv,
+                        scratch, tol, max_iter)
+
+
+@njit(**FAST)
+def assemble_drift(kern, args, w, R, A):
+    """Newton system of solve_drift: R = H(q_new) w - mom, A = H + hd d(H w)/dq at q_new =
+    q + hd (u + w)."""
+    q, u, mom, hd, p, H, dHw, q_new = args
+    n = q.shape[0]
+    for i in range(n):
+        q_new[i] = q[i] + hd * (u[i] + w[i])
+    kern.mass_matrix(q_new, p, H)
+    kern.mass_matvec_dq(q_new, w, p, dHw)
+    for i in range(n):
+        s = -mom[i]
+        for j in range(n):
+            s += H[i, j] * w[j]
+            A[i, j] = H[i, j] + hd * dHw[i, j]
+        R[i] = s
 
 
 @njit(**FAST)
@@ -63,32 +76,15 @@ def solve_drift(kern, q, u, mom, hd, p, tol, max_iter, H, A, dHw, piv, w, R, q_n
     On return q_new = q + hd (u + w) and H holds H(q_new) (unfactored).
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
-    n = q.shape[0]
-    resid = prev = 0.0
-    for it in range(1, max_iter + 1):
-        for i in range(n):
+    status, iters, resid = newton.solve(_DRIFT, kern, (q, u, mom, hd, p, H, dHw, q_new),
+                                        w, R, A, piv, scratch, tol, max_iter)
+    if status == OK:
+        for i in range(q.shape[0]):
             q_new[i] = q[i] + hd * (u[i] + w[i])
         kern.mass_matrix(q_new, p, H)
-        kern.mass_matvec_dq(q_new, w, p, dHw)
-        # R(w) = H(q_new(w)) w - mom;  dR/dw = H + hd d(H w)/dq
-        for i in range(n):
-            s = -mom[i]
-            for j in range(n):
-                s += H[i, j] * w[j]
-                A[i, j] = H[i, j] + hd * dHw[i, j]
-            R[i] = -s
-        resid = max_abs(R)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        status = newton_solve(A, piv, R, scratch)
-        if status != OK:
-            return status, it, resid
-        for i in range(n):
-            w[i] += R[i]
-        done, prev = newton_converged(R, w, prev, tol)
-        if done:
-            for i in range(n):
-                q_new[i] = q[i] + hd * (u[i] + w[i])
-            kern.mass_matrix(q_new, p, H)
-            return OK, it, resid
-    return NEWTON_DIVERGED, max_iter, resid
+    return status, iters, resid
+
+
+# The two Newton systems as modules for newton.solve (see newton.py: modules, not dispatchers).
+_KICK = newton.problem(__name__ + "._kick", assemble_kick)
+_DRIFT = newton.problem(__name__ + "._drift", assemble_drift)
