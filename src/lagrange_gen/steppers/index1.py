@@ -7,8 +7,8 @@ Phi'' + 2 alpha Phi' + beta^2 Phi = 0, and the accelerations come from the KKT s
     [[H, -J^T], [J, 0]] (a, lam) = (rhs, gamma - 2 alpha J v - beta^2 Phi)
 
 (solved through the Schur complement J H^-1 J^T, Cholesky). The resulting ODE in (q, v) is
-integrated by the classical rk4 (order 4), which is what a user of scipy's solve_ivp or of
-sympy.physics.mechanics / PyDy does.
+integrated by the classical rk4 (order 4; explicit_rk's core with the rk4 tableau), which is
+what a user of scipy's solve_ivp or of sympy.physics.mechanics / PyDy does.
 
 Why it is bad (Lacoursiere's slides; Hairer-Wanner II, sec. VII.2): Phi'' = 0 holds along the
 numerical solution only up to the local error, so Phi and J v are not controlled at all: the
@@ -32,9 +32,11 @@ from ..status import OK, SINGULAR_MASS
 from .base import FAST, W_ACC, run_loop
 from .constrained import (S_BAUMGARTE_ALPHA, S_BAUMGARTE_BETA, check_buffers, flag_index, record,
                           schur_block, solve_rows, views)
+from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 
-_QS, _VS, _A2, _A3, _A4, _V2, _V3, _V4 = 0, 1, 2, 3, 4, 5, 6, 7    # work rows (W_ACC kept)
-_H = 0                                                            # mats
+# work rows: stage velocities 0-3, stage accelerations 4-7, stage q, new state (W_ACC = 11 kept)
+_V, _A, _QS, _Q_NEW, _V_NEW = 0, 4, 8, 9, 10
+_H = 0                                  # mats
 
 
 @njit(**FAST)
@@ -74,6 +76,14 @@ def _accel(kern, q, v, t, p, alpha, beta, H, a, lam, phi, J, gam, Y, S):
 
 
 @njit(**FAST)
+def stage_acceleration(kern, ctx, q, v, t, a):
+    """explicit_rk's callback: a (n,) from the KKT system (_accel); the stage multipliers go to
+    scratch. ctx = (p, alpha, beta, H, lam, phi, J, gam, Y, S)."""
+    p, alpha, beta, H, lam, phi, J, gam, Y, S = ctx
+    return _accel(kern, q, v, t, p, alpha, beta, H, a, lam, phi, J, gam, Y, S)
+
+
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One rk4 step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS
@@ -81,42 +91,27 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     lam, phi, gam, ls, c2, c3, J, Jb, Y, T, b, K = views(extra, n, m, m)
     S = schur_block(extra, n, m)
     H = mats[_H]
-    a1, qs, vs = work[W_ACC], work[_QS], work[_VS]
-    a2, a3, a4, v2, v3, v4 = work[_A2], work[_A3], work[_A4], work[_V2], work[_V3], work[_V4]
+    a0, stage_v, stage_a = work[W_ACC], work[_V:_A], work[_A:_QS]
+    qs, q_new, v_new = work[_QS], work[_Q_NEW], work[_V_NEW]
     flag = flag_index(m)
     if extra[flag] == 0.0:                    # first step of this run: a at the start state
-        status = _accel(kern, q, v, t, p, alpha, beta, H, a1, lam, phi, J, gam, Y, S)
+        status = _accel(kern, q, v, t, p, alpha, beta, H, a0, lam, phi, J, gam, Y, S)
         if status != OK:
             return status, 0, 0.0
         extra[flag] = 1.0
-    hh = 0.5 * h
     for i in range(n):
-        qs[i] = q[i] + hh * v[i]
-        v2[i] = v[i] + hh * a1[i]
-    status = _accel(kern, qs, v2, t + hh, p, alpha, beta, H, a2, ls, phi, J, gam, Y, S)
+        stage_a[0, i] = a0[i]
+    status = rk_step(_THIS, kern, (p, alpha, beta, H, ls, phi, J, gam, Y, S), RK4_A, RK4_B,
+                     RK4_C, q, v, t, h, stage_v, stage_a, qs, q_new, v_new, True)
     if status != OK:
         return status, 0, 0.0
-    for i in range(n):
-        qs[i] = q[i] + hh * v2[i]
-        v3[i] = v[i] + hh * a2[i]
-    status = _accel(kern, qs, v3, t + hh, p, alpha, beta, H, a3, ls, phi, J, gam, Y, S)
-    if status != OK:
-        return status, 0, 0.0
-    for i in range(n):
-        qs[i] = q[i] + h * v3[i]
-        v4[i] = v[i] + h * a3[i]
-    status = _accel(kern, qs, v4, t + h, p, alpha, beta, H, a4, ls, phi, J, gam, Y, S)
-    if status != OK:
-        return status, 0, 0.0
-    for i in range(n):
-        qs[i] = q[i] + h / 6.0 * (v[i] + 2.0 * v2[i] + 2.0 * v3[i] + v4[i])
-        vs[i] = v[i] + h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
     # Acceleration and multiplier at the new state: reported now, first stage of the next step.
-    status = _accel(kern, qs, vs, t + h, p, alpha, beta, H, a2, ls, phi, J, gam, Y, S)
+    status = _accel(kern, q_new, v_new, t + h, p, alpha, beta, H, stage_a[0], ls, phi, J, gam,
+                    Y, S)
     if status != OK:
         return status, 0, 0.0
     for i in range(n):
-        q[i], v[i], a1[i] = qs[i], vs[i], a2[i]
+        q[i], v[i], a0[i] = q_new[i], v_new[i], stage_a[0, i]
     for k in range(m):
         lam[k] = ls[k]
     record(extra, m, phi, J, v)

@@ -6,8 +6,9 @@
     a4 = a(q + h v3,   v + h a3,   t + h)             (v4 = v + h a3)
     q+ = q + h/6 (v + 2 v2 + 2 v3 + v4),   v+ = v + h/6 (a1 + 2 a2 + 2 a3 + a4)
 
-with a = H(q)^-1 (Q - h - g) (generated dynamics, Cholesky). Order 4, explicit (four force
-evaluations), neither symmetric nor symplectic: energy drifts slowly over long runs. On
+with a = H(q)^-1 (Q - h - g) (generated dynamics, Cholesky), stepped by explicit_rk's
+tableau-driven core. Order 4, explicit (four force evaluations), neither symmetric nor
+symplectic: energy drifts slowly over long runs. On
 x'' = -omega^2 x the stability polynomial is 1 + z + z^2/2 + z^3/6 + z^4/24 at z = i tau,
 stable for tau <= 2 sqrt(2).
 """
@@ -18,8 +19,9 @@ from numba import njit
 
 from ..status import OK
 from .base import FAST, accel, run_loop
+from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 
-_A1, _A2, _A3, _A4, _QS, _V2, _V3, _V4 = 0, 1, 2, 3, 4, 5, 6, 7     # work rows
+_V, _A, _QS = 0, 4, 8       # work rows: stage velocities 0-3, stage accelerations 4-7, stage q
 
 
 @njit(**FAST)
@@ -29,38 +31,18 @@ def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
 
 
 @njit(**FAST)
+def stage_acceleration(kern, ctx, q, v, t, a):
+    """explicit_rk's callback: a (n,) from the generated forward dynamics; ctx = (p, H)."""
+    p, H = ctx
+    return accel(kern, q, v, t, p, H, a)
+
+
+@njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
-    n = q.shape[0]
-    a1, a2, a3, a4 = work[_A1], work[_A2], work[_A3], work[_A4]
-    qs, v2, v3, v4 = work[_QS], work[_V2], work[_V3], work[_V4]
-    H = mats[0]
-    status = accel(kern, q, v, t, p, H, a1)
-    if status != OK:
-        return status, 0, 0.0
-    for i in range(n):
-        qs[i] = q[i] + 0.5 * h * v[i]
-        v2[i] = v[i] + 0.5 * h * a1[i]
-    status = accel(kern, qs, v2, t + 0.5 * h, p, H, a2)
-    if status != OK:
-        return status, 0, 0.0
-    for i in range(n):
-        qs[i] = q[i] + 0.5 * h * v2[i]
-        v3[i] = v[i] + 0.5 * h * a2[i]
-    status = accel(kern, qs, v3, t + 0.5 * h, p, H, a3)
-    if status != OK:
-        return status, 0, 0.0
-    for i in range(n):
-        qs[i] = q[i] + h * v3[i]
-        v4[i] = v[i] + h * a3[i]
-    status = accel(kern, qs, v4, t + h, p, H, a4)
-    if status != OK:
-        return status, 0, 0.0
-    c = h / 6.0
-    for i in range(n):
-        q[i] += c * (v[i] + 2.0 * v2[i] + 2.0 * v3[i] + v4[i])
-        v[i] += c * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
-    return OK, 0, 0.0
+    status = rk_step(_THIS, kern, (p, mats[0]), RK4_A, RK4_B, RK4_C, q, v, t, h,
+                     work[_V:_A], work[_A:_QS], work[_QS], q, v, False)
+    return status, 0, 0.0
 
 
 @njit(inline="always")
