@@ -31,7 +31,7 @@ def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     return OK
 
 
-@njit(**FAST)
+@njit(inline="always")
 def assemble(kern, args, v1, R, A):
     """Newton system of the step (newton.solve): R (n,) <- R(v+), A (n, n) <- dR/dv+."""
     q, v, t1, h, p, q1, dv, rhs, H, Jq, Jqd, dHw = args

@@ -37,7 +37,7 @@ def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
     return OK
 
 
-@njit(**FAST)
+@njit(inline="always")
 def assemble(kern, args, vb, R, A):
     """Newton system of the step (newton.solve): R (n,) <- R(vb), A (n, n) <- dR/dvb."""
     q, mom, tm, hh, p, qb, f, H, Jq, Jqd, dHw = args

@@ -19,8 +19,14 @@ address: numba then refuses to cache the glue ("uses dynamic globals"; measured 
 pendulum's run_midpoint, tests/steppers/test_stepper_cache.py). A method module with one system
 passes itself; one with several (partitioned: kick and drift) wraps each assembly with
 ``problem``.
+
+Speed: ``solve`` and the assemblies are ``inline="always"`` (inlined at numba-IR level into the
+method's step), so the loop compiles as if written in the step. As separately compiled
+functions taking the args tuple they cost 40-60 ns per step on the cart pendulum (midpoint
+about 370 against 320 ns, implicit_euler 280 against 220 ns, best of 5 runs of 2e5 steps).
 """
 
+import math
 import sys
 import types
 
@@ -39,24 +45,7 @@ def problem(name, assemble):
     return module
 
 
-@njit(**FAST)
-def _iterate(x, F, J, piv, scratch, prev, tol):
-    """One Newton update from an assembled F (N,), J (N, N): x += -J^-1 F in place.
-
-    F is overwritten by -dx. Returns (status, converged, max|dx|); status is NON_FINITE when F
-    holds NaN or inf, else that of the linear solve."""
-    if not max_abs(F) < 1.0e308:        # false for NaN and inf
-        return NON_FINITE, False, prev
-    status = newton_solve(J, piv, F, scratch)
-    if status != OK:
-        return status, False, prev
-    for i in range(x.shape[0]):
-        x[i] -= F[i]
-    done, d = newton_converged(F, x, prev, tol)
-    return OK, done, d
-
-
-@njit(**FAST)
+@njit(inline="always")
 def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
     """Newton on problem.assemble's F(x) = 0; x (N,) holds the initial guess and on return the
     last iterate. F, scratch (N,), J (N, N), piv (N,) int64 are workspace.
@@ -68,9 +57,14 @@ def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
     for it in range(1, max_iter + 1):
         problem.assemble(kern, args, x, F, J)
         resid = max_abs(F)
-        status, done, prev = _iterate(x, F, J, piv, scratch, prev, tol)
+        if not resid < math.inf:        # NaN or inf in F
+            return NON_FINITE, it, resid
+        status = newton_solve(J, piv, F, scratch)        # F <- J^-1 F = -dx
         if status != OK:
             return status, it, resid
+        for i in range(x.shape[0]):
+            x[i] -= F[i]
+        done, prev = newton_converged(F, x, prev, tol)
         if done:
             return OK, it, resid
     return NEWTON_DIVERGED, max_iter, resid

@@ -24,7 +24,7 @@ from . import newton
 from .base import FAST
 
 
-@njit(**FAST)
+@njit(inline="always")
 def assemble_kick(kern, args, u, R, A):
     """Newton system of solve_kick: R = H(q) u - mom - hk f(q, u, t), A = H(q) - hk df/dv."""
     q, mom, t, hk, p, H, Jq, Jqd, f = args
@@ -51,7 +51,7 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
                         scratch, tol, max_iter)
 
 
-@njit(**FAST)
+@njit(inline="always")
 def assemble_drift(kern, args, w, R, A):
     """Newton system of solve_drift: R = H(q_new) w - mom, A = H + hd d(H w)/dq at q_new =
     q + hd (u + w)."""
