@@ -158,3 +158,14 @@ def test_composed_kernels_equal_the_symbolic_ones(tmp_path):
             mod.momentum_rate_jacobian(q, v, 0.0, p, Jq, Jqd)
         for a, b in zip(out["c"], out["s"]):
             np.testing.assert_allclose(a, b, rtol=RTOL, atol=1e-13 * np.abs(b).max())
+
+
+def test_needs_follow_newton_assemblies_bound_at_module_level():
+    """partitioned.py passes its assemblies to newton.solve as module-level problems
+    (``_KICK = newton.problem(name, assemble_kick)``): the kernels they use are verlet's needs
+    (the generalized leapfrog's Newton uses the momentum rate and its Jacobian)."""
+    from lagrange_gen.codegen.needs import method_needs
+    newton = {"momentum_rate", "momentum_rate_jacobian"}       # the kick's residual and Jacobian
+    assert newton | {"mass_matvec_dq"} <= method_needs("verlet")  # and the drift's
+    assert newton | {"mass_matvec_dq"} <= method_needs("composition")
+    assert newton <= method_needs("symplectic_euler")

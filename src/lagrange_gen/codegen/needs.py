@@ -35,6 +35,8 @@ def method_needs(method: str) -> frozenset:
             continue
         needs |= fn.kern_attrs
         roots += [target for target in (info.resolve(c) for c in fn.calls) if target]
+        # A module-level Newton problem (newton.problem(name, assemble)) the function passes on.
+        roots += [(key[0], info.problems[n]) for n in fn.names if n in info.problems]
     return frozenset(needs)
 
 
@@ -45,8 +47,10 @@ def methods_needs(methods) -> dict:
 
 class _Function:
     def __init__(self, node):
-        self.kern_attrs, self.calls = set(), []
+        self.kern_attrs, self.calls, self.names = set(), [], set()
         for sub in ast.walk(node):
+            if isinstance(sub, ast.Name):
+                self.names.add(sub.id)
             if isinstance(sub, ast.Attribute) and isinstance(sub.value, ast.Name) and sub.value.id == _KERN:
                 self.kern_attrs.add(sub.attr)
             elif isinstance(sub, ast.Call):
@@ -62,6 +66,16 @@ class _Module:
     def __init__(self, dotted, tree):
         self.dotted = dotted
         self.functions = {n.name: _Function(n) for n in tree.body if isinstance(n, ast.FunctionDef)}
+        # NAME = newton.problem("...", assemble_fn): the assembly newton.solve(NAME, ...) calls.
+        self.problems = {}
+        for node in tree.body:
+            value = getattr(node, "value", None)
+            if (isinstance(node, ast.Assign) and isinstance(value, ast.Call)
+                    and isinstance(value.func, ast.Attribute) and value.func.attr == "problem"
+                    and len(value.args) >= 2 and isinstance(value.args[1], ast.Name)):
+                for target in node.targets:
+                    if isinstance(target, ast.Name):
+                        self.problems[target.id] = value.args[1].id
         self.names, self.modules = {}, {}   # imported function name -> module; alias -> module
         for node in tree.body:
             if isinstance(node, ast.ImportFrom) and node.level:
