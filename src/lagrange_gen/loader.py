@@ -20,17 +20,12 @@ def import_generated(path):
     path = Path(path).resolve()
     if not path.is_file():
         raise GenerationError(f"{path}: no generated module here (run lagrange-gen on its model)")
-    # The name must be the same in every process (numba's cache refers to globals by module
-    # name) and must change when the file is regenerated: numba interns a module's type by its
-    # name and path, so a regenerated module under the old name would be typed as the module
-    # object imported before it, without the new kernels. Path and KEY give both.
-    key = read_key(path) or "nokey"
-    digest = hashlib.sha1(f"{path}\n{key}".encode()).hexdigest()[:16]
-    name = f"lagrange_gen_generated_{digest}_{path.stem}"
+    # The name must be the same in every process: numba's cache refers to globals by module name.
+    name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
     cached = sys.modules.get(name)
-    if cached is not None:
-        # Imported before in this process: its own import-time check runs again (its model
-        # file may have changed since).
+    # The file may have been regenerated since this process imported it: then import it again;
+    # otherwise the module's own import-time check runs again (its model may have changed).
+    if cached is not None and getattr(cached, "KEY", None) == read_key(path):
         if hasattr(cached, "SOURCES"):
             check_current(cached.__file__, cached.KEY, cached.SOURCES, cached.MODEL_PATH,
                           cached.OPTIONS, cached.TEXT_SHA)
