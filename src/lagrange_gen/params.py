@@ -36,16 +36,18 @@ def resolve_params(names, defaults, given=None, model="model", frozen=None):
     if missing:
         raise SimulationError(f"{model}: parameter(s) {', '.join(missing)} have no value; pass them, "
                               f"e.g. params={{{missing[0]!r}: ...}} or --param {missing[0]}=...")
-    bad = [f"{n}={v}" for n, v in zip(names, values) if not math.isfinite(v)]
-    if bad:
-        raise SimulationError(f"{model}: non-finite parameter value(s) {', '.join(bad)}")
     return np.array(values, dtype=np.float64)
+
+
+def is_number(value):
+    """A real number that is not a bool (h=True must not run with h = 1)."""
+    return isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(
+        value, (bool, np.bool_))
 
 
 def _finite(model, name, value):
     """float(value), or a SimulationError naming the parameter when it is not a finite number."""
-    number = (isinstance(value, (int, float, np.integer, np.floating))
-              and not isinstance(value, (bool, np.bool_)))
+    number = is_number(value)
     if not number or not math.isfinite(value):
         what = "not finite" if number else "not a number"
         raise SimulationError(f"{model}: parameter {name!r} = {value!r} is {what}; give a finite "

@@ -18,6 +18,7 @@ import os
 import numpy as np
 
 from .errors import SimulationError
+from .params import is_number
 
 #: Largest step count simulate runs. At the fastest measured step (tens of ns, reports/steppers.md)
 #: 1e12 steps are already more than half a day of integration; and the rounding error of a
@@ -39,12 +40,6 @@ TIME_RESOLUTION = 1e-6
 #: (out_extra and its copy): t, the three out_stats columns, and the energy, newton_iters and
 #: newton_residual copies made for the Trajectory.
 _ROW_COLUMNS = 7
-
-
-def is_number(value):
-    """A real number that is not a bool (h=True must not run with h = 1)."""
-    return isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(
-        value, (bool, np.bool_))
 
 
 def check_scalars(h, t0, t_end, save_every, newton_tol, max_iter, blowup_bound):
