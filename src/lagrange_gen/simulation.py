@@ -86,10 +86,9 @@ def _element_method(module, method):
     """The method that actually runs: implicit_euler becomes nonsmooth_euler on a model with
     nonsmooth elements; a method that cannot treat them is refused, naming them."""
     names = tuple(getattr(module, "ELEMENTS", ()))
-    if not names or method in registry.NONSMOOTH_METHODS:
-        return method
-    if method == "implicit_euler":
-        return "nonsmooth_euler"
+    runs = registry.runs_as(method, len(names)) if method in registry.METHODS else method
+    if not names or runs in registry.NONSMOOTH_METHODS:
+        return runs
     raise SimulationError(
         f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) {', '.join(names)} "
         f"(no silent regularization); use method='implicit_euler' (exact Saint-Venant return map, "
