@@ -201,21 +201,20 @@ def consistent_initial_state(module, q0, v0, p, t0=0.0, tol=1e-12, warn=True, st
                            jv_norm=float(np.abs(J @ v).max()), dq=dq, dv=dv)
 
 
-def check_method(module, method, constrained_methods):
+def check_method(module, method):
     """Refuse an unconstrained method on a constrained model and the other way round."""
+    from .steppers import registry
     m = getattr(module, "N_CONSTRAINTS", 0)
-    if m and method not in constrained_methods:
+    why = registry.inapplicable(method, m, getattr(module, "N_ELEMENTS", 0))
+    if not why:
+        return
+    if m and not registry.spec(method).constraints:
         names = "; ".join(constraint_label(module, i) for i in range(m))
-        raise SimulationError(
-            f"{module.NAME}: method {method!r} ignores the model's constraints ({names}); use a "
-            f"constrained method: {', '.join(constrained_methods)} (rattle: 2nd order, symplectic; "
-            f"spook: regularized; index1 only as the example of drift)")
-    if not m and method in constrained_methods:
-        raise SimulationError(f"{module.NAME}: method {method!r} is for models with constraints "
-                              f"and this model has none; use an unconstrained method")
-    if m and getattr(module, "N_ELEMENTS", 0):
-        raise SimulationError(f"{module.NAME}: constraints together with nonsmooth elements are "
-                              f"not supported by any method")
+        choices = "; ".join(f"{s.name} (order {s.order}, {s.summary})"
+                            for s in map(registry.spec, registry.CONSTRAINED_METHODS))
+        raise SimulationError(f"{module.NAME}: method {method!r} ignores the model's constraints "
+                              f"({names}); use a constrained method: {choices}")
+    raise SimulationError(f"{module.NAME}: method {method!r} does not apply: {why}")
 
 
 def diagnose_singular(module, q, p):

@@ -42,12 +42,12 @@ def raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
     if code in (st.NEWTON_DIVERGED, st.NON_FINITE):
         raise BlowUp(f"{where}: {_non_finite(module, q, v, t, p, resid)}", **kwargs)
     if code == st.SINGULAR_MASS:
-        what = "H(q) or J H^-1 J^T" if method in registry.CONSTRAINED_METHODS else "H(q)"
+        what = "H(q) or J H^-1 J^T" if registry.spec(method).constraints else "H(q)"
         raise SingularMass(f"{where}: singular mass matrix {what} at {state}"
                            f"{_constraint_hint(module, method, q, p)}", **kwargs)
     if code == st.SINGULAR_NEWTON:
         system = "the Jacobian of the step's equations"
-        if method in registry.CONSTRAINED_METHODS:
+        if registry.spec(method).constraints:
             system = "the KKT matrix of the step's equations and constraints"
         raise SingularNewtonMatrix(
             f"{where}: singular Newton matrix ({system}; H(q) is not what failed) in the step "
@@ -73,7 +73,7 @@ def _non_finite(module, q, v, t, p, resid):
 
 
 def _constraint_hint(module, method, q, p):
-    if method not in registry.CONSTRAINED_METHODS:
+    if not registry.spec(method).constraints:
         return ""
     from .consistent import diagnose_singular
     return diagnose_singular(module, np.ascontiguousarray(q), p)

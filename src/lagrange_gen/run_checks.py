@@ -42,24 +42,19 @@ TIME_RESOLUTION = 1e-6
 _ROW_COLUMNS = 7
 
 
-def check_scalars(h, t0, t_end, save_every, newton_tol, max_iter, blowup_bound):
-    """simulate's scalar arguments: finite numbers (not bools), h > 0, t_end >= t0, positive
-    integers, blowup_bound > 0 (NaN would switch the blow-up check off silently)."""
-    for name, value in (("h", h), ("t0", t0), ("t_end", t_end), ("newton_tol", newton_tol)):
+def check_scalars(h, t0, t_end, save_every):
+    """simulate's scalar arguments: finite numbers (not bools), h > 0, t_end >= t0, save_every a
+    positive integer. (A method's own settings are checked by steppers.spec.make_settings.)"""
+    for name, value in (("h", h), ("t0", t0), ("t_end", t_end)):
         if not is_number(value) or not math.isfinite(value):
             raise SimulationError(f"{name} must be a finite number, got {value!r}")
     if h <= 0:
         raise SimulationError(f"step size h must be > 0, got {h}")
     if t_end < t0:
         raise SimulationError(f"t_end = {t_end} is before t0 = {t0}")
-    for name, value in (("save_every", save_every), ("max_iter", max_iter)):
-        if not is_number(value) or not math.isfinite(value) or int(value) != value or value < 1:
-            raise SimulationError(f"{name} must be a positive integer, got {value!r}")
-    if newton_tol <= 0:
-        raise SimulationError(f"newton_tol must be > 0, got {newton_tol}")
-    if not is_number(blowup_bound) or not blowup_bound > 0:
-        raise SimulationError(f"blowup_bound must be a number > 0 (math.inf: no bound), got "
-                              f"{blowup_bound!r}")
+    if (not is_number(save_every) or not math.isfinite(save_every) or int(save_every) != save_every
+            or save_every < 1):
+        raise SimulationError(f"save_every must be a positive integer, got {save_every!r}")
 
 
 def vector(name, value, n, coords):

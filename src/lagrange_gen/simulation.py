@@ -32,7 +32,8 @@ from .failures import raise_for_status
 from .keys import regeneration_command_for
 from .params import resolve_params
 from .steppers import registry
-from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, make_settings
+from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
+from .steppers.spec import make_settings
 from .trajectory import Trajectory
 
 __all__ = ["simulate", "Trajectory", "load_module"]
@@ -95,17 +96,6 @@ def _element_method(module, method):
         f"Moreau-Jean dry friction)")
 
 
-def _extra_layout(module, method):
-    """(saved, total) columns of out_extra for a method on a module."""
-    if method == "nonsmooth_euler":
-        from .steppers.nonsmooth_euler import extra_size
-        return extra_size(module.N_COORDS, module.N_ELEMENTS)
-    if method in registry.CONSTRAINED_METHODS:
-        from .steppers.constrained import extra_size
-        return extra_size(module.N_COORDS, module.N_CONSTRAINTS)
-    return 0, 0
-
-
 def _element_energy(module, p, state):
     """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
     if not module.N_ELEMENTS:
@@ -116,10 +106,8 @@ def _element_energy(module, p, state):
 
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, params=None,
-             save_every=1, newton_tol=1e-12, max_iter=50, t0=0.0, progress=False,
-             blowup_bound=1e150, newton_always=False, out_dir="generated",
-             element_state0=None, compliance=0.0, relaxation=2.0,
-             baumgarte=(0.0, 0.0), force=False) -> Trajectory:
+             save_every=1, t0=0.0, progress=False, out_dir="generated", element_state0=None,
+             force=False, **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end with fixed step h.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -129,19 +117,19 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
         parameter without default must be given.
     save_every: keep every save_every-th state (the initial and the final state are always kept).
-    newton_tol, max_iter: Newton tolerance, relative to max(1, |unknown|) (see
-        steppers.base.newton_converged), and the iteration cap per solve.
-    blowup_bound: BlowUp when |q| or |v| exceeds it.
-    newton_always: use the Newton path of symplectic_euler / verlet / composition even when the
-        model allows the explicit one (constant H, velocity-free forces).
     element_state0: initial states of the nonsmooth elements (ne,), default 0 (virgin material).
         On models with elements, method implicit_euler runs nonsmooth_euler; the trajectory's
         energy then includes the elastic energy k u^2 / 2 stored in Saint-Venant elements.
+    settings: the method's settings by name (its SPEC.settings record; unknown names are
+        refused): blowup_bound (BlowUp when |q| or |v| exceeds it) for every method;
+        newton_tol (relative to max(1, |unknown|), see steppers.base.newton_converged) and
+        max_iter for the implicit ones; newton_always (the Newton path of the partitioned
+        methods even when the model allows the explicit one); spook's compliance (epsilon >= 0)
+        and relaxation (d > 0); index1's baumgarte = (alpha, beta).
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.consistent), and the Trajectory carries the multipliers and
-    max|Phi|, max|J v| per saved state. compliance (epsilon >= 0) and relaxation (d > 0) are
-    spook's; baumgarte = (alpha, beta) is index1's optional stabilization.
+    max|Phi|, max|J v| per saved state.
     The final time is t0 + n_steps h with n_steps = (t_end - t0) / h rounded up to a whole step.
     Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
     SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
@@ -151,29 +139,30 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     module = load_module(module_or_path, out_dir, method, force)
     method = _element_method(module, method)
     from .consistent import check_method
-    check_method(module, method, registry.CONSTRAINED_METHODS)
+    check_method(module, method)
     run = _runner(module, method)
+    spec = registry.spec(method)
     n = module.N_COORDS
-    run_checks.check_scalars(h, t0, t_end, save_every, newton_tol, max_iter, blowup_bound)
+    run_checks.check_scalars(h, t0, t_end, save_every)
+    config = make_settings(spec, settings)
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
     p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME,
                        frozen=getattr(module, "FROZEN", None))
     run_checks.check_element_coefficients(module, p)
-    h, t0, save_every, max_iter = float(h), float(t0), int(save_every), int(max_iter)
+    h, t0, save_every = float(h), float(t0), int(save_every)
     run_checks.check_step_count(t0, float(t_end), h)
     n_steps = _n_steps(t0, float(t_end), h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
-    n_saved, n_extra = _extra_layout(module, method)
+    n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
-    settings = make_settings(newton_tol, max_iter, blowup_bound, 1 if newton_always else 0)
     initial = np.zeros(0)
-    if method in registry.CONSTRAINED_METHODS:
-        settings, q, v, initial = _constrained_setup(module, q, v, p, t0, settings, compliance,
-                                                     relaxation, baumgarte)
+    if spec.constraints:
+        q, v, initial = _constrained_start(module, q, v, p, t0,
+                                           getattr(config, "newton_tol", 1e-12))
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
-    task = _Task(module, method, run, p, settings, h, t0, n_steps, save_every, max_iter, n_extra)
+    task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every)
     out = _allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial)
     compile_time, wall = _integrate(task, q, v, out, progress)
     return _trajectory(task, out, wall, compile_time)
@@ -184,23 +173,28 @@ class _Task:
     """What one run integrates: the module, the method and its glue, and the run's numbers."""
 
     module: types.ModuleType
-    method: str
+    spec: object        # the method's Spec
     run: object
     p: np.ndarray
-    settings: np.ndarray
+    settings: tuple     # the method's settings record
     h: float
     t0: float
     n_steps: int
     save_every: int
-    max_iter: int
-    n_extra: int        # length of the method's extra buffer (saved entries + scratch)
+
+    @property
+    def method(self):
+        return self.spec.name
+
+    @property
+    def max_iter(self):
+        return getattr(self.settings, "max_iter", 0)
 
 
 def _allocate(rows, n, n_saved, initial):
     """Output arrays {t (S,), q, v (S, n), stats (S, N_STATS), extra (S, n_saved)}; row 0 of
     extra holds the initial extra data (multipliers and residuals, or element states).
-    Only the n_saved leading entries of the method's extra buffer are kept per row; the rest is
-    scratch that run_loop sizes from `last` (steppers/base.py)."""
+    The n_saved columns of extra are the method's saved fields (SPEC.saved)."""
     out = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
                stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)))
     if n_saved:
@@ -213,7 +207,7 @@ def _integrate(task, q, v, out, progress):
     out["rows"] (rows used). Returns (compile seconds, integration seconds). Raises the
     exception of a failure status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
-    last = np.empty(2 * n + 3 + task.n_extra)
+    last = np.empty(2 * n + 3 + out["extra"].shape[1])
     compile_time = _warm_up(task.run, q, v, t0, h, task.p, task.settings,
                             out["extra"][:1].copy(), last.copy())
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
@@ -265,18 +259,19 @@ def _trajectory(task, out, wall, compile_time):
         out["t"][row], out["q"][row], out["v"][row] = task.t0 + task.n_steps * h, q, v
         out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n])
         out["extra"][row] = last[3 + 2 * n:3 + 2 * n + n_saved]
-    elements = out["extra"][:, :n_saved].copy()
-    energy = out["stats"][:, STAT_ENERGY] + _element_energy(m, p, elements)
-    constrained = task.method in registry.CONSTRAINED_METHODS
+    layout = task.spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS)
+    saved = {name: out["extra"][:, start:start + width].copy() for name, start, width in layout}
+    energy = out["stats"][:, STAT_ENERGY]
+    if "element_state" in saved:
+        energy = energy + _element_energy(m, p, saved["element_state"])
     traj = Trajectory(t=out["t"], q=out["q"], v=out["v"], energy=energy,
                       newton_iters=out["stats"][:, STAT_ITERS].copy(),
                       newton_residual=out["stats"][:, STAT_RESIDUAL].copy(), method=task.method,
                       h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
                       coords=tuple(m.COORDS), n_steps=task.n_steps, wall_time=wall,
-                      compile_time=compile_time, extra=elements,
-                      element_names=tuple(getattr(m, "ELEMENTS", ())) if n_saved and not
-                      constrained else (),
-                      constraint_names=tuple(m.CONSTRAINTS) if constrained else ())
+                      compile_time=compile_time, saved=saved,
+                      element_names=tuple(m.ELEMENTS) if task.spec.elements else (),
+                      constraint_names=tuple(m.CONSTRAINTS) if task.spec.constraints else ())
     message = energy_warning(m, task.method, traj.q, traj.v, traj.t, traj.energy, p, h)
     if message:
         traj.warnings.append(message)
@@ -285,29 +280,14 @@ def _trajectory(task, out, wall, compile_time):
     return traj
 
 
-def _constrained_setup(module, q, v, p, t0, settings, compliance, relaxation, baumgarte):
-    """Settings of the constrained methods, the consistent initial state, and row 0 of
-    out_extra: (settings, q, v, [lam0, max|Phi|, max|J v|])."""
+def _constrained_start(module, q, v, p, t0, tol):
+    """The consistent initial state and row 0 of the saved fields of a constrained method:
+    (q, v, [lam0, max|Phi|, max|J v|])."""
     from .consistent import consistent_initial_state
-    from .steppers.constrained import make_constrained_settings
-    for name, value, positive in (("compliance", compliance, False), ("relaxation", relaxation, True)):
-        number = run_checks.is_number(value) and math.isfinite(value)
-        if not number or value < 0 or (positive and value == 0):
-            raise SimulationError(f"{name} must be a finite number {'> 0' if positive else '>= 0'}, "
-                                  f"got {value!r}")
-    try:
-        alpha, beta = (float(x) for x in baumgarte)
-    except (TypeError, ValueError):
-        raise SimulationError(f"baumgarte must be (alpha, beta), got {baumgarte!r}") from None
-    if not (alpha >= 0 and beta >= 0 and math.isfinite(alpha + beta)):
-        raise SimulationError(f"baumgarte coefficients must be finite and >= 0, got {baumgarte!r}")
-    tol, max_iter, bound, mode = settings[:4]
-    settings = make_constrained_settings(tol, max_iter, bound, mode, float(compliance),
-                                         float(relaxation), alpha, beta)
     # stacklevel 4: the warning points at the user's call of simulate().
     state = consistent_initial_state(module, q, v, p, t0, tol, stacklevel=4)
     initial = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
-    return settings, np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial
+    return np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial
 
 
 def _warm_up(run, q, v, t0, h, p, settings, extra, last):

@@ -35,37 +35,41 @@ class Trajectory:
     n_steps: int
     wall_time: float = 0.0       # integration only, seconds
     compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
-    extra: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    saved: dict = field(default_factory=dict)   # {field name: (S, width)}: the method's SPEC.saved
     element_names: tuple = ()
     constraint_names: tuple = ()
     warnings: list = field(default_factory=list)   # one line each (also issued as Python warnings)
 
+    def field(self, name):
+        """The saved field ``name`` (S, width), or None when the method does not save it."""
+        return self.saved.get(name)
+
     @property
     def multipliers(self) -> np.ndarray:
         """(S, m): the constraint forces lam (H qdd = rhs + J^T lam) at each saved state, from a
-        constrained method (see its module docstring for which of its multipliers it reports)."""
-        return self.extra[:, :len(self.constraint_names)]
+        constrained method (see its module docstring for which of its multipliers it reports);
+        (S, 0) for a run without constraints."""
+        lam = self.saved.get("multipliers")
+        return lam if lam is not None else np.zeros((len(self.t), 0))
 
     @property
     def constraint_error(self):
-        """(S,): max_i |Phi_i(q)| at each saved state; None for a run without constraints
-        (extra then holds other data, e.g. the element states of a nonsmooth run)."""
-        if not self.constraint_names:
-            return None
-        return self.extra[:, len(self.constraint_names)]
+        """(S,): max_i |Phi_i(q)| at each saved state; None for a run without constraints."""
+        phi = self.saved.get("constraint_error")
+        return None if phi is None else phi[:, 0]
 
     @property
     def velocity_constraint_error(self):
         """(S,): max_i |(J(q) v)_i| at each saved state; None for a run without constraints."""
-        if not self.constraint_names:
-            return None
-        return self.extra[:, len(self.constraint_names) + 1]
+        jv = self.saved.get("velocity_constraint_error")
+        return None if jv is None else jv[:, 0]
 
     @property
     def element_state(self) -> np.ndarray:
         """(S, ne): per nonsmooth element, u (elastic strain of a Saint-Venant element) or r (the
-        dry-friction force) at each saved state."""
-        return self.extra[:, :len(self.element_names)]
+        dry-friction force) at each saved state; (S, 0) for a run without elements."""
+        state = self.saved.get("element_state")
+        return state if state is not None else np.zeros((len(self.t), 0))
 
     @property
     def energy_error(self) -> np.ndarray:
@@ -79,31 +83,29 @@ class Trajectory:
     def to_npz(self, path):
         """Write every array and the metadata to a .npz file."""
         _parent(path)
+        saved = {name: (a[:, 0] if a.shape[1] == 1 else a) for name, a in self.saved.items()}
+        saved.setdefault("element_state", self.element_state)
+        saved.setdefault("multipliers", self.multipliers)
         np.savez(path, t=self.t, q=self.q, v=self.v, energy=self.energy,
                  newton_iters=self.newton_iters, newton_residual=self.newton_residual,
                  method=self.method, h=self.h, model=self.model, coords=np.array(self.coords),
                  param_names=np.array(list(self.params)),
                  param_values=np.array(list(self.params.values()), dtype=float),
                  n_steps=self.n_steps, element_names=np.array(self.element_names, dtype=str),
-                 element_state=self.element_state,
-                 constraint_names=np.array(self.constraint_names, dtype=str),
-                 multipliers=self.multipliers, **self._constraint_arrays())
-
-    def _constraint_arrays(self):
-        if not self.constraint_names:
-            return {}
-        return dict(constraint_error=self.constraint_error,
-                    velocity_constraint_error=self.velocity_constraint_error)
+                 constraint_names=np.array(self.constraint_names, dtype=str), **saved)
 
     def to_csv(self, path):
-        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters (and
-        for a constrained method lam_0..lam_m-1, max|Phi|, max|J v|)."""
+        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters and
+        the method's saved fields (a field of width w > 1 as name_0..name_w-1; for a constrained
+        method lam_0..lam_m-1, constraint_error, velocity_constraint_error)."""
         header = ["t", *self.coords, *(f"{c}_dot" for c in self.coords), "energy", "newton_iters"]
         data = np.column_stack([self.t, self.q, self.v, self.energy, self.newton_iters])
-        if self.constraint_names:
-            header += [f"lam_{i}" for i in range(len(self.constraint_names))]
-            header += ["constraint_error", "velocity_constraint_error"]
-            data = np.column_stack([data, self.extra])
+        short = {"multipliers": "lam"}
+        for name, values in self.saved.items():
+            stem = short.get(name, name)
+            header += [stem] if values.shape[1] == 1 and name not in short else [
+                f"{stem}_{i}" for i in range(values.shape[1])]
+            data = np.column_stack([data, values])
         _parent(path)
         np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
 

@@ -4,19 +4,26 @@ The rules every method module (``steppers/<method>.py``) follows:
 
 * One integrator per module, with a module docstring stating the scheme, its order and the
   properties the tests check.
-* Two jitted functions with the same signatures in every module::
+* A declaration ``SPEC = spec.Spec(...)`` at the end of the module (see spec.py): name, order,
+  family, the models it applies to, its typed settings record, the kernels it calls and the
+  named fields it saves per output row.
+* Three jitted functions with the same signatures in every fixed-step module::
 
-      prepare(kern, q, v, mom, t, p, settings, work, mats, piv) -> status
-      step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra)
+      workspace(kern, n) -> a namedtuple of the method's named scratch arrays
+      prepare(kern, q, v, mom, t, p, settings, ws, extra) -> status
+      step(kern, q, v, mom, t, h, p, settings, ws, extra)
           -> (status, newton_iterations, newton_residual)
 
-  ``prepare`` fills whatever per-run state the method carries between steps (the momentum
-  ``mom = H(q) v`` or a cached acceleration); ``step`` advances (q, v, mom) from t to t + h in
-  place. On failure ``step`` leaves q, v and mom at the start of the step, so the driver reports
-  the state it could not step from.
+  ``workspace`` allocates once per run (run_loop calls it); ``settings`` is the method's
+  settings record (a NamedTuple, fields read by name); ``extra`` (n_saved,) holds the fields the
+  method saves per output row (SPEC.saved, in that order), carried from step to step and from
+  one chunk of a run to the next. ``prepare`` fills whatever per-run state the method carries
+  between steps (the momentum ``mom = H(q) v``, a cached acceleration in its workspace);
+  ``step`` advances (q, v, mom) from t to t + h in place. On failure ``step`` leaves q, v and
+  mom at the start of the step, so the driver reports the state it could not step from.
 * ``run(kern, q0, v0, t0, h, n_steps, save_every, p, settings, out_t, out_q, out_v, out_stats,
-  out_extra, out_last)`` is ``run_loop`` over the module's prepare and step; the generated glue
-  ``run_<method>`` calls it (see registry.py for why the glue exists).
+  out_extra, out_last)`` is ``run_loop`` over the module's workspace, prepare and step; the
+  generated glue ``run_<method>`` calls it (see registry.py for why the glue exists).
 * No allocation per step: work arrays are allocated once per ``run`` and passed to ``step``.
 * Failures are status codes (lagrange_gen.status), never garbage and never exceptions.
 
@@ -38,8 +45,8 @@ functions with loops and early returns: on the cart pendulum that was half of th
 the Newton methods (perf: NRT_incref/NRT_decref), and a 2 x 2 LU solve through calls cost 85 ns
 against 29 ns without. Only ``run_loop`` allocates (once per run) and keeps reference counting.
 
-Shapes: n coordinates; q, v, mom (n,); p (n_params,); work (N_WORK, n); mats (N_MAT, n, n);
-piv (n,) int64; extra (n_extra,) per-step method output (empty for unconstrained methods).
+Shapes: n coordinates; q, v, mom (n,); p (n_params,); extra (n_saved,) the method's saved
+fields (empty for the unconstrained methods).
 """
 
 import math
@@ -56,12 +63,16 @@ from ..status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
 #: numba drops its zero-divisor checks on every division.
 FAST = dict(_nrt=False, error_model="numpy")
 
-# Layout of the float64 ``settings`` array shared by every method.
-S_TOL = 0          # Newton tolerance, relative to max(1, |unknown|) (see newton_converged)
-S_MAX_ITER = 1     # Newton iteration cap per solve
-S_BOUND = 2        # UNSTABLE when max(|q|, |v|) exceeds this
-S_MODE = 3         # 0: explicit path when the model allows it; 1: always the Newton path
-N_SETTINGS = 4
+# TRANSITIONAL (removed once every method reads its settings record and workspace by name).
+S_TOL, S_MAX_ITER, S_BOUND, S_MODE, N_SETTINGS = 0, 1, 2, 3, 4
+N_WORK, N_MAT, W_ACC = 12, 6, 11
+W_SAVE_Q, W_SAVE_V, W_SAVE_MOM = 8, 9, 10
+
+
+def make_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0):
+    """TRANSITIONAL: the old float64 settings array."""
+    return np.array([newton_tol, max_iter, bound, mode], dtype=np.float64)
+
 
 # Columns of ``out_stats`` (n_saves, N_STATS), one row per saved state.
 STAT_ENERGY = 0     # E = T + V at the saved state
@@ -69,25 +80,11 @@ STAT_ITERS = 1      # Newton iterations summed over the steps since the previous
 STAT_RESIDUAL = 2   # largest Newton residual (max norm, last iterate of a step) over those steps
 N_STATS = 3
 
-# Work array sizes (rows of ``work`` are n-vectors, entries of ``mats`` are n x n matrices).
-N_WORK = 12
-N_MAT = 6
-# Rows a method may keep across steps (all others are scratch within one step): the cached
-# acceleration of explicit Verlet, and composition's copy of the state at the start of a step.
-W_ACC = 11
-W_SAVE_Q, W_SAVE_V, W_SAVE_MOM = 8, 9, 10
-
-
-def make_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0):
-    """The float64 settings array (N_SETTINGS,) in the layout above."""
-    return np.array([newton_tol, max_iter, bound, mode], dtype=np.float64)
-
-
 @njit(**FAST)
 def explicit_path(kern, settings):
     """True when a partitioned method may skip Newton: the model has constant H and
-    velocity-free forces (generated flags) and settings[S_MODE] allows it."""
-    return kern.MASS_IS_CONSTANT and kern.FORCES_VELOCITY_FREE and settings[S_MODE] == 0.0
+    velocity-free forces (generated flags) and settings.newton_always is off."""
+    return kern.MASS_IS_CONSTANT and kern.FORCES_VELOCITY_FREE and not settings.newton_always
 
 
 @njit(cache=True, **FAST)
@@ -257,15 +254,16 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
              out_t, out_q, out_v, out_stats, out_extra, out_last):
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
 
-    ``method`` is a stepper module (its prepare and step are called), ``kern`` the generated
-    module.
+    ``method`` is a stepper module (its workspace, prepare and step are called), ``kern`` the
+    generated module, ``settings`` the method's settings record (spec.py).
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
-    n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
-    (S, N_STATS), out_extra (S, n_extra), whose row 0 also holds the initial extra data.
-    out_last (2n + 3 [+ n_total],) receives [t, q, v, Newton
-    iterations since the last save, Newton residual, extra data] of the final state, or on failure: of the
-    state the failing step started from (Newton failure, singular mass) or of the offending state
-    after it (NON_FINITE, UNSTABLE; also a non-finite energy at a saved state).
+    S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
+    (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
+    also holds the initial values of those fields (element states, multipliers).
+    out_last (2n + 3 + n_saved,) receives [t, q, v, Newton iterations since the last save,
+    Newton residual, saved fields] of the final state, or on failure: of the state the failing
+    step started from (Newton failure, singular mass) or of the offending state after it
+    (NON_FINITE, UNSTABLE; also a non-finite energy at a saved state).
     Returns (status, steps_done): steps_done = index of the failing step on failure, -1 when the
     initial state itself is refused (non-finite or past the bound, its energy non-finite, or the
     method's prepare failed).
@@ -274,21 +272,16 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     q = q0.copy()
     v = v0.copy()
     mom = np.zeros(n)
-    work = np.zeros((N_WORK, n))
-    mats = np.zeros((N_MAT, n, n))
-    piv = np.zeros(n, dtype=np.int64)
-    # The method's persistent per-run data (element states, multipliers) start from row 0 of
-    # out_extra, so a run continued in chunks carries them over.
-    # The buffer is n_total = max(n_extra, len(out_last) - 2n - 3) long: a method may keep
-    # scratch (or per-step data not worth saving) after the n_extra saved entries, so out_extra
-    # need not store it on every row (the constrained methods: m + 2 saved of O((n + m)^2)).
-    extra = np.zeros(max(out_extra.shape[1], out_last.shape[0] - 3 - 2 * n))
+    ws = method.workspace(kern, n)
+    # The saved fields start from row 0 of out_extra, so a run continued in chunks carries them
+    # over (element states; multipliers, also the next Newton guess).
+    extra = np.zeros(out_extra.shape[1])
     for k in range(out_extra.shape[1]):
         extra[k] = out_extra[0, k]
-    bound = settings[S_BOUND]
+    bound = settings.blowup_bound
     status = check_state(q, v, bound)
     if status == OK:
-        status = method.prepare(kern, q, v, mom, t0, p, settings, work, mats, piv)
+        status = method.prepare(kern, q, v, mom, t0, p, settings, ws, extra)
     energy = kern.energy(q, v, t0, p)
     if status == OK and not math.isfinite(energy):
         status = NON_FINITE
@@ -301,8 +294,7 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     since = 0
     for i in range(n_steps):
         t = t0 + i * h       # not accumulated: no drift of t over millions of steps
-        status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, work, mats,
-                                           piv, extra)
+        status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
         iters_acc += iters
         resid_max = max(resid_max, resid)
         if status != OK:

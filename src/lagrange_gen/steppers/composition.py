@@ -16,6 +16,7 @@ from numba import njit
 
 from ..status import OK
 from . import verlet
+from .spec import PartitionedSettings, Spec
 from .base import FAST, W_SAVE_MOM, W_SAVE_Q, W_SAVE_V, copy_into, run_loop
 
 _CBRT2 = 2.0 ** (1.0 / 3.0)
@@ -65,3 +66,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="composition", order=4, family="partitioned", implicit=True, symplectic=True,
+    symmetric=True,
+    summary="Yoshida 4th-order triple jump of verlet",
+    stable="stable for tau < 1.57",
+    settings=PartitionedSettings,
+    kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))

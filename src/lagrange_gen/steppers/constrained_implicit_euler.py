@@ -31,6 +31,7 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK
+from .spec import NewtonSettings, Spec
 from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_converged, max_abs,
                    run_loop)
 from .constrained import (check_buffers, gauss_solve, record, schur_block,
@@ -141,3 +142,12 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="constrained_implicit_euler", order=1, family="constrained", implicit=True, symplectic=False,
+    symmetric=False,
+    summary="index-3 backward Euler with velocity projection",
+    constraints=True,
+    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    settings=NewtonSettings,
+    kernels=("constraint_dq", "constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq", "rhs_jacobian"))

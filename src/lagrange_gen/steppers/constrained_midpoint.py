@@ -32,6 +32,7 @@ import sys
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, OK
+from .spec import NewtonSettings, Spec
 from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_converged, max_abs,
                    momentum_from_velocity, run_loop)
 from .constrained import (check_buffers, gauss_solve, record, schur_block,
@@ -155,3 +156,12 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="constrained_midpoint", order=2, family="constrained", implicit=True, symplectic=True,
+    symmetric=True,
+    summary="midpoint variational integrator with constraints",
+    constraints=True,
+    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    settings=NewtonSettings,
+    kernels=("constraints", "energy", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))

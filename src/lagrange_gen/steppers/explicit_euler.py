@@ -13,6 +13,7 @@ import sys
 from numba import njit
 
 from ..status import OK
+from .spec import ExplicitSettings, Spec
 from .base import FAST, accel, run_loop
 
 _A = 0     # work row: acceleration
@@ -49,3 +50,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="explicit_euler", order=1, family="explicit", implicit=False, symplectic=False,
+    symmetric=False,
+    summary="forward Euler (what not to do)",
+    stable="unstable for every tau > 0 (rho = sqrt(1 + tau^2))",
+    settings=ExplicitSettings,
+    kernels=("energy", "forward_dynamics"))

@@ -19,6 +19,7 @@ from numba import njit
 
 from ..status import OK
 from . import newton
+from .spec import NewtonSettings, Spec
 from .base import FAST, S_MAX_ITER, S_TOL, run_loop
 
 _V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
@@ -78,3 +79,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="implicit_euler", order=1, family="implicit", implicit=True, symplectic=False,
+    symmetric=False,
+    summary="backward Euler (L-stable)",
+    stable="stable for every tau, damping (rho = 1/sqrt(1 + tau^2))",
+    settings=NewtonSettings,
+    kernels=("dynamics", "energy", "mass_matvec_dq", "rhs_jacobian"))

@@ -24,11 +24,13 @@ Settings: settings[S_BAUMGARTE_ALPHA], settings[S_BAUMGARTE_BETA] (default 0: no
 """
 
 import sys
+from typing import NamedTuple
 
 from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
+from .spec import Spec
 from .base import FAST, W_ACC, run_loop
 from .constrained import (S_BAUMGARTE_ALPHA, S_BAUMGARTE_BETA, check_buffers, flag_index, record,
                           schur_block, solve_rows, views)
@@ -130,3 +132,20 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+class Index1Settings(NamedTuple):
+    """index1's settings: Baumgarte's (alpha, beta), Phi'' + 2 alpha Phi' + beta^2 Phi = 0."""
+
+    blowup_bound: float = 1e150
+    baumgarte: tuple = (0.0, 0.0)
+
+
+SPEC = Spec(
+    name="index1", order=4, family="constrained", implicit=False, symplectic=False,
+    symmetric=False,
+    summary="rk4 on the acceleration-level KKT form (drifts: the bad example)",
+    constraints=True,
+    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    limits={"baumgarte": (0.0, True, False)},
+    settings=Index1Settings,
+    kernels=("constraints", "dynamics", "energy"))

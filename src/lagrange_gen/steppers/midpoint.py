@@ -19,21 +19,34 @@ from ``mass_matvec_dq`` and ``momentum_rate_jacobian``.
 """
 
 import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..status import OK
 from . import newton
-from .base import FAST, S_MAX_ITER, S_TOL, momentum_from_velocity, run_loop, velocity_from_momentum
+from .base import FAST, momentum_from_velocity, run_loop, velocity_from_momentum
+from .spec import NewtonSettings, Spec
 
-_VB, _QB, _R, _F, _S, _QN, _VN, _PN = 0, 1, 2, 3, 4, 5, 6, 7    # work rows
-_H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4                         # mats
+#: Scratch of one run: the Newton unknown vb and midpoint qb, residual R, momentum rate f,
+#: solver scratch s and pivots, the new state; H, the Newton matrix A, df/dq, df/dv, d(H vb)/dq.
+Workspace = namedtuple("Workspace", "vb qb R f s piv q_new v_new p_new H A Jq Jqd dHw")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps."""
-    momentum_from_velocity(kern, q, v, p, mats[_H], mom)
+    momentum_from_velocity(kern, q, v, p, ws.H, mom)
     return OK
 
 
@@ -57,17 +70,17 @@ def assemble(kern, args, vb, R, A):
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]
-    vb, qb, f = work[_VB], work[_QB], work[_F]
-    q_new, v_new, p_new = work[_QN], work[_VN], work[_PN]
+    vb, qb, f = ws.vb, ws.qb, ws.f
+    q_new, v_new, p_new = ws.q_new, ws.v_new, ws.p_new
     tm = t + 0.5 * h
     for i in range(n):
         vb[i] = v[i]
-    args = (q, mom, tm, 0.5 * h, p, qb, f, mats[_H], mats[_JQ], mats[_JQD], mats[_DHW])
-    status, iters, resid = newton.solve(_THIS, kern, args, vb, work[_R], mats[_A], piv,
-                                        work[_S], settings[S_TOL], int(settings[S_MAX_ITER]))
+    args = (q, mom, tm, 0.5 * h, p, qb, f, ws.H, ws.Jq, ws.Jqd, ws.dHw)
+    status, iters, resid = newton.solve(_THIS, kern, args, vb, ws.R, ws.A, ws.piv, ws.s,
+                                        settings.newton_tol, settings.max_iter)
     if status != OK:
         return status, iters, resid
     for i in range(n):
@@ -76,7 +89,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     kern.momentum_rate(qb, vb, tm, p, f)      # at the converged vb: p+ = p + h f exactly
     for i in range(n):
         p_new[i] = mom[i] + h * f[i]
-    status = velocity_from_momentum(kern, q_new, p_new, p, mats[_A], v_new)
+    status = velocity_from_momentum(kern, q_new, p_new, p, ws.A, v_new)
     if status != OK:
         return status, iters, resid
     for i in range(n):
@@ -94,3 +107,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="midpoint", order=2, family="implicit", implicit=True, symplectic=True, symmetric=True,
+    summary="midpoint variational integrator (A-stable)",
+    stable="linearly stable for every tau (rho = 1), accurate only for tau << 1",
+    settings=NewtonSettings,
+    kernels=("energy", "mass_matrix", "mass_matvec_dq", "momentum_rate",
+             "momentum_rate_jacobian"))

@@ -31,6 +31,7 @@ from numba import njit
 from ..linalg import lu_inplace, lu_solve_inplace
 from ..nonsmooth.play import return_map
 from ..status import NEWTON_DIVERGED, OK
+from .spec import NewtonSettings, Spec
 from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_small, max_abs,
                    run_loop)
 
@@ -201,3 +202,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="nonsmooth_euler", order=1, family="nonsmooth", implicit=True, symplectic=False,
+    symmetric=False,
+    summary="implicit Euler with Saint-Venant return map and Moreau-Jean friction",
+    elements=True, stands_in_for=("implicit_euler",), saved=(("element_state", "ne"),),
+    settings=NewtonSettings,
+    kernels=("dynamics", "elements", "elements_hessian", "energy", "mass_matvec_dq", "rhs_jacobian"))

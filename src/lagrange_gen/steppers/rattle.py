@@ -44,6 +44,7 @@ from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
+from .spec import PartitionedSettings, Spec
 from .base import (FAST, increment_converged, S_MAX_ITER, S_TOL, W_ACC, explicit_path,
                    failed_solve_status, max_abs, momentum_from_velocity, run_loop)
 from .constrained import (check_buffers, flag_index, gauss_solve, phi_small,
@@ -261,3 +262,12 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="rattle", order=2, family="constrained", implicit=True, symplectic=True,
+    symmetric=True,
+    summary="constrained Verlet, Newton on the multipliers",
+    constraints=True,
+    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    settings=PartitionedSettings,
+    kernels=("constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))

@@ -10,7 +10,7 @@ KEY of a generated module hashes the sources of the steppers it glues and of the
 modules they import (codegen.needs.source_closure), so a change there regenerates the module
 and thereby invalidates that cache.
 
-Glue signature (identical for every method)::
+Glue signature of the fixed-step methods::
 
     run_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
                  out_t, out_q, out_v, out_stats, out_extra, out_last) -> (status, steps_done)
@@ -19,15 +19,12 @@ Glue signature (identical for every method)::
     h          float             step (may be negative: steps backwards in time)
     n_steps, save_every  int     saves after every save_every-th step, plus row 0
     p          (n_params,)       parameter values in PARAMS order
-    settings   (N_SETTINGS,)     base.make_settings(newton_tol, max_iter, bound, mode)
-    out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_extra)
-               S = n_steps // save_every + 1; n_extra = 0 for the unconstrained methods, the
-               element states of nonsmooth_euler, m + 2 (multipliers, max|Phi|, max|J v|) for
-               the constrained methods (steppers/constrained.py)
-    out_last   (2 n + 3 + n_total,)  [t, q, v, Newton iterations since the last save, Newton
-                                 residual, the method's extra buffer] at the end, or at the
-                                 failure; n_total >= n_extra sizes that buffer (scratch after
-                                 the saved entries; see base.run_loop)
+    settings   the method's settings record (SPEC.settings, built by spec.make_settings)
+    out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_saved)
+               S = n_steps // save_every + 1; n_saved = SPEC.n_saved(n, m, ne), the method's
+               saved fields (multipliers and residuals, element states; none for most)
+    out_last   (2 n + 3 + n_saved,)  [t, q, v, Newton iterations since the last save, Newton
+                                 residual, saved fields] at the end, or at the failure
     status     lagrange_gen.status code; steps_done = index of the failing step on failure, -1
                when the initial state is refused (see base.run_loop)
 
@@ -37,32 +34,35 @@ arithmetic gives inf/NaN, which the run loop reports as NON_FINITE, never a Pyth
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import importlib
 
+#: The registry: one line per method, in the order reports list them. Everything else about a
+#: method is declared by its module's SPEC (spec.py).
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
            "composition", "nonsmooth_euler", "rattle", "constrained_midpoint",
            "constrained_implicit_euler", "spook", "index1")
 
-#: Methods for models with holonomic constraints (extra = multipliers and residuals, see
-#: steppers/constrained.py); simulate() refuses every other method on a constrained model and
-#: these on an unconstrained one. index1 is the acceleration-level formulation that drifts,
-#: kept as the documented bad example.
-CONSTRAINED_METHODS = ("rattle", "constrained_midpoint", "constrained_implicit_euler", "spook",
-                       "index1")
+#: {method: its Spec}.
+INFO = {m: importlib.import_module(f"{__package__}.{m}").SPEC for m in METHODS}
 
-#: Methods that treat nonsmooth elements (SaintVenant, DryFriction); simulate() routes
-#: implicit_euler to nonsmooth_euler on models that have elements.
-NONSMOOTH_METHODS = ("nonsmooth_euler",)
+#: Methods for models with holonomic constraints (they save multipliers and residuals).
+CONSTRAINED_METHODS = tuple(m for m in METHODS if INFO[m].constraints)
 
-#: Which models each method applies to, as data (what simulate() accepts; it reads the two
-#: tuples above): ``constraints`` True = only models with holonomic constraints, False = only
-#: models without; ``elements`` True = treats nonsmooth elements (the only methods for models
-#: with elements; on a model without them nonsmooth_euler is implicit Euler, and simulate and
-#: the convergence tests run it there). The generator emits glue for the methods that apply.
-APPLIES = {m: {"constraints": m in CONSTRAINED_METHODS, "elements": m in NONSMOOTH_METHODS} for m in METHODS}
+#: Methods that treat nonsmooth elements (SaintVenant, DryFriction).
+NONSMOOTH_METHODS = tuple(m for m in METHODS if INFO[m].elements)
+
+#: Methods that choose their own steps (adaptive glue signature, simulate's rtol/atol/t_eval).
+ADAPTIVE_METHODS = tuple(m for m in METHODS if INFO[m].adaptive)
 
 #: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
-ON_ELEMENTS = {"implicit_euler": "nonsmooth_euler"}
+ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}
+
+
+def spec(method: str):
+    """The Spec of a method; KeyError naming the known ones."""
+    if method not in INFO:
+        raise KeyError(f"unknown stepper method {method!r}; known: {', '.join(METHODS)}")
+    return INFO[method]
 
 
 def runs_as(method: str, n_elements: int) -> str:
@@ -72,14 +72,16 @@ def runs_as(method: str, n_elements: int) -> str:
 
 def inapplicable(method: str, n_constraints: int, n_elements: int) -> str:
     """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
-    flags = APPLIES[method]
+    flags = INFO[method]
     if n_constraints and n_elements:
         return "constraints together with nonsmooth elements are not supported by any method"
-    if bool(n_constraints) != flags["constraints"]:
+    if bool(n_constraints) != flags.constraints:
         return ("it ignores the model's constraints" if n_constraints
                 else "it is for models with constraints and this model has none")
-    if n_elements and not flags["elements"]:
-        return "it cannot treat the model's nonsmooth elements (implicit_euler runs nonsmooth_euler)"
+    if n_elements and not flags.elements:
+        standins = [f"{a} runs {m}" for a, m in ON_ELEMENTS.items()]
+        return ("it cannot treat the model's nonsmooth elements"
+                + (f" ({', '.join(standins)})" if standins else ""))
     return ""
 
 
@@ -91,48 +93,6 @@ def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
 GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
              "out_t, out_q, out_v, out_stats, out_extra, out_last")
 
-
-@dataclass(frozen=True)
-class MethodInfo:
-    """What the tests and reports may rely on for a method. ``stable``: the linear stability
-    range in tau = h omega (README's steppers table, reports/stability.md; closed forms in
-    bench.stability), quoted by simulate's energy warning; "" for the constrained methods."""
-
-    order: int
-    symplectic: bool
-    symmetric: bool
-    implicit: bool
-    summary: str
-    stable: str = ""
-
-
-INFO = {
-    "explicit_euler": MethodInfo(1, False, False, False, "forward Euler (what not to do)",
-                                 "unstable for every tau > 0 (rho = sqrt(1 + tau^2))"),
-    "symplectic_euler": MethodInfo(1, True, False, True, "symplectic Euler A in (q, p = H v)",
-                                   "stable for tau < 2"),
-    "verlet": MethodInfo(2, True, True, True, "velocity Verlet / generalized leapfrog",
-                         "stable for tau < 2"),
-    "midpoint": MethodInfo(2, True, True, True, "midpoint variational integrator (A-stable)",
-                           "linearly stable for every tau (rho = 1), accurate only for tau << 1"),
-    "implicit_euler": MethodInfo(1, False, False, True, "backward Euler (L-stable)",
-                                 "stable for every tau, damping (rho = 1/sqrt(1 + tau^2))"),
-    "rk4": MethodInfo(4, False, False, False, "classical Runge-Kutta 4",
-                      "stable for tau <= 2.83 (2 sqrt(2))"),
-    "composition": MethodInfo(4, True, True, True, "Yoshida 4th-order triple jump of verlet",
-                              "stable for tau < 1.57"),
-    "nonsmooth_euler": MethodInfo(1, False, False, True,
-                                  "implicit Euler with Saint-Venant return map and Moreau-Jean friction"),
-    "rattle": MethodInfo(2, True, True, True, "constrained Verlet, Newton on the multipliers"),
-    "constrained_midpoint": MethodInfo(2, True, True, True,
-                                       "midpoint variational integrator with constraints"),
-    "constrained_implicit_euler": MethodInfo(1, False, False, True,
-                                             "index-3 backward Euler with velocity projection"),
-    "spook": MethodInfo(1, False, False, True,
-                        "Lacoursiere's regularized linearly implicit stepper (compliance, relaxation)"),
-    "index1": MethodInfo(4, False, False, False,
-                         "rk4 on the acceleration-level KKT form (drifts: the bad example)"),
-}
 
 # _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
 # cores call kernels through; assigning it in every glue block keeps each block self-contained.
@@ -153,11 +113,10 @@ def run_{method}({wrapped}):
 
 def glue_source(method: str) -> str:
     """Source text of ``run_<method>`` to append to a generated module (deterministic)."""
-    if method not in INFO:
-        raise KeyError(f"unknown stepper method {method!r}; known: {', '.join(METHODS)}")
+    summary = spec(method).summary
     indent = " " * (len(f"def run_{method}("))
     wrapped = GLUE_ARGS.replace("settings, ", "settings,\n" + indent)
     call_indent = " " * len(f"    return _stepper_{method}.run(")
     wrapped_call = GLUE_ARGS.replace("settings, ", "settings,\n" + call_indent)
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
-                        summary=INFO[method].summary)
+                        summary=summary)

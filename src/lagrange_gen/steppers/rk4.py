@@ -18,6 +18,7 @@ import sys
 from numba import njit
 
 from ..status import OK
+from .spec import ExplicitSettings, Spec
 from .base import FAST, accel, run_loop
 from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 
@@ -55,3 +56,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="rk4", order=4, family="explicit", implicit=False, symplectic=False,
+    symmetric=False,
+    summary="classical Runge-Kutta 4",
+    stable="stable for tau <= 2.83 (2 sqrt(2))",
+    settings=ExplicitSettings,
+    kernels=("energy", "forward_dynamics"))

@@ -30,11 +30,13 @@ recommends a few steps; default 2). The reported multiplier is lam = nu / h.
 """
 
 import sys
+from typing import NamedTuple
 
 from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
+from .spec import Spec
 from .base import FAST, run_loop
 from .constrained import (S_COMPLIANCE, S_RELAXATION, check_buffers, record, schur_block,
                           solve_rows, views)
@@ -109,3 +111,21 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+class SpookSettings(NamedTuple):
+    """spook's settings (no Newton: one linear solve per step)."""
+
+    blowup_bound: float = 1e150
+    compliance: float = 0.0      # epsilon >= 0: 1/stiffness of Phi (0: rigid)
+    relaxation: float = 2.0      # d = tau / h > 0: constraint damping time in steps
+
+
+SPEC = Spec(
+    name="spook", order=1, family="constrained", implicit=True, symplectic=False,
+    symmetric=False,
+    summary="Lacoursiere's regularized linearly implicit stepper (compliance, relaxation)",
+    constraints=True,
+    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    limits={"compliance": (0.0, True, False), "relaxation": (0.0, False, False)},
+    settings=SpookSettings,
+    kernels=("constraints", "dynamics", "energy"))

@@ -19,6 +19,7 @@ import sys
 from numba import njit
 
 from ..status import OK
+from .spec import PartitionedSettings, Spec
 from .base import (FAST, S_MAX_ITER, S_TOL, accel, explicit_path, momentum_from_velocity,
                    run_loop, velocity_from_momentum)
 from .partitioned import solve_kick
@@ -81,3 +82,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="symplectic_euler", order=1, family="partitioned", implicit=True, symplectic=True,
+    symmetric=False,
+    summary="symplectic Euler A in (q, p = H v)",
+    stable="stable for tau < 2",
+    settings=PartitionedSettings,
+    kernels=("energy", "forward_dynamics", "mass_matrix", "momentum_rate", "momentum_rate_jacobian"))

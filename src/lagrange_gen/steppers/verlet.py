@@ -26,6 +26,7 @@ import sys
 from numba import njit
 
 from ..status import OK
+from .spec import PartitionedSettings, Spec
 from .base import (FAST, S_MAX_ITER, S_TOL, W_ACC, accel, explicit_path, momentum_from_velocity,
                    run_loop, velocity_from_momentum)
 from .partitioned import solve_drift, solve_kick
@@ -113,3 +114,11 @@ def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
 
 # This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="verlet", order=2, family="partitioned", implicit=True, symplectic=True,
+    symmetric=True,
+    summary="velocity Verlet / generalized leapfrog",
+    stable="stable for tau < 2",
+    settings=PartitionedSettings,
+    kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))
