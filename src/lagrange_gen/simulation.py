@@ -196,7 +196,8 @@ def _allocate(rows, n, n_saved, initial):
     extra holds the initial extra data (multipliers and residuals, or element states).
     The n_saved columns of extra are the method's saved fields (SPEC.saved)."""
     out = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
-               stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)))
+               stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)),
+               events=np.zeros((0, 3 + 2 * n)))
     if n_saved:
         out["extra"][0] = initial
     return out
@@ -209,7 +210,7 @@ def _integrate(task, q, v, out, progress):
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     last = np.empty(2 * n + 3 + out["extra"].shape[1])
     compile_time = _warm_up(task.run, q, v, t0, h, task.p, task.settings,
-                            out["extra"][:1].copy(), last.copy())
+                            out["extra"][:1].copy(), last.copy(), out["events"])
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = _ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
@@ -220,9 +221,9 @@ def _integrate(task, q, v, out, progress):
         # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
         # Newton statistics, which belong to the steps before it.
         kept = out["stats"][row].copy()
-        code, steps = task.run(q, v, t0 + done * h, h, k, task.save_every, task.p, task.settings,
-                               out["t"][rows], out["q"][rows], out["v"][rows],
-                               out["stats"][rows], out["extra"][rows], last)
+        code, steps, _ = task.run(q, v, t0 + done * h, h, k, task.save_every, task.p,
+                                  task.settings, out["t"][rows], out["q"][rows], out["v"][rows],
+                                  out["stats"][rows], out["extra"][rows], last, out["events"])
         if row > 0:
             out["stats"][row, STAT_ITERS:] = kept[STAT_ITERS:]
         if code != st.OK:
@@ -290,14 +291,14 @@ def _constrained_start(module, q, v, p, t0, tol):
     return np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial
 
 
-def _warm_up(run, q, v, t0, h, p, settings, extra, last):
+def _warm_up(run, q, v, t0, h, p, settings, extra, last, events):
     """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
     measured wall time is integration only. extra (1, n_saved) and last are scratch copies with
     the method's sizes. Returns the seconds it took."""
     n = q.shape[0]
     start = time.perf_counter()
     run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
-        np.empty((1, N_STATS)), extra, last)
+        np.empty((1, N_STATS)), extra, last, events)
     return time.perf_counter() - start
 
 

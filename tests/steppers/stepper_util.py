@@ -17,7 +17,9 @@ from lagrange_gen.codegen import generate_model
 from lagrange_gen.loader import import_generated
 
 from lagrange_gen.status import OK
-from lagrange_gen.steppers.base import N_STATS, make_settings
+from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.base import N_STATS
+from lagrange_gen.steppers.spec import make_settings
 
 HERE = Path(__file__).resolve().parent
 MODEL_FILES = {
@@ -59,15 +61,18 @@ def params(mod, **given):
 
 
 def run(mod, method, q0, v0, h, n_steps, p, t0=0.0, save_every=1, settings=None):
-    """Integrate with run_<method>; returns (t (S,), q (S, n), v (S, n), stats (S, N_STATS))."""
+    """Integrate with run_<method> (an unconstrained method without saved fields); returns
+    (t (S,), q (S, n), v (S, n), stats (S, N_STATS)). settings: a dict of the method's
+    settings (spec.make_settings), default its defaults."""
     n = mod.N_COORDS
     rows = n_steps // save_every + 1
     out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
     out_stats, out_extra, last = np.empty((rows, N_STATS)), np.empty((rows, 0)), np.empty(2 * n + 3)
-    settings = make_settings() if settings is None else settings
-    status, done = getattr(mod, f"run_{method}")(
+    record = make_settings(registry.spec(method), settings or {})
+    status, done, _ = getattr(mod, f"run_{method}")(
         np.asarray(q0, dtype=np.float64), np.asarray(v0, dtype=np.float64), float(t0), float(h),
-        n_steps, save_every, p, settings, out_t, out_q, out_v, out_stats, out_extra, last)
+        n_steps, save_every, p, record, out_t, out_q, out_v, out_stats, out_extra, last,
+        np.empty((0, 3 + 2 * n)))
     assert status == OK, f"{method}: status {status} at step {done}"
     return out_t, out_q, out_v, out_stats
 

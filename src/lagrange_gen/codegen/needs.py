@@ -21,8 +21,11 @@ _KERN = "kern"                                         # the parameter naming th
 
 def method_needs(method: str) -> frozenset:
     """Names ``kern.<name>`` used by ``steppers/<method>.py`` and everything it calls."""
+    from ..steppers.registry import LOOPS, spec
     module = f"steppers.{method}"
+    loop_module, loop = LOOPS[spec(method).adaptive]
     roots = [(module, name) for name in _parse(module).functions]
+    roots.append((f"steppers.{loop_module}", loop))     # the loop the glue runs the method in
     seen, needs = set(), set()
     while roots:
         key = roots.pop()

@@ -250,12 +250,14 @@ def _last(out_last, t, q, v, iters, resid, extra):
 
 
 @njit(inline="always")
-def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-             out_t, out_q, out_v, out_stats, out_extra, out_last):
+def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, settings,
+             out_t, out_q, out_v, out_stats, out_extra, out_last, out_events):
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
 
     ``method`` is a stepper module (its workspace, prepare and step are called), ``kern`` the
-    generated module, ``settings`` the method's settings record (spec.py).
+    generated module, ``settings`` the method's settings record (spec.py), n_saved the width
+    of the method's saved fields on this model (the glue passes it as a literal).
+    out_events (E, 3 + 2n): located events [t, event index, direction, q, v] (see events.py).
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
@@ -264,11 +266,14 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
     Newton residual, saved fields] of the final state, or on failure: of the state the failing
     step started from (Newton failure, singular mass) or of the offending state after it
     (NON_FINITE, UNSTABLE; also a non-finite energy at a saved state).
-    Returns (status, steps_done): steps_done = index of the failing step on failure, -1 when the
-    initial state itself is refused (non-finite or past the bound, its energy non-finite, or the
-    method's prepare failed).
+    Returns (status, steps_done, n_events): steps_done = index of the failing step on failure,
+    -1 when the initial state itself is refused (non-finite or past the bound, its energy
+    non-finite, or the method's prepare failed); n_events rows of out_events filled.
     """
     n = q0.shape[0]
+    if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved:
+        raise ValueError("run_<method>: out_extra needs n_saved columns and out_last "
+                         "2 n + 3 + n_saved entries (n_saved = SPEC.n_saved(n, m, ne))")
     q = q0.copy()
     v = v0.copy()
     mom = np.zeros(n)
@@ -287,7 +292,7 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
         status = NON_FINITE
     _last(out_last, t0, q, v, 0.0, 0.0, extra)
     if status != OK:
-        return status, -1
+        return status, -1, 0
     _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
     iters_acc = 0.0
     resid_max = 0.0
@@ -299,22 +304,22 @@ def run_loop(method, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
         resid_max = max(resid_max, resid)
         if status != OK:
             _last(out_last, t, q, v, iters_acc, resid, extra)
-            return status, i
+            return status, i, 0
         t_new = t0 + (i + 1) * h
         status = check_state(q, v, bound)
         if status != OK:
             _last(out_last, t_new, q, v, iters_acc, resid, extra)
-            return status, i
+            return status, i, 0
         since += 1
         if since == save_every:
             since = 0
             energy = kern.energy(q, v, t_new, p)
             if not math.isfinite(energy):      # e.g. log(x) at x <= 0: outside the model
                 _last(out_last, t_new, q, v, iters_acc, resid, extra)
-                return NON_FINITE, i
+                return NON_FINITE, i, 0
             _save((i + 1) // save_every, t_new, q, v, energy, iters_acc,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
             iters_acc = 0.0
             resid_max = 0.0
     _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max, extra)
-    return OK, n_steps
+    return OK, n_steps, 0

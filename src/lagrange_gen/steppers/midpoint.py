@@ -26,7 +26,7 @@ from numba import njit
 
 from ..status import OK
 from . import newton
-from .base import FAST, momentum_from_velocity, run_loop, velocity_from_momentum
+from .base import FAST, momentum_from_velocity, velocity_from_momentum
 from .spec import NewtonSettings, Spec
 
 #: Scratch of one run: the Newton unknown vb and midpoint qb, residual R, momentum rate f,
@@ -97,15 +97,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return OK, iters, resid
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop."""
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

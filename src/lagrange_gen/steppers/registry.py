@@ -90,8 +90,12 @@ def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
     return tuple(m for m in METHODS if not inapplicable(m, n_constraints, n_elements))
 
 
+#: Glue arguments of the adaptive methods (see adaptive.run_adaptive).
+ADAPTIVE_GLUE_ARGS = ("q0, v0, t0, t_end, h0, p, settings, t_eval, "
+                      "out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters")
+
 GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
-             "out_t, out_q, out_v, out_stats, out_extra, out_last")
+             "out_t, out_q, out_v, out_stats, out_extra, out_last, out_events")
 
 
 # _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
@@ -99,24 +103,36 @@ GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
 _GLUE = '''import sys as _sys
 
 from lagrange_gen.steppers import {method} as _stepper_{method}
+from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}
 
 _THIS_MODULE = _sys.modules[__name__]
 
 
 @njit(cache=True, error_model="numpy")
 def run_{method}({wrapped}):
-    """Integrate with {method} ({summary}); returns (status, steps_done).
+    """Integrate with {method} ({summary}); returns (status, steps_done, n_events).
 
     Argument shapes: see lagrange_gen.steppers.registry; lagrange_gen.simulate wraps this."""
-    return _stepper_{method}.run(_THIS_MODULE, {wrapped_call})'''
+    return _{loop}(_stepper_{method}, _THIS_MODULE, {n_saved}, {wrapped_call})'''
+
+#: The jitted loop each kind of method runs in: (module, function).
+LOOPS = {False: ("base", "run_loop"), True: ("adaptive", "run_adaptive")}
 
 
-def glue_source(method: str) -> str:
-    """Source text of ``run_<method>`` to append to a generated module (deterministic)."""
-    summary = spec(method).summary
+def glue_args(method: str) -> str:
+    """The argument list of ``run_<method>`` (fixed-step or adaptive)."""
+    return ADAPTIVE_GLUE_ARGS if spec(method).adaptive else GLUE_ARGS
+
+
+def glue_source(method: str, n_saved: int) -> str:
+    """Source text of ``run_<method>`` to append to a generated module whose model gives the
+    method n_saved saved fields (SPEC.n_saved); deterministic."""
+    loop_module, loop = LOOPS[spec(method).adaptive]
+    args = glue_args(method)
     indent = " " * (len(f"def run_{method}("))
-    wrapped = GLUE_ARGS.replace("settings, ", "settings,\n" + indent)
-    call_indent = " " * len(f"    return _stepper_{method}.run(")
-    wrapped_call = GLUE_ARGS.replace("settings, ", "settings,\n" + call_indent)
+    wrapped = args.replace("settings, ", "settings,\n" + indent)
+    call_indent = " " * len(f"    return _{loop}(")
+    wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
-                        summary=summary)
+                        summary=spec(method).summary, loop_module=loop_module, loop=loop,
+                        n_saved=n_saved)
