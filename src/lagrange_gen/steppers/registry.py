@@ -91,7 +91,7 @@ def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
 
 
 #: Glue arguments of the adaptive methods (see adaptive.run_adaptive).
-ADAPTIVE_GLUE_ARGS = ("q0, v0, t0, t_end, h0, p, settings, t_eval, "
+ADAPTIVE_GLUE_ARGS = ("q0, v0, t0, t_end, p, settings, t_eval, "
                       "out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters")
 
 GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
