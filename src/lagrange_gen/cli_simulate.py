@@ -21,6 +21,7 @@ from pathlib import Path
 
 from .errors import SimulationError
 from .steppers.registry import INFO, METHODS
+from .steppers.spec import SETTING_HELP
 
 OUT_SUFFIXES = (".npz", ".csv")
 PLOT_SUFFIXES = (".png", ".pdf", ".svg")
@@ -28,17 +29,19 @@ PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 def add_parser(subparsers):
     """Add the ``simulate`` subcommand to an argparse subparsers object."""
-    methods = "\n".join(f"  {m:17s} order {INFO[m].order}, {INFO[m].summary}" for m in METHODS)
+    methods = "\n".join(f"  {m:27s} order {INFO[m].order}, {INFO[m].summary}" for m in METHODS)
     p = subparsers.add_parser(
         "simulate", help="integrate a model with one of the steppers",
         description="Integrate a model file (generated into --gen-dir when missing or stale) or a "
-                    "generated module with a fixed step; print a summary, optionally write the "
-                    "trajectory (.npz or .csv) and a plot (.png).",
+                    "generated module; print a summary, optionally write the trajectory (.npz or "
+                    ".csv) and a plot (.png). A method's settings are options named after its "
+                    "settings record; an option the method does not have is refused.",
         epilog="methods:\n" + methods, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("model", metavar="MODEL.py", help="model file or generated module")
     p.add_argument("--method", default="midpoint", choices=METHODS,
                    help="stepper (default: midpoint)")
-    p.add_argument("--h", type=float, required=True, help="step size")
+    p.add_argument("--h", type=float,
+                   help="step size (required by the fixed-step methods; adaptive: first step)")
     p.add_argument("--t-end", type=float, required=True, help="final time")
     p.add_argument("--t0", type=float, default=0.0, help="initial time (default 0)")
     p.add_argument("--q0", type=float, nargs="+", metavar="Q",
@@ -48,25 +51,53 @@ def add_parser(subparsers):
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="parameter value, repeatable (default: the model's defaults)")
     p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
-    p.add_argument("--newton-tol", type=float, default=1e-12,
-                   help="Newton tolerance (default 1e-12)")
-    p.add_argument("--max-iter", type=int, default=50, help="Newton iteration cap (default 50)")
+    p.add_argument("--t-eval", type=float, nargs="+", metavar="T",
+                   help="adaptive methods: save the states at these times (default: every step)")
     p.add_argument("--out", metavar="FILE", help="write the trajectory (.npz or .csv)")
     p.add_argument("--plot", metavar="FILE.png",
                    help="plot coordinates and energy error (.png, .pdf or .svg)")
     p.add_argument("--gen-dir", default="generated", metavar="DIR",
                    help="where model files are generated (default: generated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
-    p.add_argument("--compliance", type=float, default=0.0, metavar="EPS",
-                   help="spook: constraint compliance epsilon >= 0 (0: rigid; 1/k: a spring of stiffness k)")
-    p.add_argument("--relaxation", type=float, default=2.0, metavar="D",
-                   help="spook: relaxation d > 0 in steps (default 2)")
-    p.add_argument("--baumgarte", type=float, nargs=2, default=(0.0, 0.0), metavar=("ALPHA", "BETA"),
-                   help="index1: Baumgarte stabilization gains (default 0 0)")
+    _add_setting_options(p)
     p.add_argument("--force", action="store_true",
                    help="regenerate the module even when the one on disk comes from another model "
                         "file or was generated with another freeze or build options")
     return p
+
+
+def _setting_fields():
+    """{field: (default, methods having it)} over every method's settings record, in order."""
+    fields = {}
+    for m in METHODS:
+        record = INFO[m].settings
+        for name in record._fields:
+            fields.setdefault(name, (record._field_defaults[name], []))[1].append(m)
+    return fields
+
+
+def _add_setting_options(p):
+    """One option per settings field of any method (--newton-tol, --compliance, --rtol, ...):
+    read from the methods' specs, so a new method's settings need no edit here. Every option
+    defaults to None: only what the user gives reaches simulate."""
+    group = p.add_argument_group("method settings (each applies to the methods listed)")
+    for name, (default, methods) in _setting_fields().items():
+        which = ", ".join(methods) if len(methods) < len(METHODS) else "every method"
+        text = f"{SETTING_HELP.get(name, name)} [{which}; default {default}]"
+        flag = "--" + name.replace("_", "-")
+        if isinstance(default, bool):
+            group.add_argument(flag, action="store_true", default=None, help=text)
+        elif isinstance(default, tuple):
+            group.add_argument(flag, type=float, nargs=len(default), default=None, help=text)
+        else:
+            group.add_argument(flag, type=type(default), default=None, help=text)
+
+
+def _given_settings(args):
+    """{field: value} of the settings options the user gave."""
+    given = {name: getattr(args, name) for name in _setting_fields()}
+    return {name: tuple(v) if isinstance(v, list) else v for name, v in given.items()
+            if v is not None}
 
 
 def _parse_params(pairs):
@@ -121,11 +152,9 @@ def run(args) -> int:
         try:
             traj = simulate(args.model, args.method, args.q0, args.v0, t_end=args.t_end,
                             h=args.h, params=_parse_params(args.param),
-                            save_every=args.save_every, newton_tol=args.newton_tol,
-                            max_iter=args.max_iter, t0=args.t0, progress=args.progress,
-                            out_dir=args.gen_dir, compliance=args.compliance,
-                            relaxation=args.relaxation, baumgarte=tuple(args.baumgarte),
-                            force=args.force)
+                            save_every=args.save_every, t_eval=args.t_eval, t0=args.t0,
+                            progress=args.progress, out_dir=args.gen_dir, force=args.force,
+                            **_given_settings(args))
         finally:
             for warning in caught:      # one line each, also when the run then failed
                 print(f"lagrange-gen: warning: {warning.message}", file=sys.stderr)
@@ -136,8 +165,13 @@ def run(args) -> int:
 
 def _summary(traj):
     per_step = traj.wall_time / max(traj.n_steps, 1)
-    print(f"model {traj.model}, method {traj.method}, h = {traj.h:g}, "
+    kind = "mean h" if traj.step_counts else "h"
+    print(f"model {traj.model}, method {traj.method}, {kind} = {traj.h:g}, "
           f"{traj.n_steps} steps to t = {traj.t[-1]:.9g}")
+    if traj.step_counts:
+        print("adaptive: " + ", ".join(f"{k} {v}" for k, v in traj.step_counts.items()))
+    for event in traj.events[:10]:
+        print(f"event {event}")
     print(f"wall time {traj.wall_time:.3f} s ({per_step * 1e9:.0f} ns/step), "
           f"compile/load {traj.compile_time:.2f} s")
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")

@@ -38,9 +38,9 @@ POWER_RTOL = 1e-6
 _SAMPLES = 4
 
 
-def energy_warning(module, method, q, v, t, energy, p, h):
+def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
     """One line (str) or None. q, v (S, n), t (S,), energy (S,) of a finished unconstrained run,
-    p (n_params,), h the step."""
+    p (n_params,), h the step (an adaptive run: its mean step), advice what to change."""
     err = float(np.max(np.abs(energy - energy[0])))
     floor = 64 * np.finfo(float).eps * float(np.max(np.abs(energy)))
     if not err > floor:
@@ -58,7 +58,7 @@ def energy_warning(module, method, q, v, t, energy, p, h):
     return (f"{module.NAME}, {method}: max |E - E0| = {err:.3g} is {err / scale:.3g} times the "
             f"energy scale {scale:.3g} (max T + range of V over the run; warning above "
             f"{ENERGY_FRACTION:g}) on a conservative model: h omega_max = {tau} at q0 "
-            f"(K v = omega^2 H v, K = dg/dq), and {method} is {stable}; reduce h")
+            f"(K v = omega^2 H v, K = dg/dq), and {method} is {stable}; {advice}")
 
 
 def energy_scale(module, q, t, energy, p):

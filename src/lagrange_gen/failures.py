@@ -28,11 +28,12 @@ def format_state(coords, q, v):
 
 
 def raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
-    """Raise the exception of status ``code``; step is 1-based, 0 for the initial state."""
+    """Raise the exception of status ``code``; step is 1-based, 0 for the initial state;
+    n_steps None for an adaptive run (its step count is not known in advance)."""
     n = module.N_COORDS
     t, q, v, resid = last[0], last[1:1 + n], last[1 + n:1 + 2 * n], last[2 + 2 * n]
     state = format_state(module.COORDS, q, v)
-    at = "the initial state" if step == 0 else f"step {step} of {n_steps}"
+    at = "the initial state" if step == 0 else f"step {step}" + (f" of {n_steps}" if n_steps else "")
     where = f"{module.NAME}, {method}: {at} (t = {t:.9g}, h = {h:g})"
     kwargs = dict(step=step, time=float(t), state=np.concatenate([q, v]), residual=float(resid))
     if code == st.NEWTON_DIVERGED and math.isfinite(resid):

@@ -57,6 +57,23 @@ def check_scalars(h, t0, t_end, save_every):
         raise SimulationError(f"save_every must be a positive integer, got {save_every!r}")
 
 
+def check_t_eval(t_eval, t0, t_end):
+    """t_eval: finite, strictly increasing times within [t0, t_end]."""
+    try:
+        times = np.asarray(t_eval, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SimulationError(f"t_eval must be a sequence of numbers, got {t_eval!r}") from None
+    if times.ndim != 1 or not len(times) or not np.all(np.isfinite(times)):
+        raise SimulationError("t_eval must be a non-empty 1-d sequence of finite times")
+    if np.any(np.diff(times) <= 0):
+        k = int(np.argmax(np.diff(times) <= 0))
+        raise SimulationError(f"t_eval must be strictly increasing: t_eval[{k + 1}] = "
+                              f"{times[k + 1]:g} after {times[k]:g}")
+    if times[0] < t0 or times[-1] > t_end:
+        raise SimulationError(f"t_eval must lie in [t0, t_end] = [{t0:g}, {t_end:g}], got "
+                              f"[{times[0]:g}, {times[-1]:g}]")
+
+
 def vector(name, value, n, coords):
     """value as a float64 vector (n,) (zeros when None), or a SimulationError naming ``name``."""
     if value is None:

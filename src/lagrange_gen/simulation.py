@@ -5,18 +5,17 @@
     traj.plot("traj.png"); traj.to_npz("traj.npz")
 
 The integration itself runs inside the generated module's jitted ``run_<method>`` (see
-steppers/registry.py), in chunks of steps so that a progress bar can be shown; this driver only
-checks inputs (run_checks: element coefficients, step count, time resolution, memory), allocates
-outputs, turns status codes into exceptions that name the step, the time, the state and (for
-Newton) the residual (failures.py), and warns when a conservative run lost its energy
-(energy_check.py).
+steppers/registry.py), driven in chunks by fixed_run.py or, for an adaptive method, by
+adaptive_run.py; this module only checks inputs (run_checks: element coefficients, step count,
+time resolution, memory; the method's settings by its spec), builds the Trajectory from the
+method's declared saved fields, and warns when a conservative run lost its energy
+(energy_check.py). What a method is and which models it applies to is read from its spec
+(steppers/spec.py), never from its name.
 """
 
 from __future__ import annotations
 
 import math
-import sys
-import time
 import types
 import warnings
 from dataclasses import dataclass
@@ -26,21 +25,19 @@ import numpy as np
 
 from . import run_checks
 from . import status as st
+from .adaptive_run import C_ACCEPTED, C_EVALS, C_REJECTED, integrate_adaptive
 from .energy_check import energy_warning
 from .errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
+from .fixed_run import allocate, integrate_fixed, n_steps_to
 from .keys import regeneration_command_for
 from .params import resolve_params
 from .steppers import registry
-from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
+from .steppers.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
 from .steppers.spec import make_settings
 from .trajectory import Trajectory
 
 __all__ = ["simulate", "Trajectory", "load_module"]
-
-#: Steps per call into the jitted loop (a multiple of save_every is used): large enough that the
-#: Python overhead per chunk (a few microseconds) is negligible, small enough for a progress bar.
-CHUNK_STEPS = 200_000
 
 
 def load_module(module_or_path, out_dir="generated", method=None, force=False):
@@ -62,15 +59,6 @@ def load_module(module_or_path, out_dir="generated", method=None, force=False):
     return module
 
 
-def _n_steps(t0, t_end, h):
-    """Whole steps to reach t_end; rounded up when (t_end - t0) / h is not an integer."""
-    ratio = (t_end - t0) / h
-    nearest = round(ratio)
-    if abs(ratio - nearest) <= 1e-9 * max(1.0, abs(ratio)):
-        return int(nearest)
-    return int(math.ceil(ratio))
-
-
 def _runner(module, method):
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
@@ -84,57 +72,63 @@ def _runner(module, method):
 
 
 def _element_method(module, method):
-    """The method that actually runs: implicit_euler becomes nonsmooth_euler on a model with
-    nonsmooth elements; a method that cannot treat them is refused, naming them."""
+    """The method that actually runs: on a model with nonsmooth elements a method that a
+    nonsmooth one stands in for (SPEC.stands_in_for) becomes it; a method that cannot treat
+    them is refused, naming them."""
     names = tuple(getattr(module, "ELEMENTS", ()))
     runs = registry.runs_as(method, len(names)) if method in registry.METHODS else method
-    if not names or runs in registry.NONSMOOTH_METHODS:
+    if not names or runs not in registry.METHODS or registry.spec(runs).elements:
         return runs
+    use = "; ".join(f"method={asked!r} (runs {m}: {registry.spec(m).summary})"
+                    for asked, m in registry.ON_ELEMENTS.items())
     raise SimulationError(
-        f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) {', '.join(names)} "
-        f"(no silent regularization); use method='implicit_euler' (exact Saint-Venant return map, "
-        f"Moreau-Jean dry friction)")
+        f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) "
+        f"{', '.join(names)} (no silent regularization); use {use}")
 
 
 def _element_energy(module, p, state):
     """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
-    if not module.N_ELEMENTS:
-        return 0.0
     coef = run_checks.element_coefficients(module, p)
     k = np.where(coef[:, 2] == 0.0, coef[:, 0], 0.0)
     return 0.5 * (state**2 * k).sum(axis=1)
 
 
-def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, params=None,
-             save_every=1, t0=0.0, progress=False, out_dir="generated", element_state0=None,
-             force=False, **settings) -> Trajectory:
-    """Integrate a generated model from t0 to t_end with fixed step h.
+def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
+             save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
+             element_state0=None, force=False, **settings) -> Trajectory:
+    """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
         into out_dir when missing or stale; see load_module, and ``force`` there).
     method: one of steppers.registry.METHODS.
     q0, v0: initial coordinates and velocities (n,), default zeros.
+    h: the step of a fixed-step method (required); for an adaptive method (dop853) only the
+        first step tried (default: chosen automatically).
     params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
         parameter without default must be given.
-    save_every: keep every save_every-th state (the initial and the final state are always kept).
+    save_every: fixed-step methods keep every save_every-th state (the initial and the final
+        state are always kept).
+    t_eval: adaptive methods return the states at these increasing times in [t0, t_end] (from
+        the dense output); default: the state after every accepted step.
     element_state0: initial states of the nonsmooth elements (ne,), default 0 (virgin material).
         On models with elements, method implicit_euler runs nonsmooth_euler; the trajectory's
         energy then includes the elastic energy k u^2 / 2 stored in Saint-Venant elements.
-    settings: the method's settings by name (its SPEC.settings record; unknown names are
-        refused): blowup_bound (BlowUp when |q| or |v| exceeds it) for every method;
+    settings: the method's settings by name (its SPEC.settings record; a name the method does
+        not have is refused): blowup_bound (BlowUp when |q| or |v| exceeds it) for every method;
         newton_tol (relative to max(1, |unknown|), see steppers.base.newton_converged) and
         max_iter for the implicit ones; newton_always (the Newton path of the partitioned
         methods even when the model allows the explicit one); spook's compliance (epsilon >= 0)
-        and relaxation (d > 0); index1's baumgarte = (alpha, beta).
+        and relaxation (d > 0); index1's baumgarte = (alpha, beta); dop853's rtol, atol, h_max.
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.consistent), and the Trajectory carries the multipliers and
     max|Phi|, max|J v| per saved state.
-    The final time is t0 + n_steps h with n_steps = (t_end - t0) / h rounded up to a whole step.
+    A fixed-step run ends at t0 + n_steps h with n_steps = (t_end - t0) / h rounded up.
     Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
     SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
-    blowup_bound). A conservative run whose energy error passes energy_check.ENERGY_FRACTION of
-    its energy scale warns (EnergyWarning, the line also in Trajectory.warnings).
+    blowup_bound), StepSizeTooSmall (adaptive). A conservative run whose energy error passes
+    energy_check.ENERGY_FRACTION of its energy scale warns (EnergyWarning, the line also in
+    Trajectory.warnings).
     """
     module = load_module(module_or_path, out_dir, method, force)
     method = _element_method(module, method)
@@ -143,43 +137,71 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h, p
     run = _runner(module, method)
     spec = registry.spec(method)
     n = module.N_COORDS
-    run_checks.check_scalars(h, t0, t_end, save_every)
+    h = _check_times(spec, h, t0, t_end, save_every, t_eval)
     config = make_settings(spec, settings)
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
     p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME,
                        frozen=getattr(module, "FROZEN", None))
     run_checks.check_element_coefficients(module, p)
-    h, t0, save_every = float(h), float(t0), int(save_every)
-    run_checks.check_step_count(t0, float(t_end), h)
-    n_steps = _n_steps(t0, float(t_end), h)
-    run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
+    t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS)
-    run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     initial = np.zeros(0)
     if spec.constraints:
         q, v, initial = _constrained_start(module, q, v, p, t0,
                                            getattr(config, "newton_tol", 1e-12))
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    if spec.adaptive:
+        task = _Task(module, spec, run, p, config, h, t0, 0, 1)
+        wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
+        out, compile_time, wall = integrate_adaptive(
+            task, q, v, initial, t_end, None if wanted is None else wanted[wanted > t0], progress)
+        return _adaptive_trajectory(task, out, wanted, wall, compile_time)
+    n_steps = n_steps_to(t0, t_end, h)
+    run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
+    run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every)
-    out = _allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial)
-    compile_time, wall = _integrate(task, q, v, out, progress)
+    out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
+                   getattr(module, "N_EVENTS", 0))
+    compile_time, wall = integrate_fixed(task, q, v, out, progress)
     return _trajectory(task, out, wall, compile_time)
+
+
+def _check_times(spec, h, t0, t_end, save_every, t_eval):
+    """The step (float, or 0.0 for an adaptive method's automatic first step) after checking
+    the time arguments; SimulationError naming the one that is wrong."""
+    if spec.adaptive:
+        run_checks.check_scalars(1.0 if h is None else h, t0, t_end, save_every)
+        if save_every != 1:
+            raise SimulationError(f"save_every is for the fixed-step methods; {spec.name} saves "
+                                  f"every accepted step, or the times given as t_eval")
+        if t_eval is not None:
+            run_checks.check_t_eval(t_eval, t0, t_end)
+        return 0.0 if h is None else float(h)
+    if h is None:
+        raise SimulationError(f"method {spec.name!r} has a fixed step: give h")
+    if t_eval is not None:
+        raise SimulationError(f"t_eval is for the adaptive methods "
+                              f"({', '.join(registry.ADAPTIVE_METHODS)}); {spec.name} saves every "
+                              f"save_every-th step")
+    run_checks.check_scalars(h, t0, t_end, save_every)
+    run_checks.check_step_count(float(t0), float(t_end), float(h))
+    return float(h)
 
 
 @dataclass
 class _Task:
-    """What one run integrates: the module, the method and its glue, and the run's numbers."""
+    """What one run integrates: the module, the method's spec and glue, and the run's numbers."""
 
     module: types.ModuleType
     spec: object        # the method's Spec
     run: object
     p: np.ndarray
     settings: tuple     # the method's settings record
-    h: float
+    h: float            # the step (adaptive: the first step tried, 0 = automatic)
     t0: float
-    n_steps: int
+    n_steps: int        # fixed-step methods
     save_every: int
 
     @property
@@ -191,93 +213,83 @@ class _Task:
         return getattr(self.settings, "max_iter", 0)
 
 
-def _allocate(rows, n, n_saved, initial):
-    """Output arrays {t (S,), q, v (S, n), stats (S, N_STATS), extra (S, n_saved)}; row 0 of
-    extra holds the initial extra data (multipliers and residuals, or element states).
-    The n_saved columns of extra are the method's saved fields (SPEC.saved)."""
-    out = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
-               stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)),
-               events=np.zeros((0, 3 + 2 * n)))
-    if n_saved:
-        out["extra"][0] = initial
-    return out
-
-
-def _integrate(task, q, v, out, progress):
-    """Run the glue chunk by chunk from (q, v), filling ``out``; fills out["last"] and
-    out["rows"] (rows used). Returns (compile seconds, integration seconds). Raises the
-    exception of a failure status (failures.raise_for_status)."""
-    m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
-    last = np.empty(2 * n + 3 + out["extra"].shape[1])
-    compile_time = _warm_up(task.run, q, v, t0, h, task.p, task.settings,
-                            out["extra"][:1].copy(), last.copy(), out["events"])
-    chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
-    bar = _ProgressBar(task.n_steps) if progress else None
-    start = time.perf_counter()
-    done, row = 0, 0
-    while True:
-        k = min(chunk, task.n_steps - done)
-        rows = slice(row, row + k // task.save_every + 1)
-        # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
-        # Newton statistics, which belong to the steps before it.
-        kept = out["stats"][row].copy()
-        code, steps, _ = task.run(q, v, t0 + done * h, h, k, task.save_every, task.p,
-                                  task.settings, out["t"][rows], out["q"][rows], out["v"][rows],
-                                  out["stats"][rows], out["extra"][rows], last, out["events"])
-        if row > 0:
-            out["stats"][row, STAT_ITERS:] = kept[STAT_ITERS:]
-        if code != st.OK:
-            raise_for_status(code, m, task.method, done + steps + 1, task.n_steps, last,
-                             task.max_iter, h, task.p)
-        q, v = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy()
-        done += k
-        row += k // task.save_every
-        if bar:
-            bar.update(done)
-        if done >= task.n_steps:
-            break
-    wall = time.perf_counter() - start
-    if bar:
-        bar.close()
-    out["last"], out["rows"] = last, row + 1
-    return compile_time, wall
-
-
 def _trajectory(task, out, wall, compile_time):
-    """The Trajectory of a finished run: times t0 + k h (not accumulated, independent of the
-    chunking), the final state when it is not on a save, energies, and the energy warning."""
+    """The Trajectory of a finished fixed-step run: times t0 + k h (not accumulated,
+    independent of the chunking), the final state when it is not on a save (or a terminal
+    event stopped the run), energies, and the energy warning."""
     m, n, h, p = task.module, task.module.N_COORDS, task.h, task.p
-    last, row, n_saved = out["last"], out["rows"] - 1, out["extra"].shape[1]
+    last, row = out["last"], out["rows"] - 1
     out["t"][:row + 1] = task.t0 + h * task.save_every * np.arange(row + 1)
-    if task.n_steps % task.save_every:
+    steps = out["steps"]
+    if steps % task.save_every or steps < task.n_steps:
         row += 1
         q, v = last[1:1 + n], last[1 + n:1 + 2 * n]
-        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v),
-                          task.t0 + task.n_steps * h, p)
+        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v), float(last[0]), p)
         if not math.isfinite(energy):
-            raise_for_status(st.NON_FINITE, m, task.method, task.n_steps, task.n_steps, last,
+            raise_for_status(st.NON_FINITE, m, task.method, steps, task.n_steps, last,
                              task.max_iter, h, p)
-        out["t"][row], out["q"][row], out["v"][row] = task.t0 + task.n_steps * h, q, v
+        out["t"][row], out["q"][row], out["v"][row] = last[0], q, v
         out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n])
-        out["extra"][row] = last[3 + 2 * n:3 + 2 * n + n_saved]
-    layout = task.spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS)
-    saved = {name: out["extra"][:, start:start + width].copy() for name, start, width in layout}
-    energy = out["stats"][:, STAT_ENERGY]
+        out["extra"][row] = last[3 + 2 * n:]
+    rows = slice(0, row + 1)
+    traj = _build(task, {k: out[k][rows] for k in ("t", "q", "v", "stats", "extra")},
+                  out, steps, h, wall, compile_time)
+    return _warn_energy(task, traj, h, "reduce h")
+
+
+def _adaptive_trajectory(task, out, t_eval, wall, compile_time):
+    """The Trajectory of an adaptive run; with t_eval, only the requested times (row 0, the
+    initial state, only when t_eval starts at t0). h = the mean accepted step."""
+    rows = {k: out[k] for k in ("t", "q", "v", "stats", "extra")}
+    if t_eval is not None and not (len(t_eval) and t_eval[0] == task.t0):
+        rows = {k: a[1:] for k, a in rows.items()}
+    counters = out["counters"]
+    accepted = int(counters[C_ACCEPTED])
+    h = (out["last"][0] - task.t0) / max(accepted, 1)
+    traj = _build(task, rows, out, accepted, h, wall, compile_time)
+    traj.newton_iters[:] = 0.0          # the stats columns hold step counts and error norms
+    traj.newton_residual[:] = 0.0
+    traj.saved["accepted_steps"] = rows["stats"][:, STAT_ITERS:STAT_ITERS + 1].copy()
+    traj.saved["error_norm"] = rows["stats"][:, STAT_RESIDUAL:STAT_RESIDUAL + 1].copy()
+    traj.step_counts = dict(accepted=accepted, rejected=int(counters[C_REJECTED]),
+                            evaluations=int(counters[C_EVALS]))
+    return _warn_energy(task, traj, h, "tighten rtol and atol")
+
+
+def _build(task, rows, out, steps, h, wall, compile_time):
+    """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
+    m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
+    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS)
+    saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
+    energy = rows["stats"][:, STAT_ENERGY].copy()
     if "element_state" in saved:
         energy = energy + _element_energy(m, p, saved["element_state"])
-    traj = Trajectory(t=out["t"], q=out["q"], v=out["v"], energy=energy,
-                      newton_iters=out["stats"][:, STAT_ITERS].copy(),
-                      newton_residual=out["stats"][:, STAT_RESIDUAL].copy(), method=task.method,
+    return Trajectory(t=rows["t"], q=rows["q"], v=rows["v"], energy=energy,
+                      newton_iters=rows["stats"][:, STAT_ITERS].copy(),
+                      newton_residual=rows["stats"][:, STAT_RESIDUAL].copy(), method=spec.name,
                       h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
-                      coords=tuple(m.COORDS), n_steps=task.n_steps, wall_time=wall,
+                      coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
                       compile_time=compile_time, saved=saved,
-                      element_names=tuple(m.ELEMENTS) if task.spec.elements else (),
-                      constraint_names=tuple(m.CONSTRAINTS) if task.spec.constraints else ())
-    message = energy_warning(m, task.method, traj.q, traj.v, traj.t, traj.energy, p, h)
+                      element_names=tuple(m.ELEMENTS) if spec.elements else (),
+                      constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
+                      events=_events(m, out))
+
+
+def _events(module, out):
+    """The located events of a run (steppers/events.py), () for a model without events."""
+    if not out["n_events"]:
+        return ()
+    from .steppers.events import events_table
+    return events_table(module, out["events"], out["n_events"])
+
+
+def _warn_energy(task, traj, h, advice):
+    message = energy_warning(task.module, task.method, traj.q, traj.v, traj.t, traj.energy,
+                             task.p, h, advice)
     if message:
         traj.warnings.append(message)
-        # stacklevel 3: _trajectory <- simulate <- the user's call
-        warnings.warn(message, EnergyWarning, stacklevel=3)
+        # stacklevel 4: _warn_energy <- _trajectory <- simulate <- the user's call
+        warnings.warn(message, EnergyWarning, stacklevel=4)
     return traj
 
 
@@ -289,35 +301,3 @@ def _constrained_start(module, q, v, p, t0, tol):
     state = consistent_initial_state(module, q, v, p, t0, tol, stacklevel=4)
     initial = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
     return np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial
-
-
-def _warm_up(run, q, v, t0, h, p, settings, extra, last, events):
-    """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
-    measured wall time is integration only. extra (1, n_saved) and last are scratch copies with
-    the method's sizes. Returns the seconds it took."""
-    n = q.shape[0]
-    start = time.perf_counter()
-    run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
-        np.empty((1, N_STATS)), extra, last, events)
-    return time.perf_counter() - start
-
-
-class _ProgressBar:
-    """A one-line text bar on stderr, redrawn only when the percentage changes."""
-
-    def __init__(self, total, width=40, stream=None):
-        self.total, self.width, self.stream = max(total, 1), width, stream or sys.stderr
-        self.shown = -1
-        self.update(0)
-
-    def update(self, done):
-        pct = int(100 * done / self.total)
-        if pct != self.shown:
-            self.shown = pct
-            filled = self.width * pct // 100
-            self.stream.write(f"\r[{'#' * filled}{' ' * (self.width - filled)}] {pct:3d}%")
-            self.stream.flush()
-
-    def close(self):
-        self.stream.write("\n")
-        self.stream.flush()

@@ -39,6 +39,8 @@ class Trajectory:
     element_names: tuple = ()
     constraint_names: tuple = ()
     warnings: list = field(default_factory=list)   # one line each (also issued as Python warnings)
+    events: tuple = ()          # located events (steppers/events.py events_table), in time order
+    step_counts: dict = field(default_factory=dict)  # adaptive runs: accepted, rejected, evaluations
 
     def field(self, name):
         """The saved field ``name`` (S, width), or None when the method does not save it."""

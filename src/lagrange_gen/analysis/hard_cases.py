@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..steppers import registry
 from . import reference, scenes, stability
 from .runs import fmt, guarded_run, load_module, params_of, short_error, \
     unconstrained_methods
@@ -47,19 +48,22 @@ def case3_tau(osc, methods=None):
     2 atan(tau / 2). ``methods`` restricts the unconstrained methods (None: all)."""
     rows, oks = [], []
     for method, tau, rho, closed in stability.tau_table(osc, _methods(methods)):
+        spec = registry.spec(method)
         ok = closed is None or abs(rho - closed) <= 1e-10 * max(1.0, closed)
-        if method == "verlet":
-            ok = ok and ((abs(rho - 1) < 1e-10) if tau < 2 else (rho > 1 + 1e-3))
-        if method == "midpoint":
+        if spec.symplectic and spec.stable_tau and tau < spec.stable_tau:
+            ok = ok and abs(rho - 1) < 1e-10     # symplectic and stable: neither grows nor damps
+        if spec.phase is not None:
             phase = stability.phase_per_step(stability.step_matrix(osc, method, tau))
-            ok = ok and abs(phase - stability.midpoint_phase(tau)) <= 1e-10
+            ok = ok and abs(phase - spec.phase(tau)) <= 1e-10
         oks.append(ok)
         rows.append([method, f"{tau:g}", f"{rho:.10g}", fmt(closed, ".10g"),
                      PASS if ok else FAIL])
-    notes = ["Closed forms: explicit Euler sqrt(1 + tau^2), implicit Euler 1/sqrt(1 + tau^2), "
-             "midpoint 1 (phase 2 atan(tau/2) checked), Verlet and symplectic Euler 1 for "
-             "tau <= 2 (trace 2 - tau^2, det 1), RK4 |1 + z + ... + z^4/24| at z = i tau, "
-             "composition the product of three Verlet matrices. Tolerance 1e-10 relative."]
+    notes = ["Closed forms (each method's SPEC.rho, and SPEC.phase where declared): explicit "
+             "Euler sqrt(1 + tau^2), implicit Euler 1/sqrt(1 + tau^2), midpoint 1 (phase "
+             "2 atan(tau/2) checked), Verlet and symplectic Euler 1 for tau <= 2 (trace "
+             "2 - tau^2, det 1), RK4 |1 + z + ... + z^4/24| at z = i tau, the compositions the "
+             "product of their Verlet matrices; a symplectic method has rho = 1 below its "
+             "SPEC.stable_tau. Tolerance 1e-10 relative."]
     return CaseResult(3, "linear stability: rho(tau) of the step matrix", _verdict(oks),
                       ["method", "tau", "measured rho", "closed form", "verdict"], rows, notes)
 
@@ -69,16 +73,25 @@ def case3_tau(osc, methods=None):
 COMPLIANCES = (1e-1, 1e-4, 1e-6)
 BOUNDED = frozenset({"accurate", "inaccurate", "stiff mode kept", "over-damped"})
 GREW = "energy grew / blew up"
-_EXPLICIT_AT_TAU_10 = ("explicit_euler", "symplectic_euler", "verlet", "rk4", "composition")
-#: HARD_CASES case 4 and the slides: at low frequency (c = 1e-1) midpoint is accurate; at high
-#: frequency midpoint stays bounded and at tau = 10 keeps the stiff mode, implicit Euler damps
-#: it, explicit methods blow up (at tau = 10 every method with a finite stability interval).
-EXPECT4 = {
-    1e-1: {"midpoint": {"accurate"}, "implicit_euler": BOUNDED},
-    1e-4: {"midpoint": BOUNDED, "implicit_euler": {"over-damped"}, "explicit_euler": {GREW}},
-    1e-6: {"midpoint": {"stiff mode kept"}, "implicit_euler": {"over-damped"},
-           **{m: {GREW} for m in _EXPLICIT_AT_TAU_10}},
-}
+
+
+def expected_damped(spec, tau):
+    """The outcomes HARD_CASES case 4 and the slides allow a method (its spec) at tau = h omega,
+    or None (no expectation): an A-stable method is accurate at low frequency; at high
+    frequency a symmetric one (midpoint) keeps the stiff mode bounded and undamped and a
+    non-symmetric one (implicit Euler) damps it; a method whose stable range ends below tau
+    blows up (tau >= 1: explicit Euler at tau = 1, every finite range at tau = 10)."""
+    if spec.stable_tau is None:
+        return None
+    if math.isinf(spec.stable_tau):
+        if tau < 0.1:
+            return {"accurate"} if spec.symmetric else BOUNDED
+        if spec.symmetric:
+            return {"stiff mode kept"} if tau >= 10 else BOUNDED
+        return {"over-damped"}
+    if tau >= 1 and spec.stable_tau < tau:
+        return {GREW}
+    return None
 
 
 def classify_damped(run, e_exact, e0):
@@ -111,7 +124,7 @@ def case4_damped(models_dir, gen_dir, methods):
             run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), sc.h,
                               sc.t_end, p)
             got = classify_damped(run, e_exact, e0)
-            allowed = EXPECT4[c].get(method)
+            allowed = expected_damped(registry.spec(method), sc.h / math.sqrt(c))
             ok = allowed is None or got in allowed
             oks.append(ok)
             energies[(c, method)] = (run.traj.t, run.traj.energy / e0) if run.ok else \
@@ -158,8 +171,9 @@ def fpu_row(run, omega=reference.FPU_OMEGA, dt=0.5):
 
 
 def case5_fpu(models_dir, gen_dir, methods, h=0.01):
-    """FPU to t = 200 at h omega = 0.5 against the published I_j; explicit Euler must fail.
-    The case passes when some method reproduces the reference and explicit Euler does not."""
+    """FPU to t = 200 at h omega = 0.5 against the published I_j; explicit Euler (every method
+    unstable at every h, SPEC.stable_tau = 0) must fail. The case passes when some method
+    reproduces the reference and explicit Euler does not."""
     sc = scenes.fpu_scene(h=h)
     mod = load_module(models_dir, sc.stem, gen_dir)
     p = params_of(mod, **sc.params)
@@ -176,8 +190,8 @@ def case5_fpu(models_dir, gen_dir, methods, h=0.01):
         rows.append([method, *cells, fmt(dev, ".3f"), fmt(drift, ".1e"),
                      PASS if ok else FAIL])
         good.append(ok)
-        if method == "explicit_euler":
-            euler_ok = ok
+        if registry.spec(method).stable_tau == 0:     # unstable at every h: explicit Euler
+            euler_ok = bool(euler_ok) or ok
     rows.append(["reference (HARD_CASES)",
                  *(", ".join(f"{x:.3f}" for x in v) for v in reference.FPU_REFERENCE.values()),
                  "-", "-", "-"])
@@ -219,8 +233,8 @@ def case6_separatrix(models_dir, gen_dir, methods, h=0.01):
         over = bool(np.max(np.abs(tr.q[:, 0])) >= math.pi)
         ok = err <= SEPARATRIX_TOL and not over
         good.append(ok)
-        if method == "explicit_euler":
-            euler_over = over
+        if registry.spec(method).stable_tau == 0:     # unstable at every h: explicit Euler
+            euler_over = over if euler_over is None else (euler_over and over)
         rows.append([method, f"{err:.2e}", "yes" if over else "no",
                      f"{tr.max_energy_error:.1e}", PASS if ok else FAIL])
     verdict = _verdict([any(good), euler_over is not False])

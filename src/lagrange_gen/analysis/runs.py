@@ -17,22 +17,19 @@ import numpy as np
 from ..errors import EnergyWarning, SimulationError
 from ..steppers import registry
 
-#: Constrained methods of issue 4, used when a build registers them (registry.METHODS).
-CONSTRAINED_NAMES = ("rattle", "constrained_midpoint", "constrained_implicit_euler", "spook",
-                     "index1")
 NOT_AVAILABLE = "not available in this build"
 
 
 def constrained_methods():
     """Constrained methods registered in this build, in registry order (maybe empty)."""
-    named = getattr(registry, "CONSTRAINED_METHODS", CONSTRAINED_NAMES)
-    return tuple(m for m in registry.METHODS if m in named)
+    return registry.CONSTRAINED_METHODS
 
 
 def unconstrained_methods():
-    """Methods for unconstrained smooth models: not the constrained or the nonsmooth ones."""
-    skip = set(constrained_methods()) | set(registry.NONSMOOTH_METHODS)
-    return tuple(m for m in registry.METHODS if m not in skip)
+    """Fixed-step methods for unconstrained smooth models: not the constrained, the nonsmooth
+    or the adaptive ones (the hard cases compare methods at a given step h)."""
+    return tuple(m for m in registry.METHODS if not (
+        registry.spec(m).constraints or registry.spec(m).elements or registry.spec(m).adaptive))
 
 
 def methods_for(mod, methods=None):

@@ -108,7 +108,8 @@ def no_damping_row(stab, hard_results):
 
 def constraints_row(prec, hard_results):
     cart = _result(prec, "cartesian_pendulum")
-    projected = [m for m in hard_constrained.PROJECTED if runs.has_method(m)]
+    projected = [m for m in runs.constrained_methods()
+                 if registry.spec(m).constraint_drift == "none"]
     if cart is None or not projected:
         return ["constraints", "-", runs.NOT_AVAILABLE]
 

@@ -59,6 +59,21 @@ class PartitionedSettings(NamedTuple):
     newton_always: bool = False     # use the Newton path even for constant H, velocity-free forces
 
 
+#: One line per settings field for the CLI's help (cli_simulate builds an option per field).
+SETTING_HELP = {
+    "newton_tol": "Newton tolerance, relative to max(1, |unknown|)",
+    "max_iter": "Newton iteration cap per solve",
+    "blowup_bound": "BlowUp when max(|q|, |v|) exceeds this",
+    "newton_always": "use the Newton path even for constant H and velocity-free forces",
+    "compliance": "constraint compliance epsilon >= 0 (0: rigid; 1/k: a spring of stiffness k)",
+    "relaxation": "constraint relaxation d > 0, in steps",
+    "baumgarte": "Baumgarte stabilization gains ALPHA BETA",
+    "rtol": "relative tolerance of the local error",
+    "atol": "absolute tolerance of the local error",
+    "h_max": "largest step",
+    "max_steps": "cap on the steps (accepted and rejected) of one call",
+}
+
 #: Validation of the common fields: (lower bound, bound included, inf allowed).
 LIMITS = {"newton_tol": (0.0, False, False), "max_iter": (1, True, False),
           "blowup_bound": (0.0, False, True)}
@@ -84,6 +99,16 @@ class Spec:
     saved: tuple = ()
     limits: dict = field(default_factory=dict)
     adaptive: bool = False
+    #: Linear stability on x'' = -omega^2 x, tau = h omega (fixed-step unconstrained methods):
+    #: the end of the first stable interval (0: unstable for every tau, inf: A-stable), the
+    #: closed-form spectral radius rho(tau) and phase per step of the step matrix (callables or
+    #: None); the analysis checks the measured step matrix against them.
+    stable_tau: float = None
+    rho: object = None
+    phase: object = None
+    #: Constrained methods: "none" (|Phi| and |J v| held to the Newton tolerance), "bounded"
+    #: (regularized: a compliance-sized violation) or "grows" (no projection: drift).
+    constraint_drift: str = ""
 
     def __post_init__(self):
         if self.family not in FAMILIES:

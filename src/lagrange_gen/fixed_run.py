@@ -1,0 +1,128 @@
+"""Drive a fixed-step method's glue from Python: chunks of steps, progress, failures, events.
+
+simulate (simulation.py) checks the inputs and builds the Trajectory; this module runs the
+generated ``run_<method>`` (steppers/registry.py, base.run_loop) chunk by chunk so that a
+progress bar can be shown, and turns a failure status into the exception naming the step
+(failures.py). adaptive_run.py is the same for the adaptive methods.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+
+import numpy as np
+
+from . import status as st
+from .failures import raise_for_status
+from .steppers.base import N_STATS, STAT_ITERS
+
+#: Steps per call into the jitted loop (a multiple of save_every is used): large enough that the
+#: Python overhead per chunk (a few microseconds) is negligible, small enough for a progress bar.
+CHUNK_STEPS = 200_000
+
+#: Rows of located events kept per run (steppers/events.py); more are counted, not stored.
+EVENT_ROWS = 10_000
+
+
+def n_steps_to(t0, t_end, h):
+    """Whole steps to reach t_end; rounded up when (t_end - t0) / h is not an integer."""
+    ratio = (t_end - t0) / h
+    nearest = round(ratio)
+    if abs(ratio - nearest) <= 1e-9 * max(1.0, abs(ratio)):
+        return int(nearest)
+    return int(math.ceil(ratio))
+
+
+def allocate(rows, n, n_saved, initial, n_events):
+    """Output arrays {t (S,), q, v (S, n), stats (S, N_STATS), extra (S, n_saved), events
+    (E, 3 + 2 n)}; row 0 of extra holds the initial values of the method's saved fields
+    (SPEC.saved: multipliers and residuals, or element states). E = EVENT_ROWS when the model
+    has events, else 0."""
+    out = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
+               stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)),
+               events=np.zeros((EVENT_ROWS if n_events else 0, 3 + 2 * n)), n_events=0)
+    if n_saved:
+        out["extra"][0] = initial
+    return out
+
+
+def integrate_fixed(task, q, v, out, progress):
+    """Run the glue chunk by chunk from (q, v), filling ``out``; sets out["last"], out["rows"]
+    (rows used), out["steps"] (steps done: fewer than task.n_steps after a terminal event) and
+    out["n_events"]. Returns (compile seconds, integration seconds). Raises the exception of a
+    failure status (failures.raise_for_status)."""
+    m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
+    last = np.empty(2 * n + 3 + out["extra"].shape[1])
+    compile_time = warm_up(task.run, q, v, t0, h, task.p, task.settings,
+                           out["extra"][:1].copy(), last.copy(), out["events"][:0])
+    chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
+    bar = ProgressBar(task.n_steps) if progress else None
+    start = time.perf_counter()
+    done, row = 0, 0
+    while True:
+        k = min(chunk, task.n_steps - done)
+        rows = slice(row, row + k // task.save_every + 1)
+        # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
+        # Newton statistics, which belong to the steps before it.
+        kept = out["stats"][row].copy()
+        found = min(out["n_events"], out["events"].shape[0])
+        code, steps, n_events = task.run(
+            q, v, t0 + done * h, h, k, task.save_every, task.p, task.settings, out["t"][rows],
+            out["q"][rows], out["v"][rows], out["stats"][rows], out["extra"][rows], last,
+            out["events"][found:])
+        out["n_events"] += n_events
+        if row > 0:
+            out["stats"][row, STAT_ITERS:] = kept[STAT_ITERS:]
+        if code != st.OK:
+            raise_for_status(code, m, task.method, done + steps + 1, task.n_steps, last,
+                             task.max_iter, h, task.p)
+        q, v = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy()
+        if steps < k:                    # a terminal event stopped the run inside this chunk
+            done += steps
+            row += steps // task.save_every
+            break
+        done += k
+        row += k // task.save_every
+        if bar:
+            bar.update(done)
+        if done >= task.n_steps:
+            break
+    wall = time.perf_counter() - start
+    if bar:
+        bar.close()
+    out["last"], out["rows"], out["steps"] = last, row + 1, done
+    return compile_time, wall
+
+
+def warm_up(run, q, v, t0, h, p, settings, extra, last, events):
+    """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
+    measured wall time is integration only. extra (1, n_saved) and last are scratch copies with
+    the method's sizes. Returns the seconds it took."""
+    n = q.shape[0]
+    start = time.perf_counter()
+    run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
+        np.empty((1, N_STATS)), extra, last, events)
+    return time.perf_counter() - start
+
+
+class ProgressBar:
+    """A one-line text bar on stderr, redrawn only when the percentage changes."""
+
+    def __init__(self, total, width=40, stream=None):
+        self.total, self.width, self.stream = max(total, 1), width, stream or sys.stderr
+        self.shown = -1
+        self.update(0)
+
+    def update(self, done):
+        pct = int(100 * min(done, self.total) / self.total)
+        if pct != self.shown:
+            self.shown = pct
+            filled = self.width * pct // 100
+            self.stream.write(f"\r[{'#' * filled}{' ' * (self.width - filled)}] {pct:3d}%")
+            self.stream.flush()
+
+    def close(self):
+        self.stream.write("\n")
+        self.stream.flush()
