@@ -160,12 +160,17 @@ def test_non_finite_parameter_on_the_command_line_is_named(cart, capsys, value, 
     (dict(blowup_bound=math.nan), r"blowup_bound must be a number > 0 .*got nan"),
     (dict(blowup_bound=-1.0), r"blowup_bound must be a number > 0"),
     (dict(blowup_bound="big"), r"blowup_bound must be a number > 0"),
+    (dict(newton_tol=0.0), r"newton_tol must be a number > 0, got 0.0"),
+    (dict(newton_always=True), r"method 'midpoint' has no setting 'newton_always'; its "
+                               r"settings: newton_tol, max_iter, blowup_bound"),
+    (dict(h=None), r"method 'midpoint' has a fixed step: give h"),
+    (dict(t_eval=[0.5]), r"t_eval is for the adaptive methods"),
 ])
 def test_bad_api_arguments_are_one_line_errors_naming_them(cart, kwargs, match):
     args = dict(q0=Q0, v0=V0, t_end=1.0, h=0.01)
     args.update(kwargs)
     with pytest.raises(SimulationError, match=match) as info:
-        simulate(cart, "rk4", **args)
+        simulate(cart, "midpoint", **args)
     assert "\n" not in str(info.value)
 
 
@@ -221,3 +226,25 @@ def test_only_models_whose_flow_conserves_energy_count_as_conservative(generated
     assert not is_conservative(prandtl, np.zeros(1), np.zeros(1), 0.0,
                                np.array(prandtl.DEFAULTS, dtype=float))
     assert 0 < ENERGY_FRACTION < 1
+
+
+# Issue 12: the method's settings on the command line come from its spec --------------------------
+
+def test_cli_passes_only_the_settings_given_and_refuses_one_the_method_lacks(cart, capsys):
+    code, out, err = cli(capsys, cart.__file__, "--method", "midpoint", "--h", 0.01,
+                         "--t-end", 0.1, "--max-iter", 7, "--newton-tol", 1e-10)
+    assert code == 0, err
+    code, out, err = cli(capsys, cart.__file__, "--method", "rk4", "--h", 0.01, "--t-end", 0.1,
+                         "--newton-tol", 1e-10)
+    assert_one_line_error(code, err, "method 'rk4' has no setting 'newton_tol'",
+                          "its settings: blowup_bound")
+
+
+def test_cli_has_an_option_for_every_setting_of_every_method(capsys):
+    from lagrange_gen.steppers import registry
+    with pytest.raises(SystemExit):
+        main(["simulate", "--help"])
+    text = capsys.readouterr().out
+    for method in registry.METHODS:
+        for name in registry.spec(method).settings._fields:
+            assert "--" + name.replace("_", "-") in text, (method, name)

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..analysis import reference as ref
 from ..analysis import runs
+from ..steppers import registry
 from . import common, peers
 
 TARGET = 1e-8          # the headline's final-state error
@@ -132,6 +133,31 @@ def sweep_ours(mod, method, case, p, reference, settings, progress):
     return points
 
 
+def sweep_adaptive(mod, method, case, p, reference, settings, progress):
+    """An adaptive method of ours (dop853) over settings.dop_rtols (atol = rtol / 100), states
+    at the sample times from its dense output; stops after a run slower than the budget or once
+    the final error is below the floor. Point.param is the rtol. Returns [Point]."""
+    points, t_grid = [], np.linspace(0.0, case.t_end, case.samples + 1)
+    q0, v0 = np.array(case.q0, float), np.array(case.v0, float)
+    rtols = settings.dop_rtols
+    for i, rtol in enumerate(rtols):
+        run = runs.guarded_run(mod, method, q0, v0, None, case.t_end, p,
+                               repeats=settings.repeats, t_eval=t_grid, rtol=rtol,
+                               atol=rtol / 100)
+        progress.step(f"{case.stem} {method} rtol={rtol:.0e}")
+        if not run.ok:
+            points.append(Point(method, "ours", rtol, run.wall, failed=run.error))
+            continue
+        tr = run.traj
+        y_grid = np.vstack((tr.q.T, tr.v.T))
+        points.append(_errors(Point(method, "ours", rtol, run.wall), mod, p, reference, t_grid,
+                              y_grid, y_grid[:, -1]))
+        if points[-1].final < settings.floor or run.wall > settings.budget:
+            progress.step(count=len(rtols) - 1 - i)
+            break
+    return points
+
+
 def sweep_peer(name, f, jac, method, rtols, mod, case, p, reference, settings, progress):
     """One solve_ivp method over rtols on the right-hand side f; stops after a run slower than
     the budget. Returns [Point]."""
@@ -204,11 +230,11 @@ def run_case(case, models_dir, gen_dir, settings, methods=None, progress=None):
     mod = runs.load_module(models_dir, case.stem, gen_dir)
     p = runs.params_of(mod)
     reference = _reference(mod, case, p, settings)
-    wanted = runs.constrained_methods() if case.constrained else runs.unconstrained_methods()
-    wanted = [m for m in wanted if methods is None or m in methods]
+    wanted = _ours(case, methods)
     points = []
     for method in wanted:
-        points += sweep_ours(mod, method, case, p, reference, settings, progress)
+        sweep = sweep_adaptive if registry.spec(method).adaptive else sweep_ours
+        points += sweep(mod, method, case, p, reference, settings, progress)
     for name, f, jac, solver, rtols in _peer_list(mod, case, p,
                                                   Path(models_dir) / f"{case.stem}.py", settings):
         points += sweep_peer(name, f, jac, solver, rtols, mod, case, p, reference, settings,
@@ -253,6 +279,14 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
     return {"results": results, "report": path}
 
 
+def _ours(case, methods):
+    """Our methods for a case: the constrained ones, or the fixed-step unconstrained ones and
+    the adaptive ones; restricted to ``methods`` when given."""
+    pool = runs.constrained_methods() if case.constrained else \
+        runs.unconstrained_methods() + registry.ADAPTIVE_METHODS
+    return [m for m in pool if methods is None or m in methods]
+
+
 def _has_pydy():
     import importlib.util
     return importlib.util.find_spec("pydy") is not None
@@ -260,8 +294,8 @@ def _has_pydy():
 
 def _n_runs(case, settings, methods):
     """Runs of a case for the progress bar (sweeps that stop early count what they skip)."""
-    pool = runs.constrained_methods() if case.constrained else runs.unconstrained_methods()
-    ours = sum(1 for m in pool if methods is None or m in methods) * (settings.k_max + 1)
+    ours = sum(len(settings.dop_rtols) if registry.spec(m).adaptive else settings.k_max + 1
+               for m in _ours(case, methods))
     dop, radau = len(settings.dop_rtols), len(settings.radau_rtols)
     return ours + (dop if case.constrained else (3 if _has_pydy() else 2) * dop + radau)
 
@@ -269,7 +303,8 @@ def _n_runs(case, settings, methods):
 def _intro(settings, quick):
     return ["# Work-precision", "",
             f"`lagrange-gen bench precision{' --quick' if quick else ''}`. Ours: every stepper "
-            f"through `simulate` at h = h0 / 2^k, k <= {settings.k_max}; peers: scipy solve_ivp "
+            f"through `simulate` at h = h0 / 2^k, k <= {settings.k_max} (the adaptive ones at "
+            f"the peers' rtols, atol = rtol / 100); peers: scipy solve_ivp "
             f"on our generated right-hand side (DOP853; Radau with the generated Jacobian), and "
             f"sympy.physics.mechanics LagrangesMethod lambdified + DOP853 on the model's own "
             f"L = T - V, and PyDy's generate_ode_function + DOP853 when pydy is installed "
