@@ -2,7 +2,7 @@
 
 Public API (explicit re-exports)::
 
-    from lagrange_gen import Model, coordinates, parameters, t, PointForce, load_model
+    from lagrange_gen import Model, coordinates, parameters, t, PointForce, Event, load_model
     from lagrange_gen import load, import_generated, simulate
 
 The modelling names load sympy on first use only, so that importing a generated module (which
@@ -18,6 +18,7 @@ from .errors import (BlowUp, EnergyWarning, GenerationError, LagrangeGenError, M
 _LAZY = {
     "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
     "t": "model", "load_model": "model_file", "SaintVenant": "model", "DryFriction": "model",
+    "Event": "model",
     "import_generated": "loader", "load": "loader",
     "simulate": "simulation", "Trajectory": "trajectory",
 }

@@ -12,11 +12,11 @@ import sympy as sp
 
 from .errors import ModelError
 from .loads import DryFriction, PointForce, SaintVenant
-from .model_input import _check_rayleigh, _convert_dynamicsymbols, _sympify
+from .model_input import Event, _check_rayleigh, _convert_dynamicsymbols, _events, _sympify
 from .symbols import Coordinate, Parameter, Velocity, _check_name, coordinates, parameters, t
 
 __all__ = [
-    "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Model",
+    "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Event", "Model",
     "coordinates", "parameters", "t",
 ]
 
@@ -36,12 +36,14 @@ class Model:
     dissipation : Rayleigh function D(q, qdot); contributes Q = -dD/dqdot.
     constraints : list of holonomic constraints Phi(q) = 0.
     elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
+    events : {name: g} with g(q, qdot, t) an expression, or Event(g, terminal=, direction=):
+        simulate locates the zero crossings of each g and records them (steppers/events.py).
     params : optional explicit parameter order; default: order of declaration.
     description : one line shown in the generated module's docstring.
     """
 
     def __init__(self, name, coords, T, V=0, forces=None, dissipation=0, constraints=(),
-                 elements=(), params=None, description=""):
+                 elements=(), params=None, description="", events=None):
         _check_name("model", str(name))
         self.name = str(name)
         self.description = description
@@ -57,6 +59,7 @@ class Model:
         self.constraints = [self._scalar(c, f"constraint {i}", replace)
                             for i, c in enumerate(self._sequence(constraints, "constraints", "expressions Phi(q)"))]
         self.elements = self._elements(elements, replace)
+        self.events = _events(self.name, events, replace)
         self.params = self._collect_params(params)
         self.source_path = None      # set by load_model
         self.source_text = ""
@@ -148,11 +151,19 @@ class Model:
             for c in e.coefficients():
                 yield f"coefficient of element {e.name}", c
 
+    def _input_expressions(self):
+        """_all_expressions and the events: everything whose symbols must be known. The events
+        stay out of _all_expressions, which chooses the derivation backend (derive/backend.py):
+        an event is evaluated, never differentiated."""
+        yield from self._all_expressions()
+        for e in self.events:
+            yield f"event {e.name}", e.expr
+
     def _collect_params(self, explicit):
         """The parameters in PARAMS order: ``explicit`` (params=), or the used ones in
         declaration order. Fills param_defaults {name: default or None}."""
         found = {}
-        for where, expr in self._all_expressions():
+        for where, expr in self._input_expressions():
             for s in expr.free_symbols:
                 if isinstance(s, Parameter) and found.setdefault(s.name, s) != s:
                     raise ModelError(f"model {self.name}: parameter {s.name} is declared twice (two "
@@ -183,7 +194,7 @@ class Model:
                 names[s.name] = kind
         q, qd = set(self.coords), set(self.velocities)
         allowed = q | qd | set(self.params) | {t}
-        for where, expr in self._all_expressions():
+        for where, expr in self._input_expressions():
             unknown = sorted(str(s) for s in expr.free_symbols - allowed)
             if unknown:
                 raise ModelError(f"model {self.name}: {where} uses symbol(s) {', '.join(unknown)} "

@@ -1,12 +1,13 @@
 """Turning what a model file gives into checked scalar sympy expressions: dynamicsymbols
-converted to Coordinates, sympify with one-line errors, and the Rayleigh-function check."""
+converted to Coordinates, sympify with one-line errors, the Rayleigh-function check, and the
+events g(q, qdot, t) (Event) whose zero crossings simulate locates."""
 
 from __future__ import annotations
 
 import sympy as sp
 
 from .errors import ModelError
-from .symbols import Coordinate, t
+from .symbols import Coordinate, _check_name, t
 
 
 def _convert_dynamicsymbols(coords):
@@ -106,3 +107,51 @@ def _vanishes_at_rest(expr, s):
     if value.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
         value = sp.limit(expr, s, 0, "+")
     return value == 0 or sp.simplify(value) == 0
+
+
+class Event:
+    """An event function g(q, qdot, t) of a model (``Model(events={name: expr or Event})``):
+    simulate locates the times where g crosses zero inside a step and records (time, state,
+    which event, direction).
+
+    ``direction``: +1 records only rising crossings (g from negative to >= 0 in the order of
+    integration), -1 only falling ones (g from positive to <= 0), 0 both. ``terminal``: the run
+    stops at the first recorded crossing (the final state is the state at the event).
+    """
+
+    def __init__(self, expr, terminal=False, direction=0):
+        if not isinstance(terminal, (bool, int)) or terminal not in (0, 1):
+            raise ModelError(f"Event: terminal must be True or False, got {terminal!r}")
+        if isinstance(direction, bool) or direction not in (-1, 0, 1):
+            raise ModelError(f"Event: direction must be +1 (rising), -1 (falling) or 0 (both), "
+                             f"got {direction!r}")
+        self.expr, self.terminal, self.direction = expr, bool(terminal), int(direction)
+        self.name = None        # the key of the events dict (set by Model)
+
+    def __repr__(self):
+        return (f"Event({self.name or ''}: {self.expr}, terminal={self.terminal}, "
+                f"direction={self.direction:+d})")
+
+
+def _events(model_name, events, replace):
+    """``events`` {name: expression or Event} as a list of named Events with scalar sympy
+    expressions (``replace`` applied); ModelError naming the model and the event."""
+    if events is None:
+        return []
+    if not isinstance(events, dict):
+        raise ModelError(f"model {model_name}: events must be a dict {{name: expression or "
+                         f"Event(expression, terminal=, direction=)}}, got {events!r}")
+    out = []
+    for name, given in events.items():
+        if not isinstance(name, str):
+            raise ModelError(f"model {model_name}: event name {name!r} is not a string")
+        _check_name("event", name)
+        event = given if isinstance(given, Event) else Event(given)
+        try:
+            expr = _sympify(event.expr, f"event {name}", replace)
+        except ModelError as exc:
+            raise ModelError(f"model {model_name}: {exc}") from None
+        named = Event(expr, event.terminal, event.direction)
+        named.name = name
+        out.append(named)
+    return out

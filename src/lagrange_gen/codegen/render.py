@@ -7,7 +7,7 @@ import sympy as sp
 from ..derive.elements import KIND_CODES
 from ..keys import KEY_PREFIX, TEXT_SHA_PREFIX, key_of_text, text_hash
 from .forward import factor_at_import, forward_source
-from .spec import default_kernels
+from .spec import default_kernels, event_functions
 
 
 def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
@@ -28,9 +28,17 @@ def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
         lines.append("Nonsmooth elements (index in s / rows of G and coef):")
         lines += [f"    {i}: {e.name} ({e.kind}) on s = {sp.sstr(e.strain)}, coef = "
                   f"({', '.join(sp.sstr(c) for c in e.coefficients())})" for i, e in enumerate(m.elements)]
+    if m.events:
+        lines.append("Events g(q, qd, t) (index in the out of events; direction, terminal):")
+        lines += [f"    {i}: {e.name}: {sp.sstr(g)} ({_DIRECTIONS[e.direction]}"
+                  f"{', terminal' if e.terminal else ''})"
+                  for i, (e, g) in enumerate(zip(m.events, event_functions(dyn)))]
     lines += _specialization(dyn, methods, why or {}, texts)
     lines.append("Equations of motion: H(q) qddot + h(q, qd) + g(q) = Q(q, qd, t) + J(q)^T lam, Phi(q) = 0.")
     return "\n".join(lines)
+
+
+_DIRECTIONS = {1: "+1 rising", -1: "-1 falling", 0: "both directions"}
 
 
 def _specialization(dyn, methods, why, texts):
@@ -78,6 +86,7 @@ def _model_constants(dyn, methods, texts):
     defaults = dyn.model.defaults()
     default_arr = ", ".join("float('nan')" if d is None else repr(d) for d in defaults)
     elements = dyn.model.elements
+    events = dyn.model.events
     return [
         f"NAME = {dyn.model.name!r}",
         f"COORDS = {tuple(c.name for c in dyn.q)!r}",
@@ -93,6 +102,11 @@ def _model_constants(dyn, methods, texts):
         f"N_ELEMENTS = {dyn.n_elements}",
         f"ELEMENTS = {tuple(e.name for e in elements)!r}",
         f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in elements)!r}  # 0 Saint-Venant, 1 dry friction",
+        f"N_EVENTS = {len(events)}",
+        f"EVENT_NAMES = {tuple(e.name for e in events)!r}",
+        f"EVENT_TERMINAL = np.array({[e.terminal for e in events]!r}, dtype=np.bool_)",
+        f"EVENT_DIRECTION = np.array({[e.direction for e in events]!r}, dtype=np.int64)"
+        "  # +1 rising, -1 falling, 0 both",
         f"MASS_IS_CONSTANT = {dyn.mass_is_constant}",
         f"FORCES_VELOCITY_FREE = {dyn.forces_velocity_free}",
         f"METHODS = {tuple(methods)!r}",

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from ..symbols import Parameter
+
 
 @dataclass
 class Output:
@@ -101,8 +103,28 @@ def kernel_table(dyn) -> dict:
         "elements_hessian": lambda: KernelSpec(
             "elements_hessian", ["q", "we", "p"], [Output("out_mat", nat["elem_hess_w"], symmetric=True)],
             doc="sum_e we[e] d2 s_e/dq2 (n, n) for weights we (ne,)"),
+        "events": lambda: KernelSpec(
+            "events", ["q", "qd", "t", "p"], [Output("out", _column(event_functions(dyn)))],
+            doc="event functions g (n_events,) in EVENT_NAMES order, whose zero crossings "
+                "steppers/events.py locates"),
     }
     return table
+
+
+def _column(exprs):
+    """A column Matrix (len, 1), also for no entries (sp.Matrix([]) is 0 x 0)."""
+    return sp.Matrix(len(exprs), 1, list(exprs))
+
+
+def event_functions(dyn) -> list:
+    """The model's event functions g_k(q, qd, t) (sympy), frozen parameters substituted (the
+    derivation's freeze_model substitutes the expressions it derives; events are only printed)."""
+    out = []
+    for event in dyn.model.events:
+        frozen = {s: sp.Float(dyn.frozen[s.name]) for s in event.expr.free_symbols
+                  if isinstance(s, Parameter) and s.name in dyn.frozen}
+        out.append(event.expr.xreplace(frozen) if frozen else event.expr)
+    return out
 
 
 def default_kernels(dyn) -> tuple:

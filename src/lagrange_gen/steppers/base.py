@@ -249,6 +249,11 @@ def _last(out_last, t, q, v, iters, resid, extra):
         out_last[3 + 2 * n + k] = extra[k]
 
 
+# Imported here, not at the top: events.py and hermite.py import FAST, accel and copy_into
+# from this module.
+from . import events, hermite  # noqa: E402
+
+
 @njit(inline="always")
 def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, settings,
              out_t, out_q, out_v, out_stats, out_extra, out_last, out_events):
@@ -257,7 +262,6 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     ``method`` is a stepper module (its workspace, prepare and step are called), ``kern`` the
     generated module, ``settings`` the method's settings record (spec.py), n_saved the width
     of the method's saved fields on this model (the glue passes it as a literal).
-    out_events (E, 3 + 2n): located events [t, event index, direction, q, v] (see events.py).
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
@@ -266,9 +270,19 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     Newton residual, saved fields] of the final state, or on failure: of the state the failing
     step started from (Newton failure, singular mass) or of the offending state after it
     (NON_FINITE, UNSTABLE; also a non-finite energy at a saved state).
-    Returns (status, steps_done, n_events): steps_done = index of the failing step on failure,
-    -1 when the initial state itself is refused (non-finite or past the bound, its energy
-    non-finite, or the method's prepare failed); n_events rows of out_events filled.
+    Events (models with N_EVENTS > 0; see events.py): after each step the event functions are
+    evaluated at the new state; a crossing is located on the step's Hermite interpolant
+    (hermite.py) and recorded in out_events (E, 3 + 2n) as [t, event index, direction (+1
+    rising, -1 falling), q, v] while there is room (E may be 0: further events are counted
+    only). A terminal event ends the run inside step i: status OK, steps_done = i (steps i and
+    later are not saved), out_last = [t of the event, q, v there (interpolated), iterations,
+    residual, saved fields after step i]. Without events (N_EVENTS = 0, a constant of the
+    generated module) none of this is compiled into the loop's work.
+    Returns (status, steps_done, n_events): steps_done = n_steps, or the index of the failing
+    step on failure (or of the step in which a terminal event stopped the run), -1 when the
+    initial state itself is refused (non-finite or past the bound, its energy non-finite, or
+    the method's prepare failed); n_events: events located (rows of out_events written: at
+    most E).
     """
     n = q0.shape[0]
     if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved:
@@ -278,6 +292,8 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     v = v0.copy()
     mom = np.zeros(n)
     ws = method.workspace(kern, n)
+    ew = events.workspace(kern, n)
+    iw = hermite.workspace(n)
     # The saved fields start from row 0 of out_extra, so a run continued in chunks carries them
     # over (element states; multipliers, also the next Newton guess).
     extra = np.zeros(out_extra.shape[1])
@@ -294,32 +310,46 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     if status != OK:
         return status, -1, 0
     _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
+    if kern.N_EVENTS > 0:
+        events.start(kern, ew, q, v, t0, p)
+    n_events = 0
     iters_acc = 0.0
     resid_max = 0.0
     since = 0
     for i in range(n_steps):
         t = t0 + i * h       # not accumulated: no drift of t over millions of steps
+        if kern.N_EVENTS > 0:
+            hermite.begin(iw, q, v)
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
         iters_acc += iters
         resid_max = max(resid_max, resid)
         if status != OK:
             _last(out_last, t, q, v, iters_acc, resid, extra)
-            return status, i, 0
+            return status, i, n_events
         t_new = t0 + (i + 1) * h
         status = check_state(q, v, bound)
         if status != OK:
             _last(out_last, t_new, q, v, iters_acc, resid, extra)
-            return status, i, 0
+            return status, i, n_events
+        if kern.N_EVENTS > 0:
+            if events.crossed(kern, ew, q, v, t_new, p):
+                hermite.fit(kern, iw, t, t_new, q, v, p)
+                n_events, stopped = events.locate(hermite, iw, kern, ew, p, t, t_new,
+                                                  out_events, n_events)
+                if stopped:
+                    _last(out_last, ew.stop[0], ew.q, ew.v, iters_acc, resid_max, extra)
+                    return OK, i, n_events
+            events.advance(ew)
         since += 1
         if since == save_every:
             since = 0
             energy = kern.energy(q, v, t_new, p)
             if not math.isfinite(energy):      # e.g. log(x) at x <= 0: outside the model
                 _last(out_last, t_new, q, v, iters_acc, resid, extra)
-                return NON_FINITE, i, 0
+                return NON_FINITE, i, n_events
             _save((i + 1) // save_every, t_new, q, v, energy, iters_acc,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
             iters_acc = 0.0
             resid_max = 0.0
     _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max, extra)
-    return OK, n_steps, 0
+    return OK, n_steps, n_events
