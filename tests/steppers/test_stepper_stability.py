@@ -12,7 +12,6 @@ import pytest
 
 from stepper_util import model, one_step, params  # model is a fixture
 from lagrange_gen.analysis.stability import CLOSED_FORMS, spectral_radius  # closed forms of case 3
-from lagrange_gen.steppers.base import make_settings
 
 TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)
 OMEGA = 3.0        # not 1, so that h and tau differ and a wrong scaling shows
@@ -70,5 +69,5 @@ def test_newton_path_equals_explicit_path_on_linear_system(model, method):
     assert mod.MASS_IS_CONSTANT and mod.FORCES_VELOCITY_FREE
     for tau in (0.1, 1.0, 1.9):
         explicit = step_matrix(mod, method, tau)
-        newton = step_matrix(mod, method, tau, settings=make_settings(mode=1))
+        newton = step_matrix(mod, method, tau, settings={"newton_always": True})
         np.testing.assert_allclose(newton, explicit, rtol=1e-12, atol=1e-14)

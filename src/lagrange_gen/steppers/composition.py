@@ -1,71 +1,102 @@
-"""Yoshida's fourth-order triple jump of Stormer-Verlet.
+"""Symmetric compositions of Stormer-Verlet; this module's method is Yoshida's triple jump.
 
-    Psi_h = V_{g1 h} o V_{g2 h} o V_{g1 h},   g1 = 1 / (2 - 2^(1/3)),   g2 = 1 - 2 g1 < 0
+A composition method with coefficients g_1, ..., g_s (sum 1) is
+
+    Psi_h = V_{g_s h} o ... o V_{g_2 h} o V_{g_1 h}
 
 with V the verlet step (velocity Verlet or the generalized leapfrog, see verlet.py). A
-composition of symmetric symplectic maps with symmetric coefficients is symmetric and symplectic;
-the coefficients cancel the h^3 error term, so the order is 4 (Yoshida, Phys. Lett. A 150, 1990;
-Hairer-Lubich-Wanner, GNI, sec. II.4). Cost: three verlet steps per step. The middle substep
-runs backwards in time (g2 ~ -1.70); the substeps are longer than h, so on x'' = -omega^2 x the
-step is stable (rho = 1) only for tau = h omega < 1.573, against 2 for Verlet.
+composition of symmetric symplectic maps with symmetric coefficients (g_i = g_{s+1-i}) is
+symmetric and symplectic, and its order is even (Hairer-Lubich-Wanner, GNI, sec. II.4 and
+V.3). ``composed_step`` is that step for any such coefficients; a composition method is a
+module that declares its coefficients (``palindrome``), a ``step`` passing them, and its SPEC
+(composition6.py is one). On x'' = -omega^2 x the step matrix is the product of the verlet
+matrices at g_i tau, tau = h omega; its determinant is 1, so the step is stable (rho = 1) where
+|trace / 2| <= 1 of that product.
+
+This module's method, Yoshida's fourth-order triple jump (Yoshida, Phys. Lett. A 150, 1990;
+GNI sec. II.4):
+
+    g1 = g3 = 1 / (2 - 2^(1/3)),   g2 = 1 - 2 g1 ~ -1.70
+
+The coefficients cancel the h^3 error term, so the order is 4. Cost: three verlet steps per step.
+The middle substep runs backwards in time; the substeps are longer than h, so on the oscillator
+the step is stable only for tau < 1.5734 (|trace / 2| = 1 there), against 2 for Verlet.
 """
 
-import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..status import OK
 from . import verlet
+from .base import FAST, copy_into
 from .spec import PartitionedSettings, Spec
-from .base import FAST, W_SAVE_MOM, W_SAVE_Q, W_SAVE_V, copy_into, run_loop
 
-_CBRT2 = 2.0 ** (1.0 / 3.0)
-G1 = 1.0 / (2.0 - _CBRT2)
-G2 = 1.0 - 2.0 * G1
+#: Scratch of one run: verlet's workspace (its cached acceleration included) and the state at
+#: the start of the step, q, v, mom, acc (n,), restored when a substep fails.
+Workspace = namedtuple("Workspace", "verlet q v mom acc")
+
+
+def palindrome(*half):
+    """The symmetric coefficients (g_1, ..., g_k, ..., g_1) from (g_1, ..., g_k), g_k the middle
+    one; checks that they sum to 1 (a consistent composition)."""
+    coeffs = tuple(float(g) for g in half + half[-2::-1])
+    if abs(sum(coeffs) - 1.0) > 1e-14:
+        raise ValueError(f"composition coefficients {coeffs} do not sum to 1")
+    return coeffs
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    return Workspace(verlet.workspace(kern, n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
-    """The same per-run state as verlet."""
-    return verlet.prepare(kern, q, v, mom, t, p, settings, work, mats, piv)
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """The per-run state of verlet (its cached acceleration or the momentum)."""
+    return verlet.prepare(kern, q, v, mom, t, p, settings, ws.verlet, extra)
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
-    """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual).
-
-    On a failing substep the state is restored to the start of the step."""
-    copy_into(work[W_SAVE_Q], q)
-    copy_into(work[W_SAVE_V], v)
-    copy_into(work[W_SAVE_MOM], mom)
+def composed_step(kern, q, v, mom, t, h, p, settings, ws, extra, coeffs):
+    """The verlet substeps g h for g in ``coeffs`` (a tuple of floats) from (q, v, mom) at t, in
+    place. Returns (status, Newton iterations summed, largest residual). On a failing substep
+    the state (and verlet's cached acceleration) is restored to the start of the step."""
+    copy_into(ws.q, q)
+    copy_into(ws.v, v)
+    copy_into(ws.mom, mom)
+    copy_into(ws.acc, ws.verlet.acc)
     iters = 0
     resid = 0.0
     t_sub = t
-    for k in range(3):
-        g = G2 if k == 1 else G1
-        status, it, res = verlet.step(kern, q, v, mom, t_sub, g * h, p, settings, work,
-                                      mats, piv, extra)
+    for g in coeffs:
+        status, it, res = verlet.step(kern, q, v, mom, t_sub, g * h, p, settings, ws.verlet,
+                                      extra)
         iters += it
         resid = max(resid, res)
         if status != OK:
-            copy_into(q, work[W_SAVE_Q])
-            copy_into(v, work[W_SAVE_V])
-            copy_into(mom, work[W_SAVE_MOM])
+            copy_into(q, ws.q)
+            copy_into(v, ws.v)
+            copy_into(mom, ws.mom)
+            copy_into(ws.verlet.acc, ws.acc)
             return status, iters, resid
         t_sub += g * h
     return OK, iters, resid
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop."""
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
+G1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
+#: Yoshida's triple jump (g1, g2, g1).
+COEFFS = palindrome(G1, 1.0 - 2.0 * G1)
 
 
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
-_THIS = sys.modules[__name__]
+@njit(**FAST)
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
+    """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
+    return composed_step(kern, q, v, mom, t, h, p, settings, ws, extra, COEFFS)
+
 
 SPEC = Spec(
     name="composition", order=4, family="partitioned", implicit=True, symplectic=True,
@@ -73,4 +104,5 @@ SPEC = Spec(
     summary="Yoshida 4th-order triple jump of verlet",
     stable="stable for tau < 1.57",
     settings=PartitionedSettings,
-    kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))
+    kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate",
+             "momentum_rate_jacobian"))
