@@ -8,30 +8,38 @@ radius is sqrt(1 + tau^2) > 1 for every h: energy grows geometrically, however s
 One force evaluation (one Cholesky solve) per step.
 """
 
-import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..status import OK
+from .base import FAST, accel
 from .spec import ExplicitSettings, Spec
-from .base import FAST, accel, run_loop
 
-_A = 0     # work row: acceleration
+#: Scratch of one run: the acceleration a (n,) and the mass matrix H (n, n) it is solved with.
+Workspace = namedtuple("Workspace", "a H")
 
 
 # No cache=True on functions that receive kernels: they are compiled (and cached) as part of
 # the generated module's run_<method> glue, see registry.py.
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    return Workspace(np.zeros(n), np.zeros((n, n)))
+
+
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Nothing is carried between steps."""
     return OK
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
-    a = work[_A]
-    status = accel(kern, q, v, t, p, mats[0], a)
+    a = ws.a
+    status = accel(kern, q, v, t, p, ws.H, a)
     if status != OK:
         return status, 0, 0.0
     for i in range(q.shape[0]):
@@ -39,17 +47,6 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
         v[i] += h * a[i]
     return OK, 0, 0.0
 
-
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop."""
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
-_THIS = sys.modules[__name__]
 
 SPEC = Spec(
     name="explicit_euler", order=1, family="explicit", implicit=False, symplectic=False,

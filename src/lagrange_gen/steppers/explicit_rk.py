@@ -70,8 +70,8 @@ def rk_step(source, kern, ctx, A, b, c, q, v, t, h, stage_v, stage_a, qs, q_out,
             first_known):
     """One step of the tableau (A, b, c) from (q, v) at t; the new state goes to q_out, v_out.
 
-    stage_v, stage_a (s', n) with s' >= s: stage velocities V_i and accelerations a_i (rows of
-    the caller's work array); qs (n,) scratch. first_known: stage_a[0] already holds a(q, v, t)
+    stage_v, stage_a (s', n) with s' >= s: stage velocities V_i and accelerations a_i (arrays of
+    the caller's workspace); qs (n,) scratch. first_known: stage_a[0] already holds a(q, v, t)
     (cached by the caller, e.g. from the end of the previous step), so it is not evaluated.
     q_out, v_out (n,) may be q, v themselves (each entry k is written after its last read).
     Returns OK or the first non-OK status of source.stage_acceleration; then q_out, v_out are

@@ -14,20 +14,31 @@ from ``mass_matvec_dq`` and ``rhs_jacobian``.
 """
 
 import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..status import OK
 from . import newton
+from .base import FAST
 from .spec import NewtonSettings, Spec
-from .base import FAST, S_MAX_ITER, S_TOL, run_loop
 
-_V1, _Q1, _DV, _RHS, _R, _S = 0, 1, 2, 3, 4, 5     # work rows
-_H, _A, _JQ, _JQD, _DHW = 0, 1, 2, 3, 4           # mats
+#: Scratch of one run: the Newton unknown v1 = v+, q1 = q+, dv = v+ - v, rhs, residual R, solver
+#: scratch s and pivots; H, the Newton matrix A, d rhs/dq, d rhs/dv, d(H w)/dq.
+Workspace = namedtuple("Workspace", "v1 q1 dv rhs R s piv H A Jq Jqd dHw")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros(n, np.int64), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Nothing is carried between steps."""
     return OK
 
@@ -52,16 +63,15 @@ def assemble(kern, args, v1, R, A):
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]
-    v1 = work[_V1]
+    v1 = ws.v1
     for i in range(n):
         v1[i] = v[i]
-    args = (q, v, t + h, h, p, work[_Q1], work[_DV], work[_RHS], mats[_H], mats[_JQ],
-            mats[_JQD], mats[_DHW])
-    status, iters, resid = newton.solve(_THIS, kern, args, v1, work[_R], mats[_A], piv,
-                                        work[_S], settings[S_TOL], int(settings[S_MAX_ITER]))
+    args = (q, v, t + h, h, p, ws.q1, ws.dv, ws.rhs, ws.H, ws.Jq, ws.Jqd, ws.dHw)
+    status, iters, resid = newton.solve(_THIS, kern, args, v1, ws.R, ws.A, ws.piv, ws.s,
+                                        settings.newton_tol, settings.max_iter)
     if status == OK:
         for i in range(n):
             q[i] += h * v1[i]
@@ -69,15 +79,7 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     return status, iters, resid
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop."""
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

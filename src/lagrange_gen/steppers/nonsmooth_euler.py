@@ -3,77 +3,88 @@
 Smooth part as in ``implicit_euler`` (velocity form, exact Jacobians). With strains s_e(q),
 gradients G_e = ds_e/dq and t1 = t + h, one step solves for v+ (q+ = q + h v+):
 
-    H(q+) (v+ - v) - h [rhs(q+, v+, t1) - sum_SV k_e u_e+ G_e(q+)] - h sum_DF r_e G_e(q+) = 0
+    R(v+) = H(q+) (v+ - v) - h [rhs(q+, v+, t1) - sum_SV k_e u_e+ G_e(q+)] - h sum_DF r_e G_e(q+) = 0
 
 * Saint-Venant element (stiffness k, threshold eta), internal variable u with
   u' + dpsi_[-eta, eta](u) ∋ s': backward Euler of the inclusion is exactly the return map
   u+ = clamp(u + s(q+) - s(q), -eta, eta). It sits inside a semismooth Newton whose tangent is
   du+/ds+ = 1 while elastic, 0 while sliding (plus the curvature term k u+ d2s/dq2).
 * Dry friction (bound F): the force r G with r ∈ -F Sign(G v+) is solved at the velocity level
-  (Moreau-Jean): in every Newton iteration the linearized system A dv = -R + h G^T r is reduced
-  to the Delassus problem in r (W = h G A^-1 G^T) and solved by projected Gauss-Seidel,
-  r_e <- clamp(r_e - (G v)_e / W_ee, -F_e, F_e). No regularization: sticking is exact.
+  (Moreau-Jean): in every Newton iteration the linearized system A dv = -R_s + h G^T r (R_s the
+  residual without friction) is reduced to the Delassus problem in r (W = h G A^-1 G^T) and
+  solved by projected Gauss-Seidel, r_e <- clamp(r_e - (G v)_e / W_ee, -F_e, F_e). No
+  regularization: sticking is exact.
+
+One Newton loop (newton.solve; its stopping rule, iteration cap and status codes), with the
+nonsmooth work in the assembly. At the iterate v1 it evaluates the return map (u+ from the trial
+strain; the Saint-Venant states are updated only once the step is accepted) and assembles
+F = R_s(v1), A = dR_s/dv1 (exact for linear strains). Without friction elements that is the
+system newton.solve solves. With friction elements the increment needs A^-1 before the forces
+are known (the Delassus problem), so the assembly factors a copy of A itself, solves the
+Delassus problem (updating r in the element states) and hands newton.solve the Newton system
+premultiplied by that A^-1: F <- -dv = -(X + h A^-1 G^T r) with X = -A^-1 R_s, whose Jacobian at
+the iterate is the identity (A <- I). newton.solve's update x -= I^-1 F is then the Moreau-Jean
+increment, in the same floating-point operations as the increment the projected Gauss-Seidel
+zeroes (G (v1 + dv) = 0): a sticking block stays at exactly v = 0, with no creep. The residual
+reported for friction models is therefore max|dv| of the last iteration.
 
 Order 1 (Bastien & Schatzman 2002 for the Prandtl class); for the play operator (prescribed s)
 the return map is exact. Newton's tangent is exact for linear strains; for nonlinear strains the
 friction gradients are frozen within an iteration (a quasi-Newton that converges linearly).
 
-Element data live in ``extra`` (see ``extra_size``): per element its state (u for Saint-Venant,
-the friction force r for dry friction), saved with every output row, then scratch. Row 0 of
-out_extra holds the initial states (u0 = 0: virgin material, unless the caller sets them).
-With no elements this is exactly ``implicit_euler``.
+``extra`` (ne,) holds the element states, saved with every output row (u for Saint-Venant, the
+friction force r for dry friction); row 0 of out_extra holds the initial states (u0 = 0: virgin
+material, unless the caller sets them). With no elements this is exactly ``implicit_euler``.
 """
 
 import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..linalg import lu_inplace, lu_solve_inplace
 from ..nonsmooth.play import return_map
-from ..status import NEWTON_DIVERGED, OK
+from ..status import OK
+from . import newton
+from .base import FAST, max_abs
 from .spec import NewtonSettings, Spec
-from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_small, max_abs,
-                   run_loop)
 
-_V1, _Q1, _DV, _RHS, _R, _S, _X = 0, 1, 2, 3, 4, 5, 6     # work rows (n,)
-_H, _A, _JQ, _JQD, _DHW, _HW = 0, 1, 2, 3, 4, 5          # mats (n, n)
 _PGS_SWEEPS = 200
 
+#: Scratch of one run. (n,): the Newton unknown v1 = v+, q1 = q+, dv = v+ - v, rhs, residual F,
+#: solver scratch s and pivots piv (also those of Af), the friction-free increment X; (n, n): H,
+#: the Newton matrix A and its factored copy Af for the Delassus problem, d rhs/dq, d rhs/dv,
+#: d(H w)/dq, the element Hessian term Hw; (ne,): strains s0 at q and s1 at q1, Saint-Venant
+#: weights we = k u+ and trial states u1; G (ne, n) strain gradients, coef (ne, 3) the
+#: elements' (k or F, eta, kind), Y (ne, n) rows A^-1 G_e^T, W (ne, ne) the Delassus matrix.
+Workspace = namedtuple("Workspace", "v1 q1 dv rhs F s X piv H A Af Jq Jqd dHw Hw "
+                                    "s0 s1 we u1 G coef Y W")
 
-def extra_size(n, ne):
-    """(saved, total) entries of the ``extra`` buffer: ne saved element states, then scratch."""
-    return ne, ne * (8 + 2 * n + ne)
 
-
-@njit(inline="always")
-def _views(extra, n, ne):
-    """Views into the flat extra buffer (no allocation of data)."""
-    state = extra[0:ne]
-    s0 = extra[ne:2 * ne]
-    s1 = extra[2 * ne:3 * ne]
-    we = extra[3 * ne:4 * ne]
-    u1 = extra[4 * ne:5 * ne]
-    o = 5 * ne
-    G = extra[o:o + ne * n].reshape((ne, n))
-    o += ne * n
-    coef = extra[o:o + 3 * ne].reshape((ne, 3))
-    o += 3 * ne
-    Y = extra[o:o + ne * n].reshape((ne, n))       # rows: A^-1 G_e^T (friction elements)
-    o += ne * n
-    W = extra[o:o + ne * ne].reshape((ne, ne))
-    return state, s0, s1, we, u1, G, coef, Y, W
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    ne = kern.N_ELEMENTS
+    return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros(n), np.zeros(n, np.int64), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros(ne), np.zeros(ne), np.zeros(ne), np.zeros(ne),
+                     np.zeros((ne, n)), np.zeros((ne, 3)), np.zeros((ne, n)), np.zeros((ne, ne)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
-    """Nothing is carried in mom; the element state starts at zero (virgin material)."""
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """Nothing is carried in mom; the element states come in extra (row 0 of out_extra)."""
     return OK
 
 
 @njit(inline="always")
-def _assemble(kern, q, v, t1, h, p, v1, q1, dv, rhs, R, H, A, Jq, Jqd, dHw, Hw,
-              state, s0, s1, we, u1, G, coef):
-    """Residual R = -(smooth residual with Saint-Venant forces) and its Jacobian A at v1."""
+def _smooth_and_sliders(kern, q, v, t1, h, p, v1, q1, dv, rhs, F, H, A, Jq, Jqd, dHw, Hw,
+                        state, s0, s1, we, u1, G, coef):
+    """F (n,) <- R_s(v1), the residual with the Saint-Venant forces from the return map, and
+    A (n, n) <- dR_s/dv1 (semismooth: the elastic elements' stiffness, none while sliding)."""
     n, ne = q.shape[0], state.shape[0]
     for i in range(n):
         q1[i] = q[i] + h * v1[i]
@@ -96,7 +107,7 @@ def _assemble(kern, q, v, t1, h, p, v1, q1, dv, rhs, R, H, A, Jq, Jqd, dHw, Hw,
         for j in range(n):
             s += H[i, j] * dv[j]
             A[i, j] = H[i, j] + h * dHw[i, j] - h * h * Jq[i, j] - h * Jqd[i, j] + h * h * Hw[i, j]
-        R[i] = -s
+        F[i] = s
     for e in range(ne):
         if coef[e, 2] == 0.0:
             trial = state[e] + s1[e] - s0[e]
@@ -127,7 +138,7 @@ def _delassus(h, A, piv, scratch, G, coef, Y, W):
 
 
 @njit(inline="always")
-def _pgs(h, tol, v1, X, state, G, coef, Y, W):
+def _pgs(tol, v1, X, state, G, coef, W):
     """Projected Gauss-Seidel on r for the velocities v1 + X + h Y^T r. Returns max change."""
     n, ne = X.shape[0], state.shape[0]
     change = 0.0
@@ -149,58 +160,78 @@ def _pgs(h, tol, v1, X, state, G, coef, Y, W):
     return change
 
 
-@njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
-    """One step from (q, v, element states) at t, in place. Returns (status, iterations, residual)."""
-    n, ne = q.shape[0], kern.N_ELEMENTS
-    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
-    v1, q1, dv, rhs, R, scratch, X = work[_V1], work[_Q1], work[_DV], work[_RHS], work[_R], work[_S], work[_X]
-    H, A, Jq, Jqd, dHw, Hw = mats[_H], mats[_A], mats[_JQ], mats[_JQD], mats[_DHW], mats[_HW]
-    state, s0, s1, we, u1, G, coef, Y, W = _views(extra, n, ne)
-    kern.elements(q, p, s0, G, coef)
+@njit(inline="always")
+def _friction(h, tol, v1, F, A, Af, piv_f, X, scratch, state, G, coef, Y, W):
+    """With friction elements: the Moreau-Jean increment dv = X + h Y^T r (X = -A^-1 F, the
+    forces r from projected Gauss-Seidel, updated in state) on a factored copy Af of A, handed
+    to newton.solve as F <- -dv, A <- I (see the module docstring). Without friction elements,
+    or if A cannot be factored, F and A are left alone (newton.solve then factors the same A and
+    reports SINGULAR_NEWTON or NON_FINITE)."""
+    ne, n = G.shape
+    friction = False
+    for e in range(ne):
+        friction = friction or coef[e, 2] == 1.0
+    if not friction:
+        return
     for i in range(n):
-        v1[i] = v[i]
-    resid = 0.0
-    for it in range(1, max_iter + 1):
-        _assemble(kern, q, v, t + h, h, p, v1, q1, dv, rhs, R, H, A, Jq, Jqd, dHw, Hw,
-                  state, s0, s1, we, u1, G, coef)
-        resid = max_abs(R)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        if not lu_inplace(A, piv):
-            return failed_solve_status(A), it, resid
-        for i in range(n):
-            X[i] = R[i]
-        lu_solve_inplace(A, piv, X, scratch)
-        _delassus(h, A, piv, scratch, G, coef, Y, W)
-        _pgs(h, tol, v1, X, state, G, coef, Y, W)
-        for e in range(ne):
-            if coef[e, 2] == 1.0:
-                for i in range(n):
-                    X[i] += h * Y[e, i] * state[e]
-        for i in range(n):
-            v1[i] += X[i]
-        if increment_small(X, v1, tol):
+        for j in range(n):
+            Af[i, j] = A[i, j]
+    if not lu_inplace(Af, piv_f):
+        return
+    for i in range(n):
+        X[i] = -F[i]
+    lu_solve_inplace(Af, piv_f, X, scratch)
+    _delassus(h, Af, piv_f, scratch, G, coef, Y, W)
+    _pgs(tol, v1, X, state, G, coef, W)
+    for e in range(ne):
+        if coef[e, 2] == 1.0:
             for i in range(n):
-                q[i] += h * v1[i]
-                v[i] = v1[i]
-            kern.elements(q, p, s1, G, coef)
-            for e in range(ne):
-                if coef[e, 2] == 0.0:
-                    state[e] = return_map(state[e], s1[e] - s0[e], coef[e, 1])
-            return OK, it, resid
-    return NEWTON_DIVERGED, max_iter, resid
+                X[i] += h * Y[e, i] * state[e]
+    for i in range(n):
+        F[i] = -X[i]
+        for j in range(n):
+            A[i, j] = 1.0 if i == j else 0.0
 
 
 @njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop; out_extra (S, extra_size(n, ne)[1]), first ne columns element states."""
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
+def assemble(kern, args, v1, F, A):
+    """Newton system of the step (newton.solve) at the iterate v1: F (n,) <- R_s(v1) and
+    A (n, n) <- dR_s/dv1, or with friction elements the increment form F <- -dv, A <- I."""
+    (q, v, t1, h, p, tol, q1, dv, rhs, H, Jq, Jqd, dHw, Hw, Af, piv_f, X, scratch,
+     state, s0, s1, we, u1, G, coef, Y, W) = args
+    _smooth_and_sliders(kern, q, v, t1, h, p, v1, q1, dv, rhs, F, H, A, Jq, Jqd, dHw, Hw,
+                        state, s0, s1, we, u1, G, coef)
+    _friction(h, tol, v1, F, A, Af, piv_f, X, scratch, state, G, coef, Y, W)
 
 
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+@njit(**FAST)
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
+    """One step from (q, v, element states extra (ne,)) at t, in place. Returns (status,
+    iterations, residual)."""
+    n = q.shape[0]
+    state, s0, s1, G, coef = extra, ws.s0, ws.s1, ws.G, ws.coef
+    kern.elements(q, p, s0, G, coef)
+    v1 = ws.v1
+    for i in range(n):
+        v1[i] = v[i]
+    args = (q, v, t + h, h, p, settings.newton_tol, ws.q1, ws.dv, ws.rhs, ws.H, ws.Jq, ws.Jqd,
+            ws.dHw, ws.Hw, ws.Af, ws.piv, ws.X, ws.s, state, s0, s1, ws.we, ws.u1, G, coef,
+            ws.Y, ws.W)
+    status, iters, resid = newton.solve(_THIS, kern, args, v1, ws.F, ws.A, ws.piv, ws.s,
+                                        settings.newton_tol, settings.max_iter)
+    if status != OK:
+        return status, iters, resid
+    for i in range(n):
+        q[i] += h * v1[i]
+        v[i] = v1[i]
+    kern.elements(q, p, s1, G, coef)
+    for e in range(state.shape[0]):
+        if coef[e, 2] == 0.0:
+            state[e] = return_map(state[e], s1[e] - s0[e], coef[e, 1])
+    return OK, iters, resid
+
+
+# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

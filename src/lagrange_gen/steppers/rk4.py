@@ -14,19 +14,30 @@ stable for tau <= 2 sqrt(2).
 """
 
 import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..status import OK
-from .spec import ExplicitSettings, Spec
-from .base import FAST, accel, run_loop
+from .base import FAST, accel
 from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
+from .spec import ExplicitSettings, Spec
 
-_V, _A, _QS = 0, 4, 8       # work rows: stage velocities 0-3, stage accelerations 4-7, stage q
+#: Scratch of one run: stage velocities V_i and accelerations a_i (4, n), the stage position
+#: qs (n,), the mass matrix H (n, n) of the forward dynamics.
+Workspace = namedtuple("Workspace", "stage_v stage_a qs H")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    s = RK4_B.shape[0]
+    return Workspace(np.zeros((s, n)), np.zeros((s, n)), np.zeros(n), np.zeros((n, n)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Nothing is carried between steps."""
     return OK
 
@@ -39,22 +50,14 @@ def stage_acceleration(kern, ctx, q, v, t, a):
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
-    status = rk_step(_THIS, kern, (p, mats[0]), RK4_A, RK4_B, RK4_C, q, v, t, h,
-                     work[_V:_A], work[_A:_QS], work[_QS], q, v, False)
+    status = rk_step(_THIS, kern, (p, ws.H), RK4_A, RK4_B, RK4_C, q, v, t, h,
+                     ws.stage_v, ws.stage_a, ws.qs, q, v, False)
     return status, 0, 0.0
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop."""
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+# This module as a value for rk_step (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(
