@@ -87,7 +87,7 @@ def test_spook_settings_are_checked():
 def test_trajectory_outputs(tmp_path):
     """Multipliers (S, m), |Phi| and |J v| per saved row, also in the npz file; chunked runs
     carry the multiplier across chunk boundaries (same result as one chunk)."""
-    import lagrange_gen.simulation as sim
+    import lagrange_gen.fixed_run as sim       # where the chunk size lives
     mod = generated_model("cartesian_double_pendulum")
     q0 = np.array([0.0, -1.0, 0.0, -2.0])
     v0 = np.array([1.0, 0.0, 2.5, 0.0])

@@ -8,19 +8,21 @@ import pytest
 from constraint_util import four_bar_state, generated_model, params, pendulum_state
 from lagrange_gen.consistent import initial_multipliers
 from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.constrained import extra_size, make_constrained_settings
+from lagrange_gen.steppers.registry import spec
+from lagrange_gen.steppers.spec import make_settings
 
 
 def one_step(mod, method, q, v, lam, h, p, t0=0.0):
     """(q+, v+, lam+) after one step of run_<method> (h may be negative)."""
     n, m = mod.N_COORDS, mod.N_CONSTRAINTS
-    saved, total = extra_size(n, m)
-    out_extra = np.zeros((2, saved))
+    n_saved = spec(method).n_saved(n, m, mod.N_ELEMENTS)
+    out_extra = np.zeros((2, n_saved))
     out_extra[0, :m] = lam
     out_q, out_v = np.empty((2, n)), np.empty((2, n))
-    status, _ = getattr(mod, f"run_{method}")(
-        np.array(q, float), np.array(v, float), t0, h, 1, 1, p, make_constrained_settings(),
-        np.empty(2), out_q, out_v, np.empty((2, N_STATS)), out_extra, np.empty(2 * n + 3 + total))
+    status, _, _ = getattr(mod, f"run_{method}")(
+        np.array(q, float), np.array(v, float), t0, h, 1, 1, p, make_settings(spec(method), {}),
+        np.empty(2), out_q, out_v, np.empty((2, N_STATS)), out_extra,
+        np.empty(2 * n + 3 + n_saved), np.empty((0, 3 + 2 * n)))
     assert status == 0
     return out_q[1], out_v[1], out_extra[1, :m]
 

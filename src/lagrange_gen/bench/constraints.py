@@ -26,8 +26,9 @@ import numpy as np
 from ..consistent import consistent_initial_state
 from ..errors import EnergyWarning, SimulationError
 from ..simulation import simulate
-from ..steppers.base import N_STATS, make_settings
-from ..steppers.constrained import extra_size, make_constrained_settings
+from ..steppers.base import N_STATS
+from ..steppers.registry import spec
+from ..steppers.spec import make_settings
 from ..analysis.runs import fmt, md_table
 from .common import ROOT, new_figure, save_figure, write_report
 from .steppers import _best_of
@@ -99,18 +100,18 @@ def linkage_drift(mod, n_steps):
 def _glue_runner(mod, method, n_steps, q0, v0, constrained):
     """A closure running n_steps of run_<method> with only the final state saved."""
     n, m = mod.N_COORDS, mod.N_CONSTRAINTS
-    saved, total = extra_size(n, m) if constrained else (0, 0)
-    extra = np.zeros((2, saved))
+    n_saved = spec(method).n_saved(n, m, mod.N_ELEMENTS)
+    extra = np.zeros((2, n_saved))
     if constrained:
         extra[0, :m] = consistent_initial_state(mod, q0, v0, mod.DEFAULT_PARAMS, warn=False).lam
     out = (np.empty(2), np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra,
-           np.empty(2 * n + 3 + total))
-    settings = make_constrained_settings() if constrained else make_settings()
+           np.empty(2 * n + 3 + n_saved), np.empty((0, 3 + 2 * n)))
+    settings = make_settings(spec(method), {})
     run = getattr(mod, f"run_{method}")
 
     def go():
-        status, _ = run(q0, v0, 0.0, LINKAGE_H, n_steps, n_steps, mod.DEFAULT_PARAMS, settings,
-                        *out)
+        status, _, _ = run(q0, v0, 0.0, LINKAGE_H, n_steps, n_steps, mod.DEFAULT_PARAMS,
+                           settings, *out)
         if status != 0:
             raise RuntimeError(f"bench constraints: {method} failed with status {status}")
         return out[3][1, 1] / n_steps

@@ -23,35 +23,56 @@ Newton uses the exact Jacobian of (R1, R2):
      [J(q1),                                                                          0      ]]
 
 from ``mass_matvec_dq``, ``rhs_jacobian`` and ``constraint_dq`` (the curvature of the
-constraints enters through d(J^T nu)/dq), solved by Gaussian elimination with partial pivoting.
+constraints enters through d(J^T nu)/dq), through newton.solve (LU with partial pivoting, its
+stopping rule on the increment), starting from v1 = v and the previous step's multiplier.
 """
 
 import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK
+from ..status import OK
+from . import newton
+from .base import FAST
+from .constrained import SAVED, record, velocity_projection
 from .spec import NewtonSettings, Spec
-from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_converged, max_abs,
-                   run_loop)
-from .constrained import (check_buffers, gauss_solve, record, schur_block,
-                          velocity_projection, views)
 
-_V1, _Q1, _DV, _RHS = 0, 1, 2, 3     # work rows
-_H, _JQ, _JQD, _DHW, _DJ = 0, 1, 2, 3, 4       # mats
+#: Scratch of one run (n coordinates, m constraints): the Newton unknown x = (v1, nu), residual
+#: F, solver scratch s (n + m), pivots, its matrix K (n + m, n + m); the end point q1, v1 - v,
+#: rhs, the projected velocity vp (n); H, d rhs/dq, d rhs/dv, d(H dv)/dq, d(J^T nu)/dq (n, n);
+#: Phi, gamma, the projection impulse eta (m); J(q1), d(J v1)/dq (unused), H^-1 J^T rows Y
+#: (m, n); Schur S (m, m).
+Workspace = namedtuple("Workspace", "x F s piv K q1 dv rhs vp H Jq Jqd dHw DJ phi gam eta Jb T "
+                                    "Y S")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    m = kern.N_CONSTRAINTS
+    N = n + m
+    return Workspace(np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N, np.int64),
+                     np.zeros((N, N)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, n)),
+                     np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, m)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Nothing is carried between steps but the multiplier (in extra)."""
     return OK
 
 
 @njit(inline="always")
-def _assemble(kern, q, v, t1, h, p, v1, nu, q1, dv, rhs, H, Jq, Jqd, dHw, DJ, phi, Jb, gam, T,
-              b, K):
-    """Residual b = -(R1, R2) and its Jacobian K (n + m) at (v1, nu)."""
+def assemble(kern, args, x, F, K):
+    """Newton system of the step (newton.solve): F (n + m) <- (R1, R2) at x = (v1, nu), K its
+    Jacobian."""
+    q, v, t1, h, p, q1, dv, rhs, H, Jq, Jqd, dHw, DJ, phi, Jb, gam, T = args
     n, m = q.shape[0], phi.shape[0]
+    v1, nu = x[:n], x[n:]
     for i in range(n):
         q1[i] = q[i] + h * v1[i]
         dv[i] = v1[i] - v[i]
@@ -68,9 +89,9 @@ def _assemble(kern, q, v, t1, h, p, v1, nu, q1, dv, rhs, H, Jq, Jqd, dHw, DJ, ph
         for k in range(m):
             r -= Jb[k, i] * nu[k]
             K[i, n + k] = -Jb[k, i]
-        b[i] = -r
+        F[i] = r
     for k in range(m):
-        b[n + k] = -phi[k] / h
+        F[n + k] = phi[k] / h
         for j in range(n):
             K[n + k, j] = Jb[k, j]
         for j in range(m):
@@ -78,76 +99,44 @@ def _assemble(kern, q, v, t1, h, p, v1, nu, q1, dv, rhs, H, Jq, Jqd, dHw, DJ, ph
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
-    v1, q1, dv, rhs = work[_V1], work[_Q1], work[_DV], work[_RHS]
-    H, Jq, Jqd, dHw, DJ = mats[_H], mats[_JQ], mats[_JQD], mats[_DHW], mats[_DJ]
-    lam, phi, gam, nu, c2, eta, Ja, Jb, Y, T, b, K = views(extra, n, m, n + m)
-    t1 = t + h
+    x, q1, vp, phi, Jb, eta = ws.x, ws.q1, ws.vp, ws.phi, ws.Jb, ws.eta
     for i in range(n):
-        v1[i] = v[i]
+        x[i] = v[i]
     for k in range(m):
-        nu[k] = h * lam[k]
-    resid = prev = 0.0
-    converged = False
-    iters = 0
-    for it in range(1, max_iter + 1):
-        iters = it
-        _assemble(kern, q, v, t1, h, p, v1, nu, q1, dv, rhs, H, Jq, Jqd, dHw, DJ, phi, Jb, gam,
-                  T, b, K)
-        resid = max_abs(b)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        if not gauss_solve(K, b):
-            return failed_solve_status(K), it, resid
-        xmax = 0.0
-        for i in range(n):
-            v1[i] += b[i]
-            xmax = max(xmax, abs(v1[i]))
-        for k in range(m):
-            nu[k] += b[n + k]
-            xmax = max(xmax, abs(nu[k]))
-        d = max_abs(b)
-        if increment_converged(d, xmax, prev, tol):
-            converged = True
-            break
-        prev = d
-    if not converged:
-        return NEWTON_DIVERGED, iters, resid
-    for i in range(n):
-        q1[i] = q[i] + h * v1[i]
-    kern.constraints(q1, v1, p, phi, Jb, gam)
-    status = velocity_projection(kern, q1, p, Jb, Y, H, schur_block(extra, n, m), eta, v1, False)
+        x[n + k] = h * extra[k]               # nu from the previous step's multiplier
+    args = (q, v, t + h, h, p, q1, ws.dv, ws.rhs, ws.H, ws.Jq, ws.Jqd, ws.dHw, ws.DJ, phi, Jb,
+            ws.gam, ws.T)
+    status, iters, resid = newton.solve(_THIS, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
+                                        settings.newton_tol, settings.max_iter)
     if status != OK:
         return status, iters, resid
     for i in range(n):
-        q[i], v[i] = q1[i], v1[i]
+        q1[i] = q[i] + h * x[i]
+        vp[i] = x[i]
+    kern.constraints(q1, vp, p, phi, Jb, ws.gam)
+    status = velocity_projection(kern, q1, p, Jb, ws.Y, ws.H, ws.S, eta, vp, False)
+    if status != OK:
+        return status, iters, resid
+    for i in range(n):
+        q[i], v[i] = q1[i], vp[i]
     for k in range(m):
-        lam[k] = (nu[k] + eta[k]) / h
+        extra[k] = (x[n + k] + eta[k]) / h    # total impulse over h
     record(extra, m, phi, Jb, v)
     return OK, iters, resid
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop and constrained.py: out_extra (S, m + 2), out_last (2n + 3 + total)
-    with (m + 2, total) = constrained.extra_size(n, m), settings (N_CONSTRAINED_SETTINGS,)."""
-    check_buffers(kern, q0, settings, out_extra, out_last)
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(
-    name="constrained_implicit_euler", order=1, family="constrained", implicit=True, symplectic=False,
-    symmetric=False,
+    name="constrained_implicit_euler", order=1, family="constrained", implicit=True,
+    symplectic=False, symmetric=False,
     summary="index-3 backward Euler with velocity projection",
     constraints=True,
-    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    saved=SAVED,
     settings=NewtonSettings,
-    kernels=("constraint_dq", "constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq", "rhs_jacobian"))
+    kernels=("constraint_dq", "constraints", "dynamics", "energy", "mass_matrix",
+             "mass_matvec_dq", "rhs_jacobian"))

@@ -22,57 +22,76 @@ Newton on (vb, nu) uses the exact Jacobian of (R1, R2):
      [J(q + h vb),                                          0     ]]
 
 (J(q) is the known start of the step, so no derivative of J^T nu enters), assembled from
-``mass_matvec_dq``, ``momentum_rate_jacobian`` and ``constraints``, solved by Gaussian
-elimination with partial pivoting (constrained.gauss_solve). It starts from vb = v and the
-previous step's multiplier and stops on the Newton increment (base.newton_converged's test).
+``mass_matvec_dq``, ``momentum_rate_jacobian`` and ``constraints``, through newton.solve (LU
+with partial pivoting, its stopping rule on the increment). It starts from vb = v and the
+previous step's multiplier.
 """
 
 import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
-from ..status import NEWTON_DIVERGED, OK
+from ..status import OK
+from . import newton
+from .base import FAST, momentum_from_velocity
+from .constrained import SAVED, finish_momentum_step
 from .spec import NewtonSettings, Spec
-from .base import (FAST, S_MAX_ITER, S_TOL, failed_solve_status, increment_converged, max_abs,
-                   momentum_from_velocity, run_loop)
-from .constrained import (check_buffers, gauss_solve, record, schur_block,
-                          velocity_projection, views)
 
-_VB, _QB, _Q1, _V1, _F, _PT = 0, 1, 2, 3, 4, 5     # work rows
-_H, _JQ, _JQD, _DHW = 0, 1, 2, 3                   # mats
+#: Scratch of one run (n coordinates, m constraints): the Newton unknown x = (vb, nu), residual
+#: F, solver scratch s (n + m), pivots, its matrix K (n + m, n + m); the midpoint qb, end point
+#: q1, velocity v1, momentum rate f, momentum pt (n); H, df/dq, df/dv, d(H vb)/dq (n, n);
+#: Phi, gamma, the end impulse eta (m); J(q), J(q1), H^-1 J^T rows Y (m, n); Schur S (m, m).
+Workspace = namedtuple("Workspace", "x F s piv K qb q1 v1 f pt H Jq Jqd dHw phi gam eta Ja Jb "
+                                    "Y S")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    m = kern.N_CONSTRAINTS
+    N = n + m
+    return Workspace(np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N, np.int64),
+                     np.zeros((N, N)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, n)),
+                     np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, m)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps."""
-    momentum_from_velocity(kern, q, v, p, mats[_H], mom)
+    momentum_from_velocity(kern, q, v, p, ws.H, mom)
     return OK
 
 
 @njit(inline="always")
-def _assemble(kern, q, mom, tm, h, p, vb, nu, qb, q1, f, H, Jq, Jqd, dHw, phi, Ja, Jb, gam, b, K):
-    """Residual b = -(R1, R2) and its Jacobian K (n + m) at (vb, nu)."""
+def assemble(kern, args, x, F, K):
+    """Newton system of the step (newton.solve): F (n + m) <- (R1, R2) at x = (vb, nu), K its
+    Jacobian."""
+    q, mom, tm, h, p, qb, q1, f, H, Jq, Jqd, dHw, phi, Ja, Jb, gam = args
     n, m = q.shape[0], phi.shape[0]
     hh = 0.5 * h
     for i in range(n):
-        qb[i] = q[i] + hh * vb[i]
-        q1[i] = q[i] + h * vb[i]
+        qb[i] = q[i] + hh * x[i]
+        q1[i] = q[i] + h * x[i]
     kern.mass_matrix(qb, p, H)
-    kern.mass_matvec_dq(qb, vb, p, dHw)
-    kern.momentum_rate(qb, vb, tm, p, f)
-    kern.momentum_rate_jacobian(qb, vb, tm, p, Jq, Jqd)
-    kern.constraints(q1, vb, p, phi, Jb, gam)
+    kern.mass_matvec_dq(qb, x[:n], p, dHw)
+    kern.momentum_rate(qb, x[:n], tm, p, f)
+    kern.momentum_rate_jacobian(qb, x[:n], tm, p, Jq, Jqd)
+    kern.constraints(q1, x[:n], p, phi, Jb, gam)
     for i in range(n):
         r = -mom[i] - hh * f[i]
         for j in range(n):
-            r += H[i, j] * vb[j]
+            r += H[i, j] * x[j]
             K[i, j] = H[i, j] + hh * dHw[i, j] - hh * hh * Jq[i, j] - hh * Jqd[i, j]
         for k in range(m):
-            r -= Ja[k, i] * nu[k]
+            r -= Ja[k, i] * x[n + k]
             K[i, n + k] = -Ja[k, i]
-        b[i] = -r
+        F[i] = r
     for k in range(m):
-        b[n + k] = -phi[k] / h
+        F[n + k] = phi[k] / h
         for j in range(n):
             K[n + k, j] = Jb[k, j]
         for j in range(m):
@@ -80,45 +99,23 @@ def _assemble(kern, q, mom, tm, h, p, vb, nu, qb, q1, f, H, Jq, Jqd, dHw, phi, J
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
-    vb, qb, q1, v1, f, pt = work[_VB], work[_QB], work[_Q1], work[_V1], work[_F], work[_PT]
-    H, Jq, Jqd, dHw = mats[_H], mats[_JQ], mats[_JQD], mats[_DHW]
-    lam, phi, gam, nu, c2, eta, Ja, Jb, Y, T, b, K = views(extra, n, m, n + m)
+    x, qb, q1, f, pt = ws.x, ws.qb, ws.q1, ws.f, ws.pt
     hh, tm = 0.5 * h, t + 0.5 * h
-    kern.constraints(q, v, p, phi, Ja, gam)
+    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     for i in range(n):
-        vb[i] = v[i]
+        x[i] = v[i]
     for k in range(m):
-        nu[k] = hh * lam[k]
-    resid = prev = 0.0
-    converged = False
-    iters = 0
-    for it in range(1, max_iter + 1):
-        iters = it
-        _assemble(kern, q, mom, tm, h, p, vb, nu, qb, q1, f, H, Jq, Jqd, dHw, phi, Ja, Jb, gam,
-                  b, K)
-        resid = max_abs(b)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        if not gauss_solve(K, b):
-            return failed_solve_status(K), it, resid
-        xmax = 0.0
-        for i in range(n):
-            vb[i] += b[i]
-            xmax = max(xmax, abs(vb[i]))
-        for k in range(m):
-            nu[k] += b[n + k]
-            xmax = max(xmax, abs(nu[k]))
-        d = max_abs(b)
-        if increment_converged(d, xmax, prev, tol):
-            converged = True
-            break
-        prev = d
-    if not converged:
-        return NEWTON_DIVERGED, iters, resid
+        x[n + k] = hh * extra[k]              # nu from the previous step's multiplier
+    args = (q, mom, tm, h, p, qb, q1, f, ws.H, ws.Jq, ws.Jqd, ws.dHw, ws.phi, ws.Ja, ws.Jb,
+            ws.gam)
+    status, iters, resid = newton.solve(_THIS, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
+                                        settings.newton_tol, settings.max_iter)
+    if status != OK:
+        return status, iters, resid
+    vb = x[:n]
     for i in range(n):
         qb[i] = q[i] + hh * vb[i]
         q1[i] = q[i] + h * vb[i]
@@ -126,35 +123,14 @@ def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
     for i in range(n):
         s = mom[i] + h * f[i]
         for k in range(m):
-            s += Ja[k, i] * nu[k]
+            s += ws.Ja[k, i] * x[n + k]
         pt[i] = s
-        v1[i] = s
-    kern.constraints(q1, vb, p, phi, Jb, gam)
-    status = velocity_projection(kern, q1, p, Jb, Y, H, schur_block(extra, n, m), eta, v1, True)
-    if status != OK:
-        return status, iters, resid
-    for i in range(n):
-        s = pt[i]
-        for k in range(m):
-            s += Jb[k, i] * eta[k]
-        q[i], v[i], mom[i] = q1[i], v1[i], s
-    for k in range(m):
-        lam[k] = eta[k] / hh
-    record(extra, m, phi, Jb, v)
-    return OK, iters, resid
+    status = finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, vb, ws.phi, ws.Jb, ws.gam,
+                                  ws.Y, ws.H, ws.S, ws.eta, ws.v1, extra)
+    return status, iters, resid
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop and constrained.py: out_extra (S, m + 2), out_last (2n + 3 + total)
-    with (m + 2, total) = constrained.extra_size(n, m), settings (N_CONSTRAINED_SETTINGS,)."""
-    check_buffers(kern, q0, settings, out_extra, out_last)
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(
@@ -162,6 +138,7 @@ SPEC = Spec(
     symmetric=True,
     summary="midpoint variational integrator with constraints",
     constraints=True,
-    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    saved=SAVED,
     settings=NewtonSettings,
-    kernels=("constraints", "energy", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))
+    kernels=("constraints", "energy", "mass_matrix", "mass_matvec_dq", "momentum_rate",
+             "momentum_rate_jacobian"))

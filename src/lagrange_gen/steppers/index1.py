@@ -18,33 +18,46 @@ terms turn the drift into a damped oscillation around Phi = 0 for alpha, beta > 
 dynamics and need alpha, beta tuned to h. The tests and bench show |Phi| growing over 1e5 steps
 while the projected methods stay at the Newton tolerance. The multiplier and the residuals are
 reported at the end of every step (the acceleration there is cached for the next step's first
-stage: four KKT solves per step).
+stage: four KKT solves per step; prepare computes the first one).
 
-Settings: settings[S_BAUMGARTE_ALPHA], settings[S_BAUMGARTE_BETA] (default 0: no stabilization).
+Settings (Index1Settings): baumgarte = (alpha, beta) (default (0, 0): no stabilization).
 """
 
 import sys
+from collections import namedtuple
 from typing import NamedTuple
 
+import numpy as np
 from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
-from .spec import Spec
-from .base import FAST, W_ACC, run_loop
-from .constrained import (S_BAUMGARTE_ALPHA, S_BAUMGARTE_BETA, check_buffers, flag_index, record,
-                          schur_block, solve_rows, views)
+from .base import FAST
+from .constrained import SAVED, record, solve_rows
 from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
+from .spec import Spec
 
-# work rows: stage velocities 0-3, stage accelerations 4-7, stage q, new state (W_ACC = 11 kept)
-_V, _A, _QS, _Q_NEW, _V_NEW = 0, 4, 8, 9, 10
-_H = 0                                  # mats
+#: Scratch of one run (n coordinates, m constraints): the acceleration a0 at the current state
+#: (cached from step to step), stage velocities and accelerations (4, n), stage q qs, the new
+#: state (n); H (n, n); stage multipliers ls, Phi, gamma (m); J, H^-1 J^T rows Y (m, n); Schur
+#: S (m, m).
+Workspace = namedtuple("Workspace", "a0 stage_v stage_a qs q_new v_new H ls phi gam J Y S")
 
 
-@njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
-    """The first step computes the acceleration at the initial state (it needs extra)."""
-    return OK
+class Index1Settings(NamedTuple):
+    """index1's settings: Baumgarte's (alpha, beta), Phi'' + 2 alpha Phi' + beta^2 Phi = 0."""
+
+    blowup_bound: float = 1e150
+    baumgarte: tuple = (0.0, 0.0)
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    m = kern.N_CONSTRAINTS
+    return Workspace(np.zeros(n), np.zeros((4, n)), np.zeros((4, n)), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros(m),
+                     np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, m)))
 
 
 @njit(**FAST)
@@ -78,74 +91,57 @@ def _accel(kern, q, v, t, p, alpha, beta, H, a, lam, phi, J, gam, Y, S):
 
 
 @njit(**FAST)
-def stage_acceleration(kern, ctx, q, v, t, a):
-    """explicit_rk's callback: a (n,) from the KKT system (_accel); the stage multipliers go to
-    scratch. ctx = (p, alpha, beta, H, lam, phi, J, gam, Y, S)."""
-    p, alpha, beta, H, lam, phi, J, gam, Y, S = ctx
-    return _accel(kern, q, v, t, p, alpha, beta, H, a, lam, phi, J, gam, Y, S)
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """The acceleration at the initial state (the first stage of the first step); the saved
+    multiplier of row 0 (from the driver) is left as it is."""
+    alpha, beta = settings.baumgarte
+    return _accel(kern, q, v, t, p, alpha, beta, ws.H, ws.a0, ws.ls, ws.phi, ws.J, ws.gam,
+                  ws.Y, ws.S)
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def stage_acceleration(kern, ctx, q, v, t, a):
+    """explicit_rk's callback: a (n,) from the KKT system (_accel); the stage multipliers go to
+    scratch. ctx = (p, alpha, beta, ws)."""
+    p, alpha, beta, ws = ctx
+    return _accel(kern, q, v, t, p, alpha, beta, ws.H, a, ws.ls, ws.phi, ws.J, ws.gam, ws.Y,
+                  ws.S)
+
+
+@njit(**FAST)
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One rk4 step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    alpha, beta = settings[S_BAUMGARTE_ALPHA], settings[S_BAUMGARTE_BETA]
-    lam, phi, gam, ls, c2, c3, J, Jb, Y, T, b, K = views(extra, n, m, m)
-    S = schur_block(extra, n, m)
-    H = mats[_H]
-    a0, stage_v, stage_a = work[W_ACC], work[_V:_A], work[_A:_QS]
-    qs, q_new, v_new = work[_QS], work[_Q_NEW], work[_V_NEW]
-    flag = flag_index(m)
-    if extra[flag] == 0.0:                    # first step of this run: a at the start state
-        status = _accel(kern, q, v, t, p, alpha, beta, H, a0, lam, phi, J, gam, Y, S)
-        if status != OK:
-            return status, 0, 0.0
-        extra[flag] = 1.0
+    alpha, beta = settings.baumgarte
+    a0, stage_a, q_new, v_new = ws.a0, ws.stage_a, ws.q_new, ws.v_new
     for i in range(n):
         stage_a[0, i] = a0[i]
-    status = rk_step(_THIS, kern, (p, alpha, beta, H, ls, phi, J, gam, Y, S), RK4_A, RK4_B,
-                     RK4_C, q, v, t, h, stage_v, stage_a, qs, q_new, v_new, True)
+    status = rk_step(_THIS, kern, (p, alpha, beta, ws), RK4_A, RK4_B, RK4_C, q, v, t, h,
+                     ws.stage_v, stage_a, ws.qs, q_new, v_new, True)
     if status != OK:
         return status, 0, 0.0
     # Acceleration and multiplier at the new state: reported now, first stage of the next step.
-    status = _accel(kern, q_new, v_new, t + h, p, alpha, beta, H, stage_a[0], ls, phi, J, gam,
-                    Y, S)
+    status = _accel(kern, q_new, v_new, t + h, p, alpha, beta, ws.H, stage_a[0], ws.ls, ws.phi,
+                    ws.J, ws.gam, ws.Y, ws.S)
     if status != OK:
         return status, 0, 0.0
     for i in range(n):
         q[i], v[i], a0[i] = q_new[i], v_new[i], stage_a[0, i]
     for k in range(m):
-        lam[k] = ls[k]
-    record(extra, m, phi, J, v)
+        extra[k] = ws.ls[k]
+    record(extra, m, ws.phi, ws.J, v)
     return OK, 0, 0.0
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop and constrained.py: out_extra (S, m + 2), out_last (2n + 3 + total)
-    with (m + 2, total) = constrained.extra_size(n, m), settings (N_CONSTRAINED_SETTINGS,)."""
-    check_buffers(kern, q0, settings, out_extra, out_last)
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
+# This module as a value for explicit_rk.rk_step (see base.py: modules, not dispatchers).
 _THIS = sys.modules[__name__]
-
-class Index1Settings(NamedTuple):
-    """index1's settings: Baumgarte's (alpha, beta), Phi'' + 2 alpha Phi' + beta^2 Phi = 0."""
-
-    blowup_bound: float = 1e150
-    baumgarte: tuple = (0.0, 0.0)
-
 
 SPEC = Spec(
     name="index1", order=4, family="constrained", implicit=False, symplectic=False,
     symmetric=False,
     summary="rk4 on the acceleration-level KKT form (drifts: the bad example)",
     constraints=True,
-    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    saved=SAVED,
     limits={"baumgarte": (0.0, True, False)},
     settings=Index1Settings,
     kernels=("constraints", "dynamics", "energy"))

@@ -14,16 +14,15 @@ the Newton tolerance and J v_n = 0 to round-off at every step, so there is no dr
 reported multiplier is mu (the force at t + h; first-order accurate in h, like RATTLE's two
 multipliers separately, HLW VII.1.4).
 
-Explicit path (constant H, velocity-free forces, settings[S_MODE] == 0: Cartesian models), the
+Explicit path (constant H, velocity-free forces, not settings.newton_always: Cartesian models), the
 classical RATTLE of Andersen (1983) with one force evaluation per step:
 
     v* = v + h/2 a(q),   q+ = q + h v* + h^2/2 M^-1 J(q)^T lam,   Phi(q+) = 0
     v+ = v* + h/2 a(q+) + h/2 M^-1 J(q+)^T mu,   J(q+) v+ = 0
 
-Newton on kappa = h^2/2 lam with Jacobian J(q+) M^-1 J(q)^T (m x m), started from the previous
-step's multiplier; M is factored once per run. It stops when every |Phi_i| / |J_i| is below the
-Newton tolerance (relative to max(1, |q|)), checked at the accepted q+ (so the reported |Phi| is
-verified, not extrapolated).
+Newton on kappa = h^2/2 lam (a displacement of q+) with the exact Jacobian J(q+) M^-1 J(q)^T
+(m x m), started from the previous step's multiplier; M is factored and J(q) computed once per
+run (then J(q+) is kept for the next step). The reported |Phi| is evaluated at the accepted q+.
 
 Newton path (H(q) or velocity-dependent forces): one Newton iteration on the whole position
 stage (u, w, nu = h/2 lam), size 2n + m, with the exact Jacobian
@@ -32,105 +31,123 @@ stage (u, w, nu = h/2 lam), size 2n + m, with the exact Jacobian
      [h/2 D - H(q),            H(q+) + h/2 D,      0       ],     D = d(H(q) w)/dq at q+
      [J(q+)/2,                 J(q+)/2,            0       ]]
 
-for the residuals (kick, drift, Phi(q+)/h), solved by Gaussian elimination with partial
-pivoting (constrained.gauss_solve). A singular Newton matrix is SINGULAR_NEWTON (NON_FINITE when
-it holds NaN or inf); a singular J M^-1 J^T on the explicit path (redundant constraints) is
-SINGULAR_MASS.
+for the residuals (kick, drift, Phi(q+)/h). Both Newton iterations are newton.solve's (LU with
+partial pivoting, its stopping rule on the increment): a singular Newton matrix (on the explicit
+path J M^-1 J^T: redundant constraints) is SINGULAR_NEWTON, NON_FINITE when it holds NaN or inf;
+a singular J H^-1 J^T in the velocity projection is SINGULAR_MASS.
 """
 
-import sys
+from collections import namedtuple
 
+import numpy as np
 from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
-from ..status import NEWTON_DIVERGED, OK, SINGULAR_MASS
+from ..status import OK, SINGULAR_MASS
+from . import newton
+from .base import FAST, explicit_path, momentum_from_velocity
+from .constrained import SAVED, finish_momentum_step, project, record, solve_rows
 from .spec import PartitionedSettings, Spec
-from .base import (FAST, increment_converged, S_MAX_ITER, S_TOL, W_ACC, explicit_path,
-                   failed_solve_status, max_abs, momentum_from_velocity, run_loop)
-from .constrained import (check_buffers, flag_index, gauss_solve, phi_small,
-                          project, record, schur_block, solve_rows, velocity_projection, views)
 
-_VH, _Z, _QN, _VN, _F, _U, _W, _PT = 0, 1, 2, 3, 4, 5, 6, 7     # work rows (W_ACC is kept)
-_L, _H, _H1, _JQ, _JQD, _D = 0, 1, 2, 3, 4, 5                  # mats (_L kept: chol(M))
+#: Scratch of one run (n coordinates, m constraints).
+#: Explicit path: the Newton unknown kappa, its residual Fk, solver scratch sk and pivots (m),
+#: matrix Kk (m, m); the cached acceleration acc, the half-step velocity vh, the unconstrained
+#: position z, the new state q1, v1, the force f (n); chol(M) L (n, n), kept for the run.
+#: Newton path: the unknown x = (u, w, nu), residual F, scratch s, pivots (2n + m), matrix K;
+#: the momentum pt (n); H(q), H(q+), df/dq, df/dv, d(H w)/dq at q+ (n, n).
+#: Both: Phi, gamma, the end impulse eta (m); J(q) (kept from step to step on the explicit path),
+#: J(q+), the rows H^-1 J^T Y, T (m, n); Schur S (m, m).
+Workspace = namedtuple("Workspace", "kap Fk sk pivk Kk acc vh z q1 v1 f L x F s piv K pt H0 H1 "
+                                    "Jq Jqd D phi gam eta Ja Jb Y T S")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    m = kern.N_CONSTRAINTS
+    N = 2 * n + m
+    return Workspace(np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m, np.int64),
+                     np.zeros((m, m)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros(n), np.zeros((n, n)), np.zeros(N), np.zeros(N),
+                     np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)), np.zeros(n),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, n)),
+                     np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, m)))
 
 
 @njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
-    """Explicit path: factor the constant M once (mats[_L]) and cache a(q, t) in work[W_ACC].
-    Newton path: carry p = H(q) v."""
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """Explicit path: factor the constant M once (ws.L), cache a(q, t) in ws.acc and J(q) in
+    ws.Ja. Newton path: carry p = H(q) v."""
     if explicit_path(kern, settings):
-        L, acc = mats[_L], work[W_ACC]
+        L, acc = ws.L, ws.acc
         kern.dynamics(q, v, t, p, L, acc)
         if not cholesky_inplace(L):
             return SINGULAR_MASS
         cholesky_solve_inplace(L, acc)
+        kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
         return OK
-    momentum_from_velocity(kern, q, v, p, mats[_H], mom)
+    momentum_from_velocity(kern, q, v, p, ws.H0, mom)
     return OK
 
 
+@njit(inline="always")
+def assemble_multiplier(kern, args, kap, F, K):
+    """Newton system of the explicit path: F (m) <- Phi(q+) at q+ = z + Y^T kappa, K (m, m) <-
+    J(q+) Y^T = J(q+) M^-1 J(q)^T."""
+    z, vh, p, Y, q1, phi, Jb, gam = args
+    n, m = z.shape[0], kap.shape[0]
+    for i in range(n):
+        s = z[i]
+        for k in range(m):
+            s += Y[k, i] * kap[k]
+        q1[i] = s
+    kern.constraints(q1, vh, p, phi, Jb, gam)
+    for i in range(m):
+        F[i] = phi[i]
+        for k in range(m):
+            s = 0.0
+            for j in range(n):
+                s += Jb[i, j] * Y[k, j]
+            K[i, k] = s
+
+
 @njit(**FAST)
-def _step_explicit(kern, q, v, t, h, p, settings, work, mats, extra):
+def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
-    L, Hs = mats[_L], mats[_H]
-    acc, vh, z, q1, v1, f = work[W_ACC], work[_VH], work[_Z], work[_QN], work[_VN], work[_F]
-    lam, phi, gam, kap, c2, eta, Ja, Jb, Y, T, b, K = views(extra, n, m, m)
+    L, acc, vh, z, q1, v1, f = ws.L, ws.acc, ws.vh, ws.z, ws.q1, ws.v1, ws.f
+    kap, phi, Ja, Jb, Y = ws.kap, ws.phi, ws.Ja, ws.Jb, ws.Y
     hh = 0.5 * h
     for i in range(n):
         vh[i] = v[i] + hh * acc[i]
         z[i] = q[i] + h * vh[i]
-    flag = flag_index(m)
-    if extra[flag] == 0.0:                    # else Ja = J(q) is kept from the previous step
-        kern.constraints(q, v, p, phi, Ja, gam)
-        extra[flag] = 1.0
     solve_rows(L, Ja, Y)                      # rows M^-1 J(q)_k^T: q+ = z + Y^T kappa
     for k in range(m):
-        kap[k] = hh * h * lam[k]
-    iters = 0
-    while True:
-        for i in range(n):
-            s = z[i]
-            for k in range(m):
-                s += Y[k, i] * kap[k]
-            q1[i] = s
-        kern.constraints(q1, vh, p, phi, Jb, gam)
-        resid = max_abs(phi)
-        if resid != resid:
-            return NEWTON_DIVERGED, iters, resid
-        if phi_small(phi, Jb, q1, tol):
-            break
-        if iters == max_iter:
-            return NEWTON_DIVERGED, iters, resid
-        iters += 1
-        for i in range(m):
-            b[i] = -phi[i]
-            for k in range(m):
-                s = 0.0
-                for j in range(n):
-                    s += Jb[i, j] * Y[k, j]
-                K[i, k] = s
-        if not gauss_solve(K, b):
-            return SINGULAR_MASS, iters, resid
-        for k in range(m):
-            kap[k] += b[k]
-    for i in range(n):                        # v_1/2 = v* + h/2 M^-1 J(q)^T lam
+        kap[k] = hh * h * extra[k]
+    status, iters, resid = newton.solve(_MULTIPLIER, kern, (z, vh, p, Y, q1, phi, Jb, ws.gam),
+                                        kap, ws.Fk, ws.Kk, ws.pivk, ws.sk,
+                                        settings.newton_tol, settings.max_iter)
+    if status != OK:
+        return status, iters, resid
+    for i in range(n):                        # q+ and v_1/2 = v* + h/2 M^-1 J(q)^T lam
         s = 0.0
         for k in range(m):
             s += Y[k, i] * kap[k]
+        q1[i] = z[i] + s
         vh[i] += s / h
+    kern.constraints(q1, vh, p, phi, Jb, ws.gam)
     # Velocity stage: forces are velocity-free here, so a(q+) does not depend on vh.
-    kern.dynamics(q1, vh, t + h, p, Hs, f)
+    kern.dynamics(q1, vh, t + h, p, ws.H0, f)
     cholesky_solve_inplace(L, f)
     for i in range(n):
         v1[i] = vh[i] + hh * f[i]
-    solve_rows(L, Jb, T)
-    if not project(Jb, T, v1, K, eta):        # eta = h/2 mu
+    solve_rows(L, Jb, ws.T)
+    if not project(Jb, ws.T, v1, ws.S, ws.eta):        # eta = h/2 mu
         return SINGULAR_MASS, iters, resid
     for i in range(n):
         q[i], v[i], acc[i] = q1[i], v1[i], f[i]
     for k in range(m):
-        lam[k] = eta[k] / hh
+        extra[k] = ws.eta[k] / hh
         for j in range(n):
             Ja[k, j] = Jb[k, j]               # J(q) of the next step
     record(extra, m, phi, Jb, v)
@@ -138,10 +155,12 @@ def _step_explicit(kern, q, v, t, h, p, settings, work, mats, extra):
 
 
 @njit(inline="always")
-def _assemble(kern, q, mom, t, h, p, u, w, nu, q1, f, H0, H1, Jq, Jqd, D, phi, Ja, Jb, gam,
-              b, K):
-    """Residual b = -(kick, drift, Phi(q+)/h) and its Jacobian K (2n + m) at (u, w, nu)."""
+def assemble_position(kern, args, x, F, K):
+    """Newton system of the Newton path: F (2n + m) <- (kick, drift, Phi(q+)/h) at
+    x = (u, w, nu), K its Jacobian (module docstring)."""
+    q, mom, t, h, p, q1, f, H0, H1, Jq, Jqd, D, phi, Ja, Jb, gam = args
     n, m = q.shape[0], phi.shape[0]
+    u, w = x[:n], x[n:2 * n]
     hh = 0.5 * h
     for i in range(n):
         q1[i] = q[i] + hh * (u[i] + w[i])
@@ -161,13 +180,13 @@ def _assemble(kern, q, mom, t, h, p, u, w, nu, q1, f, H0, H1, Jq, Jqd, D, phi, J
             K[n + i, j] = hh * D[i, j] - H0[i, j]
             K[n + i, n + j] = H1[i, j] + hh * D[i, j]
         for k in range(m):
-            ra -= Ja[k, i] * nu[k]
+            ra -= Ja[k, i] * x[2 * n + k]
             K[i, 2 * n + k] = -Ja[k, i]
             K[n + i, 2 * n + k] = 0.0
-        b[i] = -ra
-        b[n + i] = -rb
+        F[i] = ra
+        F[n + i] = rb
     for k in range(m):
-        b[2 * n + k] = -phi[k] / h
+        F[2 * n + k] = phi[k] / h
         for j in range(n):
             K[2 * n + k, j] = 0.5 * Jb[k, j]
             K[2 * n + k, n + j] = 0.5 * Jb[k, j]
@@ -176,48 +195,24 @@ def _assemble(kern, q, mom, t, h, p, u, w, nu, q1, f, H0, H1, Jq, Jqd, D, phi, J
 
 
 @njit(**FAST)
-def _step_newton(kern, q, v, mom, t, h, p, settings, work, mats, extra):
+def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    size = 2 * n + m
-    tol, max_iter = settings[S_TOL], int(settings[S_MAX_ITER])
-    u, w, q1, v1, f, pt = work[_U], work[_W], work[_QN], work[_VN], work[_F], work[_PT]
-    H0, H1, Jq, Jqd, D = mats[_H], mats[_H1], mats[_JQ], mats[_JQD], mats[_D]
-    lam, phi, gam, nu, c2, eta, Ja, Jb, Y, T, b, K = views(extra, n, m, size)
+    x, q1, f, pt, H0 = ws.x, ws.q1, ws.f, ws.pt, ws.H0
     hh = 0.5 * h
     kern.mass_matrix(q, p, H0)
-    kern.constraints(q, v, p, phi, Ja, gam)
+    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     for i in range(n):
-        u[i] = v[i]
-        w[i] = v[i]
+        x[i] = v[i]
+        x[n + i] = v[i]
     for k in range(m):
-        nu[k] = hh * lam[k]
-    resid = prev = 0.0
-    converged = False
-    iters = 0
-    for it in range(1, max_iter + 1):
-        iters = it
-        _assemble(kern, q, mom, t, h, p, u, w, nu, q1, f, H0, H1, Jq, Jqd, D, phi, Ja, Jb, gam,
-                  b, K)
-        resid = max_abs(b)
-        if resid != resid:
-            return NEWTON_DIVERGED, it, resid
-        if not gauss_solve(K, b):
-            return failed_solve_status(K), it, resid
-        xmax = 0.0
-        for i in range(n):
-            u[i] += b[i]
-            w[i] += b[n + i]
-            xmax = max(xmax, abs(u[i]), abs(w[i]))
-        for k in range(m):
-            nu[k] += b[2 * n + k]
-            xmax = max(xmax, abs(nu[k]))
-        d = max_abs(b)
-        if increment_converged(d, xmax, prev, tol):
-            converged = True
-            break
-        prev = d
-    if not converged:
-        return NEWTON_DIVERGED, iters, resid
+        x[2 * n + k] = hh * extra[k]          # nu from the previous step's multiplier
+    args = (q, mom, t, h, p, q1, f, H0, ws.H1, ws.Jq, ws.Jqd, ws.D, ws.phi, ws.Ja, ws.Jb,
+            ws.gam)
+    status, iters, resid = newton.solve(_POSITION, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
+                                        settings.newton_tol, settings.max_iter)
+    if status != OK:
+        return status, iters, resid
+    u, w = x[:n], x[n:2 * n]
     for i in range(n):
         q1[i] = q[i] + hh * (u[i] + w[i])
     kern.momentum_rate(q1, w, t + h, p, f)
@@ -226,48 +221,29 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, work, mats, extra):
         for j in range(n):
             s += H0[i, j] * u[j]              # H(q) u = p + h/2 f + J^T nu, exactly
         pt[i] = s
-        v1[i] = s
-    kern.constraints(q1, w, p, phi, Jb, gam)
-    status = velocity_projection(kern, q1, p, Jb, Y, H1, schur_block(extra, n, m), eta, v1, True)
-    if status != OK:
-        return status, iters, resid
-    for i in range(n):
-        s = pt[i]
-        for k in range(m):
-            s += Jb[k, i] * eta[k]
-        q[i], v[i], mom[i] = q1[i], v1[i], s
-    for k in range(m):
-        lam[k] = eta[k] / hh
-    record(extra, m, phi, Jb, v)
-    return OK, iters, resid
+    status = finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, w, ws.phi, ws.Jb, ws.gam,
+                                  ws.Y, ws.H1, ws.S, ws.eta, ws.v1, extra)
+    return status, iters, resid
 
 
 @njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
-        return _step_explicit(kern, q, v, t, h, p, settings, work, mats, extra)
-    return _step_newton(kern, q, v, mom, t, h, p, settings, work, mats, extra)
+        return _step_explicit(kern, q, v, t, h, p, settings, ws, extra)
+    return _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra)
 
 
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop and constrained.py: out_extra (S, m + 2), out_last (2n + 3 + total)
-    with (m + 2, total) = constrained.extra_size(n, m), settings (N_CONSTRAINED_SETTINGS,)."""
-    check_buffers(kern, q0, settings, out_extra, out_last)
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
-_THIS = sys.modules[__name__]
+# The two Newton systems as modules for newton.solve (see newton.py: modules, not dispatchers).
+_MULTIPLIER = newton.problem(__name__ + "._multiplier", assemble_multiplier)
+_POSITION = newton.problem(__name__ + "._position", assemble_position)
 
 SPEC = Spec(
     name="rattle", order=2, family="constrained", implicit=True, symplectic=True,
     symmetric=True,
     summary="constrained Verlet, Newton on the multipliers",
     constraints=True,
-    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    saved=SAVED,
     settings=PartitionedSettings,
-    kernels=("constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq", "momentum_rate", "momentum_rate_jacobian"))
+    kernels=("constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq",
+             "momentum_rate", "momentum_rate_jacobian"))

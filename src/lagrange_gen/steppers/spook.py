@@ -12,8 +12,9 @@ start of the step and nu = h lam the impulse:
 
     Sigma = 4 epsilon / (h^2 (1 + 4 d)),   Upsilon = 1 / (1 + 4 d),   q+ = q + h v+
 
-solved through the SPD Schur complement (G M^-1 G^T + Sigma I) nu = rhs (Cholesky; M factored
-once per step). One linear solve per step, no Newton.
+solved as one system in x = (v+, nu), (n + m), by base.newton_solve (LU with partial pivoting;
+SINGULAR_NEWTON when it is singular, e.g. redundant constraints at epsilon = 0). One linear
+solve per step, no Newton.
 
 Order 1 (the discretization is symplectic-Euler-like). Properties the tests check: for fixed h
 it is stable for any stiffness, including epsilon = 0 (rigid, stabilized constraints): on the
@@ -25,92 +26,26 @@ constraints are not met to a Newton tolerance: |Phi| is O(h^2) plus the spring's
 stretch epsilon |lam|, and is reported as is. Non-constraint forces are explicit (stiff springs
 in V still limit h).
 
-Settings: settings[S_COMPLIANCE] = epsilon >= 0, settings[S_RELAXATION] = d > 0 (Lacoursiere
-recommends a few steps; default 2). The reported multiplier is lam = nu / h.
+Settings (SpookSettings): compliance = epsilon >= 0, relaxation = d > 0 (Lacoursiere recommends
+a few steps; default 2). The reported multiplier is lam = nu / h.
 """
 
-import sys
+from collections import namedtuple
 from typing import NamedTuple
 
+import numpy as np
 from numba import njit
 
-from ..linalg import cholesky_inplace, cholesky_solve_inplace
-from ..status import OK, SINGULAR_MASS
+from ..status import OK
+from .base import FAST, newton_solve
+from .constrained import SAVED, record
 from .spec import Spec
-from .base import FAST, run_loop
-from .constrained import (S_COMPLIANCE, S_RELAXATION, check_buffers, record, schur_block,
-                          solve_rows, views)
 
-_VF, _Q1, _V1, _F = 0, 1, 2, 3     # work rows
-_H = 0                             # mats
+#: Scratch of one run (n coordinates, m constraints): the unknown x = (v+, nu) (right-hand side
+#: on entry), solver scratch s and pivots (n + m), the matrix K (n + m, n + m); rhs f (n); M (n,
+#: n); Phi, gamma (m); J(q), J(q+) (m, n).
+Workspace = namedtuple("Workspace", "x s piv K f H phi gam G Jb")
 
-
-@njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, work, mats, piv):
-    """Nothing is carried between steps."""
-    return OK
-
-
-@njit(**FAST)
-def step(kern, q, v, mom, t, h, p, settings, work, mats, piv, extra):
-    """One step from (q, v) at t, in place. Returns (status, 0, 0.0): no Newton iterations."""
-    n, m = q.shape[0], kern.N_CONSTRAINTS
-    eps, d = settings[S_COMPLIANCE], settings[S_RELAXATION]
-    vf, q1, v1, f = work[_VF], work[_Q1], work[_V1], work[_F]
-    H = mats[_H]
-    lam, phi, gam, r, c2, c3, G, Jb, Y, T, b, K = views(extra, n, m, m)
-    S = schur_block(extra, n, m)
-    ups = 1.0 / (1.0 + 4.0 * d)
-    sigma = 4.0 * eps * ups / (h * h)
-    kern.dynamics(q, v, t, p, H, f)
-    kern.constraints(q, v, p, phi, G, gam)
-    if not cholesky_inplace(H):
-        return SINGULAR_MASS, 0, 0.0
-    cholesky_solve_inplace(H, f)
-    for i in range(n):
-        vf[i] = v[i] + h * f[i]               # unconstrained velocity
-    solve_rows(H, G, Y)                       # rows M^-1 G_k^T
-    for i in range(m):
-        s = -4.0 / h * ups * phi[i]
-        for j in range(n):
-            s += ups * G[i, j] * v[j] - G[i, j] * vf[j]
-        r[i] = s
-        for k in range(m):
-            s = 0.0
-            for j in range(n):
-                s += G[i, j] * Y[k, j]
-            S[i, k] = s
-        S[i, i] += sigma
-    if not cholesky_inplace(S):
-        return SINGULAR_MASS, 0, 0.0
-    cholesky_solve_inplace(S, r)              # r = nu
-    for i in range(n):
-        s = vf[i]
-        for k in range(m):
-            s += Y[k, i] * r[k]
-        v1[i] = s
-        q1[i] = q[i] + h * s
-    for i in range(n):
-        q[i], v[i] = q1[i], v1[i]
-    for k in range(m):
-        lam[k] = r[k] / h
-    kern.constraints(q, v, p, phi, Jb, gam)
-    record(extra, m, phi, Jb, v)
-    return OK, 0, 0.0
-
-
-@njit(inline="always")
-def run(kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-        out_t, out_q, out_v, out_stats, out_extra, out_last):
-    """See base.run_loop and constrained.py: out_extra (S, m + 2), out_last (2n + 3 + total)
-    with (m + 2, total) = constrained.extra_size(n, m), settings (N_CONSTRAINED_SETTINGS,)."""
-    check_buffers(kern, q0, settings, out_extra, out_last)
-    return run_loop(_THIS, kern, q0, v0, t0, h, n_steps, save_every, p, settings,
-                    out_t, out_q, out_v, out_stats, out_extra, out_last)
-
-
-# This module as a value for run_loop (see base.py: modules, not dispatchers, are passed).
-_THIS = sys.modules[__name__]
 
 class SpookSettings(NamedTuple):
     """spook's settings (no Newton: one linear solve per step)."""
@@ -120,12 +55,66 @@ class SpookSettings(NamedTuple):
     relaxation: float = 2.0      # d = tau / h > 0: constraint damping time in steps
 
 
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop."""
+    m = kern.N_CONSTRAINTS
+    N = n + m
+    return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),
+                     np.zeros(n), np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros((m, n)),
+                     np.zeros((m, n)))
+
+
+@njit(**FAST)
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """Nothing is carried between steps."""
+    return OK
+
+
+@njit(**FAST)
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
+    """One step from (q, v) at t, in place. Returns (status, 0, 0.0): no Newton iterations."""
+    n, m = q.shape[0], kern.N_CONSTRAINTS
+    x, K, M, G, phi = ws.x, ws.K, ws.H, ws.G, ws.phi
+    ups = 1.0 / (1.0 + 4.0 * settings.relaxation)
+    sigma = 4.0 * settings.compliance * ups / (h * h)
+    kern.dynamics(q, v, t, p, M, ws.f)
+    kern.constraints(q, v, p, phi, G, ws.gam)
+    for i in range(n):                        # [M, -G^T] x = M v + h f
+        s = h * ws.f[i]
+        for j in range(n):
+            s += M[i, j] * v[j]
+            K[i, j] = M[i, j]
+        for k in range(m):
+            K[i, n + k] = -G[k, i]
+        x[i] = s
+    for k in range(m):                        # [G, sigma I] x = -(4/h) ups Phi + ups G v
+        s = -4.0 / h * ups * phi[k]
+        for j in range(n):
+            s += ups * G[k, j] * v[j]
+            K[n + k, j] = G[k, j]
+        for j in range(m):
+            K[n + k, n + j] = sigma if j == k else 0.0
+        x[n + k] = s
+    status = newton_solve(K, ws.piv, x, ws.s)
+    if status != OK:
+        return status, 0, 0.0
+    for i in range(n):
+        v[i] = x[i]
+        q[i] += h * x[i]
+    for k in range(m):
+        extra[k] = x[n + k] / h
+    kern.constraints(q, v, p, phi, ws.Jb, ws.gam)
+    record(extra, m, phi, ws.Jb, v)
+    return OK, 0, 0.0
+
+
 SPEC = Spec(
     name="spook", order=1, family="constrained", implicit=True, symplectic=False,
     symmetric=False,
     summary="Lacoursiere's regularized linearly implicit stepper (compliance, relaxation)",
     constraints=True,
-    saved=(("multipliers", "m"), ("constraint_error", 1), ("velocity_constraint_error", 1)),
+    saved=SAVED,
     limits={"compliance": (0.0, True, False), "relaxation": (0.0, False, False)},
     settings=SpookSettings,
     kernels=("constraints", "dynamics", "energy"))
