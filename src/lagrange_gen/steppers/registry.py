@@ -39,7 +39,7 @@ import importlib
 #: The registry: one line per method, in the order reports list them. Everything else about a
 #: method is declared by its module's SPEC (spec.py).
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
-           "composition", "nonsmooth_euler", "rattle", "constrained_midpoint",
+           "dop853", "composition", "nonsmooth_euler", "rattle", "constrained_midpoint",
            "constrained_implicit_euler", "spook", "index1")
 
 #: {method: its Spec}.

@@ -1,0 +1,256 @@
+"""The run loop of the adaptive methods: error-controlled steps, output at t_eval or every step.
+
+The generated glue of an adaptive method (registry.ADAPTIVE_GLUE_ARGS) calls::
+
+    run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
+                 out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters)
+        -> (status, rows, n_events)
+
+    q0, v0      (n,) state at t0;  t_end may be < t0 (integrates backwards)
+    t_eval      (E,) output times, monotone in the direction of integration; E = 0: output at
+                every accepted step
+    out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_saved);
+                S >= 2 (ValueError otherwise, like the buffer check of base.run_loop)
+    out_last    (2n + 3 + n_saved,) [t, q, v, accepted steps since the last row, last accepted
+                error norm, saved fields] of the state reached (see below)
+    out_events  (E', 3 + 2n): not written yet (n_events = 0; see "Events" below)
+    counters    (4,) float64, in/out: [h, accepted, rejected, evaluations]. In: counters[0] =
+                the first step size to try (its sign is ignored; 0: Hairer's automatic starting
+                step); out: the next step size proposed, signed (pass it back in to continue).
+                counters[1:] are incremented by this call: accepted steps, rejected steps,
+                acceleration (right-hand side) evaluations.
+
+Rows: row 0 = the state at t0 of this call. Then, with E = 0, one row per accepted step (its
+end state); with E > 0, one row per t_eval value with t0 < t_eval[j] <= t_end (values <= t0
+are skipped), from the method's dense output, except that a value equal to a step's end time
+gets the step's end state exactly. Steps are clipped to land exactly on t_end (out_last[0] ==
+t_end exactly), and the integration always runs to t_end, even after the last t_eval value.
+out_stats per row: STAT_ENERGY the energy, STAT_ITERS the accepted steps since the previous
+row (0 for a second t_eval value inside the same step), STAT_RESIDUAL the error norm of the
+accepted step the row comes from (<= 1; 0 in row 0).
+
+Chunks: ``rows`` rows were written. A call returns OK either complete (out_last[0] == t_end)
+or with full buffers: before a step whose output would not fit, it returns the state it would
+have stepped from in out_last (not necessarily a row: with t_eval it is the last step end) and
+the step it would have tried in counters[0]. The driver calls again from out_last's t, q, v
+(and its saved fields as row 0 of out_extra) with counters as returned, fresh buffers and
+(with t_eval) the t_eval values not yet output; row 0 of the new call is that start state, to
+be dropped (it repeats the previous call's last row or is not a requested time); the accepted
+steps the previous call took after its last row (out_last[1 + 2n]) belong to the STAT_ITERS of
+the new call's row 1. The
+continued run is bitwise the run in one call: the step sequence depends only on the state and
+the proposed step at step boundaries. Exception: if even a fresh buffer cannot hold the
+t_eval values one step covers, the step is shortened to end at the last one that fits.
+max_steps caps the attempted (accepted + rejected) steps of one call, not of the run.
+
+Step-size control (Hairer, dop853.f, beta = 0): with err the method's error norm,
+fac = clip(err^(1/(p+1)) / SAFETY, 1/FAC_MAX, 1/FAC_MIN), the next h = h / fac (at most
+FAC_MAX times larger, at least FAC_MIN of it); a rejected step retries with
+h / min(1/FAC_MIN, err^(1/(p+1)) / SAFETY), and the step accepted after a rejection may not
+propose a larger one. |h| <= settings.h_max. A step is clipped to land on t_end when
+t + 1.01 h passes it.
+
+Failures: status codes (lagrange_gen.status) with out_last at the state concerned, its time
+in out_last[0]:
+    SINGULAR_MASS          an evaluation failed; out_last = the state the step started from
+    NON_FINITE, UNSTABLE   the accepted state (or its energy) is non-finite / past
+                           settings.blowup_bound; out_last = that state
+    STEP_TOO_SMALL         0.1 |h| <= |t| eps (the step underflowed the time resolution, e.g.
+                           a solution blowing up in finite time); NON_FINITE instead when the
+                           rejections leading there were non-finite trials; out_last = state at t
+    TOO_MANY_STEPS         settings.max_steps attempts in this call; out_last = state at t
+``rows`` = the rows written before the failure (0: the initial state was refused).
+
+Events: after each accepted step, before ``method.advance``, the step from (t, q, v) to
+(t_new, ws.q_new, ws.v_new) is complete and ``method.dense`` + ``method.interpolate(ws, s,
+q_out, v_out)`` give the state at any s in [t, t_new]: an event locator goes there (marked
+below).
+
+What a method module provides (dop853.py): Workspace/workspace(kern, n), prepare(kern, q, v,
+t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern, q, v, t,
+direction, p, settings, ws) -> (status, |h|), attempt(kern, q, v, t, h, p, settings, ws) ->
+(status, err) into ws.q_new, ws.v_new, accept(kern, t_new, p, ws) -> status, dense(kern, q, v,
+t, h, p, ws) -> status, interpolate(ws, t, q_out, v_out), advance(q, v, ws), and the constants
+ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..status import NON_FINITE, OK
+from .base import FAST, _last, _save, check_state
+
+# TODO(integrator): move these two into lagrange_gen.status (with NAMES entries).
+STEP_TOO_SMALL = 6    # the adaptive step size underflowed (0.1 |h| <= |t| eps)
+TOO_MANY_STEPS = 7    # settings.max_steps attempted steps in one call
+
+SAFETY = 0.9          # Hairer's safe
+FAC_MIN = 0.333       # Hairer's fac1: smallest step ratio
+FAC_MAX = 6.0         # Hairer's fac2: largest step ratio
+UROUND = 2.220446049250313e-16
+
+
+@njit(**FAST)
+def next_step(h, err, exponent, h_max, after_reject):
+    """Hairer's proposal after a step of size h with error norm err <= 1 (signed result)."""
+    fac = max(1.0 / FAC_MAX, min(1.0 / FAC_MIN, err ** exponent / SAFETY))
+    h_new = min(abs(h / fac), h_max)
+    if after_reject:
+        h_new = min(h_new, abs(h))
+    return math.copysign(h_new, h)
+
+
+@njit(**FAST)
+def retry_step(h, err, exponent):
+    """The retry after a rejected step (err > 1, or NaN: then the largest reduction)."""
+    shrink = err ** exponent / SAFETY
+    if not shrink < 1.0 / FAC_MIN:      # also NaN
+        shrink = 1.0 / FAC_MIN
+    return h / shrink
+
+
+@njit(**FAST)
+def points_in(t_eval, j, t_new, direction, cap):
+    """How many of t_eval[j:] are <= t_new (in the direction of integration), counting up to
+    cap."""
+    k = 0
+    while j + k < t_eval.shape[0] and k < cap and (t_eval[j + k] - t_new) * direction <= 0.0:
+        k += 1
+    return k
+
+
+@njit(inline="always")
+def _save_row(kern, row, t, q, v, p, since, err, out_t, out_q, out_v, out_stats, extra,
+              out_extra):
+    """Write one output row; False (nothing written) when the energy there is not finite."""
+    energy = kern.energy(q, v, t, p)
+    if not math.isfinite(energy):
+        return False
+    _save(row, t, q, v, energy, since, err, out_t, out_q, out_v, out_stats, extra, out_extra)
+    return True
+
+
+@njit(inline="always")
+def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
+                 out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters):
+    """Integrate from (q0, v0) at t0 to t_end with error control; see the module docstring."""
+    n = q0.shape[0]
+    size = out_t.shape[0]
+    if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved or size < 2:
+        raise ValueError("run_<method>: out_extra needs n_saved columns, out_last 2 n + 3 + "
+                         "n_saved entries and the outputs at least 2 rows")
+    q = q0.copy()
+    v = v0.copy()
+    ws = method.workspace(kern, n)
+    extra = np.zeros(n_saved)
+    for k in range(n_saved):
+        extra[k] = out_extra[0, k]
+    bound = settings.blowup_bound
+    status = check_state(q, v, bound)
+    if status == OK:
+        status = method.prepare(kern, q, v, t0, p, settings, ws)
+        counters[3] += 1
+    _last(out_last, t0, q, v, 0.0, 0.0, extra)
+    if status != OK:
+        return status, 0, 0
+    if not _save_row(kern, 0, t0, q, v, p, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra,
+                     out_extra):
+        return NON_FINITE, 0, 0
+    direction = 1.0 if t_end >= t0 else -1.0
+    h = abs(counters[0])
+    if h == 0.0 and t_end != t0:
+        status, h = method.initial_step(kern, q, v, t0, direction, p, settings, ws)
+        counters[3] += 1
+        if status != OK:
+            return status, 1, 0
+    h = direction * min(h, settings.h_max)
+    use_eval = t_eval.shape[0] > 0
+    j = points_in(t_eval, 0, t0, direction, t_eval.shape[0])     # skip values <= t0
+    t, rows, since, err_last = t0, 1, 0.0, 0.0
+    attempts, rejected, nonfinite_retry = 0, False, False
+    while t != t_end:
+        if attempts >= settings.max_steps or 0.1 * abs(h) <= abs(t) * UROUND:
+            status = TOO_MANY_STEPS if attempts >= settings.max_steps else (
+                NON_FINITE if nonfinite_retry else STEP_TOO_SMALL)
+            _last(out_last, t, q, v, since, err_last, extra)
+            counters[0] = h
+            return status, rows, 0
+        last = (t + 1.01 * h - t_end) * direction > 0.0
+        if last:
+            h = t_end - t
+        if not rejected:          # first attempt of a step: does its output fit?
+            k = points_in(t_eval, j, t + h, direction, size) if use_eval else 1
+            if rows + k > size and rows > 1:
+                _last(out_last, t, q, v, since, err_last, extra)
+                counters[0] = h
+                return OK, rows, 0
+            if rows + k > size:   # a fresh buffer cannot hold them: end at the last that fits
+                h = t_eval[j + size - 2] - t
+                last = False
+        status, err = method.attempt(kern, q, v, t, h, p, settings, ws)
+        attempts += 1
+        counters[3] += method.STAGE_EVALS
+        if status != OK:
+            _last(out_last, t, q, v, since, err_last, extra)
+            counters[0] = h
+            return status, rows, 0
+        if not err <= 1.0:
+            counters[2] += 1
+            nonfinite_retry = not math.isfinite(err)
+            h = retry_step(h, err, method.ERROR_EXPONENT)
+            rejected = True
+            continue
+        t_new = t_end if last else t + h
+        status = method.accept(kern, t_new, p, ws)
+        counters[3] += method.ACCEPT_EVALS
+        if status == OK:
+            status = check_state(ws.q_new, ws.v_new, bound)
+        if status != OK:
+            _last(out_last, t_new, ws.q_new, ws.v_new, since, err, extra)
+            counters[0] = h
+            return status, rows, 0
+        counters[1] += 1
+        since += 1.0
+        err_last = err
+        # Event location goes here: method.dense, then method.interpolate on [t, t_new].
+        if use_eval:
+            built = False
+            while j < t_eval.shape[0] and (t_eval[j] - t_new) * direction <= 0.0:
+                if t_eval[j] == t_new:
+                    qr, vr = ws.q_new, ws.v_new
+                else:
+                    if not built:
+                        status = method.dense(kern, q, v, t, h, p, ws)
+                        counters[3] += method.DENSE_EVALS
+                        if status != OK:
+                            _last(out_last, t, q, v, since, err, extra)
+                            counters[0] = h
+                            return status, rows, 0
+                        built = True
+                    method.interpolate(ws, t_eval[j], ws.q_int, ws.v_int)
+                    qr, vr = ws.q_int, ws.v_int
+                if not _save_row(kern, rows, t_eval[j], qr, vr, p, since, err, out_t, out_q,
+                                 out_v, out_stats, extra, out_extra):
+                    _last(out_last, t_eval[j], qr, vr, since, err, extra)
+                    counters[0] = h
+                    return NON_FINITE, rows, 0
+                rows += 1
+                since = 0.0
+                j += 1
+        else:
+            if not _save_row(kern, rows, t_new, ws.q_new, ws.v_new, p, since, err, out_t, out_q,
+                             out_v, out_stats, extra, out_extra):
+                _last(out_last, t_new, ws.q_new, ws.v_new, since, err, extra)
+                counters[0] = h
+                return NON_FINITE, rows, 0
+            rows += 1
+            since = 0.0
+        h = next_step(h, err, method.ERROR_EXPONENT, settings.h_max, rejected)
+        rejected = False
+        method.advance(q, v, ws)
+        t = t_new
+    _last(out_last, t, q, v, since, err_last, extra)
+    counters[0] = h
+    return OK, rows, 0
