@@ -1,0 +1,66 @@
+"""Helpers of the event tests: the test models generated once per process, a direct call of
+the run_<method> glue that returns the located events.
+
+No conftest.py here (see tests/steppers/stepper_util.py: it would shadow the top-level one).
+"""
+
+import atexit
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from lagrange_gen.codegen import generate_model
+from lagrange_gen.loader import import_generated
+from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.base import N_STATS
+from lagrange_gen.steppers.spec import make_settings
+
+MODELS = Path(__file__).resolve().parent / "models"
+#: The methods the tests run (their glue only, to keep compile time down).
+METHODS = ["midpoint", "rk4"]
+
+_DIR = []
+_MODULES = {}
+
+
+def generated(stem):
+    """tests/events/models/<stem>.py -> its generated module (once per process, temp dir)."""
+    if stem not in _MODULES:
+        if not _DIR:
+            _DIR.append(Path(tempfile.mkdtemp(prefix="lagrange_gen_event_models_")))
+            atexit.register(shutil.rmtree, _DIR[0], True)
+        path = generate_model(MODELS / f"{stem}.py", _DIR[0], methods=METHODS).path
+        _MODULES[stem] = import_generated(path)
+    return _MODULES[stem]
+
+
+class Run:
+    """The outputs of one glue call: status, steps_done, n_events, t (S,), q, v (S, n),
+    last (2n + 3,), events (E, 3 + 2n) as filled."""
+
+    def __init__(self, mod, method, q0, v0, h, n_steps, t0=0.0, max_events=50, params=None):
+        n = mod.N_COORDS
+        rows = n_steps + 1
+        self.t = np.full(rows, np.nan)
+        self.q, self.v = np.full((rows, n), np.nan), np.full((rows, n), np.nan)
+        self.last = np.full(2 * n + 3, np.nan)
+        self.events = np.full((max_events, 3 + 2 * n), np.nan)
+        p = mod.DEFAULT_PARAMS.copy() if params is None else np.asarray(params, dtype=np.float64)
+        settings = make_settings(registry.spec(method), {})
+        self.status, self.steps, self.n_events = getattr(mod, f"run_{method}")(
+            np.asarray(q0, dtype=np.float64), np.asarray(v0, dtype=np.float64), float(t0),
+            float(h), n_steps, 1, p, settings, self.t, self.q, self.v,
+            np.empty((rows, N_STATS)), np.empty((rows, 0)), self.last, self.events)
+        self.names = mod.EVENT_NAMES
+
+    def rows(self, name=None):
+        """Recorded rows [t, k, direction, q, v] (of event ``name`` only, if given)."""
+        rows = self.events[:min(self.n_events, self.events.shape[0])]
+        if name is not None:
+            rows = rows[rows[:, 1] == self.names.index(name)]
+        return rows
+
+    def times(self, name):
+        return self.rows(name)[:, 0]
