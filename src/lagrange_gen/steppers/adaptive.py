@@ -133,6 +133,75 @@ def _save_row(kern, row, t, q, v, p, since, err, out_t, out_q, out_v, out_stats,
 
 
 @njit(inline="always")
+def _stop(out_last, counters, t, q, v, since, err, extra, h):
+    """Where a call ends: out_last = [t, q, v, since, err, extra], counters[0] = h."""
+    _last(out_last, t, q, v, since, err, extra)
+    counters[0] = h
+
+
+@njit(inline="always")
+def _first_step(method, kern, q, v, t0, t_end, p, settings, ws, counters):
+    """(status, signed h) of the first attempt: counters[0], or Hairer's starting step."""
+    direction = 1.0 if t_end >= t0 else -1.0
+    h = abs(counters[0])
+    status = OK
+    if h == 0.0 and t_end != t0:
+        status, h = method.initial_step(kern, q, v, t0, direction, p, settings, ws)
+        counters[3] += 1
+    return status, direction * min(h, settings.h_max)
+
+
+@njit(inline="always")
+def _room(t_eval, j, t, h, rows, size):
+    """Before the first attempt of a step of size h from t: (fits, h). fits False: the rows
+    this step may output do not fit (the call returns first). A fresh buffer (rows == 1) too
+    small for the t_eval values of the step shortens h to end at the last one that fits."""
+    direction = 1.0 if h > 0.0 else -1.0
+    k = points_in(t_eval, j, t + h, direction, size) if t_eval.shape[0] > 0 else 1
+    if rows + k <= size:
+        return True, h
+    if rows > 1:
+        return False, h
+    return True, t_eval[j + size - 2] - t
+
+
+@njit(inline="always")
+def _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j, rows, since, extra,
+            out_t, out_q, out_v, out_stats, out_extra, out_last, counters):
+    """The rows of an accepted step from (q, v) at t to (ws.q_new, ws.v_new) at t_new: its end
+    state, or the t_eval values it covers (dense output, built at most once). Returns
+    (status, rows, j, since); on failure out_last and counters[0] are set (_stop)."""
+    if t_eval.shape[0] == 0:
+        if not _save_row(kern, rows, t_new, ws.q_new, ws.v_new, p, since, err, out_t, out_q,
+                         out_v, out_stats, extra, out_extra):
+            _stop(out_last, counters, t_new, ws.q_new, ws.v_new, since, err, extra, h)
+            return NON_FINITE, rows, j, since
+        return OK, rows + 1, j, 0.0
+    direction = 1.0 if h > 0.0 else -1.0
+    built = False
+    while j < t_eval.shape[0] and (t_eval[j] - t_new) * direction <= 0.0:
+        qr, vr = ws.q_new, ws.v_new           # a value equal to the step end: the end state
+        if t_eval[j] != t_new:
+            if not built:
+                status = method.dense(kern, q, v, t, h, p, ws)
+                counters[3] += method.DENSE_EVALS
+                if status != OK:
+                    _stop(out_last, counters, t, q, v, since, err, extra, h)
+                    return status, rows, j, since
+                built = True
+            method.interpolate(ws, t_eval[j], ws.q_int, ws.v_int)
+            qr, vr = ws.q_int, ws.v_int
+        if not _save_row(kern, rows, t_eval[j], qr, vr, p, since, err, out_t, out_q, out_v,
+                         out_stats, extra, out_extra):
+            _stop(out_last, counters, t_eval[j], qr, vr, since, err, extra, h)
+            return NON_FINITE, rows, j, since
+        rows += 1
+        since = 0.0
+        j += 1
+    return OK, rows, j, since
+
+
+@njit(inline="always")
 def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
                  out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters):
     """Integrate from (q0, v0) at t0 to t_end with error control; see the module docstring."""
@@ -147,8 +216,7 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
     extra = np.zeros(n_saved)
     for k in range(n_saved):
         extra[k] = out_extra[0, k]
-    bound = settings.blowup_bound
-    status = check_state(q, v, bound)
+    status = check_state(q, v, settings.blowup_bound)
     if status == OK:
         status = method.prepare(kern, q, v, t0, p, settings, ws)
         counters[3] += 1
@@ -158,43 +226,34 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
     if not _save_row(kern, 0, t0, q, v, p, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra,
                      out_extra):
         return NON_FINITE, 0, 0
+    status, h = _first_step(method, kern, q, v, t0, t_end, p, settings, ws, counters)
+    if status != OK:
+        return status, 1, 0
     direction = 1.0 if t_end >= t0 else -1.0
-    h = abs(counters[0])
-    if h == 0.0 and t_end != t0:
-        status, h = method.initial_step(kern, q, v, t0, direction, p, settings, ws)
-        counters[3] += 1
-        if status != OK:
-            return status, 1, 0
-    h = direction * min(h, settings.h_max)
-    use_eval = t_eval.shape[0] > 0
     j = points_in(t_eval, 0, t0, direction, t_eval.shape[0])     # skip values <= t0
     t, rows, since, err_last = t0, 1, 0.0, 0.0
     attempts, rejected, nonfinite_retry = 0, False, False
     while t != t_end:
         if attempts >= settings.max_steps or 0.1 * abs(h) <= abs(t) * UROUND:
-            status = TOO_MANY_STEPS if attempts >= settings.max_steps else (
-                NON_FINITE if nonfinite_retry else STEP_TOO_SMALL)
-            _last(out_last, t, q, v, since, err_last, extra)
-            counters[0] = h
-            return status, rows, 0
+            _stop(out_last, counters, t, q, v, since, err_last, extra, h)
+            if attempts >= settings.max_steps:
+                return TOO_MANY_STEPS, rows, 0
+            return (NON_FINITE if nonfinite_retry else STEP_TOO_SMALL), rows, 0
         last = (t + 1.01 * h - t_end) * direction > 0.0
         if last:
             h = t_end - t
         if not rejected:          # first attempt of a step: does its output fit?
-            k = points_in(t_eval, j, t + h, direction, size) if use_eval else 1
-            if rows + k > size and rows > 1:
-                _last(out_last, t, q, v, since, err_last, extra)
-                counters[0] = h
+            fits, h_room = _room(t_eval, j, t, h, rows, size)
+            if not fits:
+                _stop(out_last, counters, t, q, v, since, err_last, extra, h)
                 return OK, rows, 0
-            if rows + k > size:   # a fresh buffer cannot hold them: end at the last that fits
-                h = t_eval[j + size - 2] - t
-                last = False
+            last = last and h_room == h
+            h = h_room
         status, err = method.attempt(kern, q, v, t, h, p, settings, ws)
         attempts += 1
         counters[3] += method.STAGE_EVALS
         if status != OK:
-            _last(out_last, t, q, v, since, err_last, extra)
-            counters[0] = h
+            _stop(out_last, counters, t, q, v, since, err_last, extra, h)
             return status, rows, 0
         if not err <= 1.0:
             counters[2] += 1
@@ -206,51 +265,22 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
         status = method.accept(kern, t_new, p, ws)
         counters[3] += method.ACCEPT_EVALS
         if status == OK:
-            status = check_state(ws.q_new, ws.v_new, bound)
+            status = check_state(ws.q_new, ws.v_new, settings.blowup_bound)
         if status != OK:
-            _last(out_last, t_new, ws.q_new, ws.v_new, since, err, extra)
-            counters[0] = h
+            _stop(out_last, counters, t_new, ws.q_new, ws.v_new, since, err, extra, h)
             return status, rows, 0
         counters[1] += 1
         since += 1.0
         err_last = err
         # Event location goes here: method.dense, then method.interpolate on [t, t_new].
-        if use_eval:
-            built = False
-            while j < t_eval.shape[0] and (t_eval[j] - t_new) * direction <= 0.0:
-                if t_eval[j] == t_new:
-                    qr, vr = ws.q_new, ws.v_new
-                else:
-                    if not built:
-                        status = method.dense(kern, q, v, t, h, p, ws)
-                        counters[3] += method.DENSE_EVALS
-                        if status != OK:
-                            _last(out_last, t, q, v, since, err, extra)
-                            counters[0] = h
-                            return status, rows, 0
-                        built = True
-                    method.interpolate(ws, t_eval[j], ws.q_int, ws.v_int)
-                    qr, vr = ws.q_int, ws.v_int
-                if not _save_row(kern, rows, t_eval[j], qr, vr, p, since, err, out_t, out_q,
-                                 out_v, out_stats, extra, out_extra):
-                    _last(out_last, t_eval[j], qr, vr, since, err, extra)
-                    counters[0] = h
-                    return NON_FINITE, rows, 0
-                rows += 1
-                since = 0.0
-                j += 1
-        else:
-            if not _save_row(kern, rows, t_new, ws.q_new, ws.v_new, p, since, err, out_t, out_q,
-                             out_v, out_stats, extra, out_extra):
-                _last(out_last, t_new, ws.q_new, ws.v_new, since, err, extra)
-                counters[0] = h
-                return NON_FINITE, rows, 0
-            rows += 1
-            since = 0.0
+        status, rows, j, since = _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j,
+                                         rows, since, extra, out_t, out_q, out_v, out_stats,
+                                         out_extra, out_last, counters)
+        if status != OK:
+            return status, rows, 0
         h = next_step(h, err, method.ERROR_EXPONENT, settings.h_max, rejected)
         rejected = False
         method.advance(q, v, ws)
         t = t_new
-    _last(out_last, t, q, v, since, err_last, extra)
-    counters[0] = h
+    _stop(out_last, counters, t, q, v, since, err_last, extra, h)
     return OK, rows, 0

@@ -354,7 +354,7 @@ SPEC = Spec(
     name="dop853", order=8, family="explicit", implicit=False, symplectic=False,
     symmetric=False, adaptive=True,
     summary="Dormand-Prince 8(5,3), adaptive, 7th-order dense output",
-    stable="explicit: the step control keeps h omega inside the stability region (about 6)",
+    stable="stable for tau <= 5.96 (the step control keeps h omega well inside for accuracy)",
     settings=Settings,
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False)},
