@@ -84,10 +84,10 @@ def scipy_run(mod, q0, v0, t_end, rtol, atol, t_eval=None):
 
 def test_matches_scipy_dop853_at_rtol_1e_10(pendulum2):
     t_eval = np.linspace(0.3, T_END, 17)
-    status, rows, t, q, v, stats, last, counters = run(pendulum2, Q0, V0, 0.0, T_END, t_eval,
-                                                       rtol=1e-10, atol=1e-10)
-    assert status == OK and rows == 18 and last[0] == T_END
-    np.testing.assert_array_equal(t[1:], t_eval)
+    status, rows, t, q, v, stats, last, counters = run(
+        pendulum2, Q0, V0, 0.0, T_END, np.concatenate([[0.0], t_eval]), rtol=1e-10, atol=1e-10)
+    assert status == OK and rows == 18 and last[0] == T_END      # t_eval = t0 is row 0 only
+    np.testing.assert_array_equal(t, np.concatenate([[0.0], t_eval]))
     ref = scipy_run(pendulum2, Q0, V0, T_END, 1e-10, 1e-10, t_eval)
     assert np.abs(np.hstack([q[1:], v[1:]]) - ref.y.T).max() < 1e-9
     # every accepted step: same step count as scipy's implementation, within a few percent
