@@ -45,7 +45,7 @@ def run_chunked(mod, q0, v0, t_end, size, t_eval=(), **settings):
     """The run as a driver does it with buffers of ``size`` rows: continue from out_last with
     the proposed step until out_last[0] == t_end; row 0 of every call but the first dropped."""
     n = mod.N_COORDS
-    t0, h, calls = 0.0, 0.0, 0
+    t0, h, calls, carried = 0.0, 0.0, 0, 0.0
     t_eval = np.asarray(t_eval, float)
     ts, qs, vs, stats, totals = [], [], [], [], np.zeros(3)
     while True:
@@ -56,7 +56,8 @@ def run_chunked(mod, q0, v0, t_end, size, t_eval=(), **settings):
         if calls and rows > 1:      # steps taken in the previous call since its last row
             st[1, STAT_ITERS] += carried
         carried = last[1 + 2 * n]
-        ts.append(t[first:]), qs.append(q[first:]), vs.append(v[first:]), stats.append(st[first:])
+        for kept, rows_of_call in zip((ts, qs, vs, stats), (t, q, v, st)):
+            kept.append(rows_of_call[first:])
         totals += counters[1:]
         calls += 1
         if last[0] == t_end:
