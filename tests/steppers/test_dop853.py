@@ -10,6 +10,7 @@ from scipy.special import ellipk
 
 from stepper_util import generated_model, params
 from lagrange_gen.codegen import generate_model
+from lagrange_gen.codegen.needs import method_needs
 from lagrange_gen.loader import import_generated
 from lagrange_gen.status import NON_FINITE, OK, UNSTABLE
 from lagrange_gen.steppers import registry
@@ -223,3 +224,8 @@ def test_blow_up_reports_status_and_time(blowup):
     assert abs((t_star - last[0]) / time_to_blow_up(last[1]) - 1) < 1e-8
     status, rows, *_ = run(blowup, [np.nan], [0.0], 0.0, 3.0)
     assert status == NON_FINITE and rows == 0
+
+
+def test_declared_kernels_are_the_ones_the_code_reaches():
+    reached = {name for name in method_needs("dop853") if not name.isupper()}
+    assert set(registry.spec("dop853").kernels) == reached == {"energy", "forward_dynamics"}

@@ -17,7 +17,8 @@ The generated glue of an adaptive method (registry.ADAPTIVE_GLUE_ARGS) calls::
     counters    (4,) float64, in/out: [h, accepted, rejected, evaluations]. In: counters[0] =
                 the first step size to try (its sign is ignored; 0: Hairer's automatic starting
                 step); out: the next step size proposed, signed (pass it back in to continue).
-                counters[1:] are incremented by this call: accepted steps, rejected steps,
+                counters[1:] are incremented by this call: accepted steps, rejected steps
+                (also those before the first accepted step, which dop853.f does not count),
                 acceleration (right-hand side) evaluations.
 
 Rows: row 0 = the state at t0 of this call. Then, with E = 0, one row per accepted step (its
@@ -64,7 +65,9 @@ in out_last[0]:
 Events: after each accepted step, before ``method.advance``, the step from (t, q, v) to
 (t_new, ws.q_new, ws.v_new) is complete and ``method.dense`` + ``method.interpolate(ws, s,
 q_out, v_out)`` give the state at any s in [t, t_new]: an event locator goes there (marked
-below).
+below). dense must run before advance (which reuses the step's stages); the interpolant stays
+valid until the next dense call. Without t_eval values inside a step, dense is not called
+(it costs DENSE_EVALS evaluations).
 
 What a method module provides (dop853.py): Workspace/workspace(kern, n), prepare(kern, q, v,
 t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern, q, v, t,
