@@ -30,18 +30,18 @@ out_stats per row: STAT_ENERGY the energy, STAT_ITERS the accepted steps since t
 row (0 for a second t_eval value inside the same step), STAT_RESIDUAL the error norm of the
 accepted step the row comes from (<= 1; 0 in row 0).
 
-Chunks: ``rows`` rows were written. A call returns OK either complete (out_last[0] == t_end)
-or with full buffers: before a step whose output would not fit, it returns the state it would
-have stepped from in out_last (not necessarily a row: with t_eval it is the last step end) and
-the step it would have tried in counters[0]. The driver calls again from out_last's t, q, v
-(and its saved fields as row 0 of out_extra) with counters as returned, fresh buffers and
-(with t_eval) the t_eval values not yet output; row 0 of the new call is that start state, to
-be dropped (it repeats the previous call's last row or is not a requested time); the accepted
+Chunks: ``rows`` rows were written. A call returns OK either complete (out_last[0] == t_end) or
+with full buffers: before a step whose output would not fit, it returns the state it would have
+stepped from in out_last (not necessarily a row: with t_eval it is the last step end) and the
+step it would have tried in counters[0]. The driver calls again from out_last's t, q, v (and
+its saved fields as row 0 of out_extra) with counters as returned, fresh buffers and (with
+t_eval) the t_eval values not yet output; row 0 of the new call is that start state, to be
+dropped (it repeats the previous call's last row or is not a requested time); the accepted
 steps the previous call took after its last row (out_last[1 + 2n]) belong to the STAT_ITERS of
-the new call's row 1. The
-continued run is bitwise the run in one call: the step sequence depends only on the state and
-the proposed step at step boundaries. Exception: if even a fresh buffer cannot hold the
-t_eval values one step covers, the step is shortened to end at the last one that fits.
+the new call's row 1. The continued run is bitwise the run in one call: the step sequence
+depends only on the state and the proposed step at step boundaries. Exception: if even a fresh
+buffer cannot hold the t_eval values one step covers, the step is shortened to end at the last
+one that fits.
 max_steps caps the attempted (accepted + rejected) steps of one call, not of the run.
 
 Step-size control (Hairer, dop853.f, beta = 0): with err the method's error norm,
@@ -49,13 +49,16 @@ fac = clip(err^(1/(p+1)) / SAFETY, 1/FAC_MAX, 1/FAC_MIN), the next h = h / fac (
 FAC_MAX times larger, at least FAC_MIN of it); a rejected step retries with
 h / min(1/FAC_MIN, err^(1/(p+1)) / SAFETY), and the step accepted after a rejection may not
 propose a larger one. |h| <= settings.h_max. A step is clipped to land on t_end when
-t + 1.01 h passes it.
+t + 1.01 h passes it. A trial whose error norm is not finite (NaN/inf in its stages) is
+rejected with the largest reduction, FAC_MIN.
 
 Failures: status codes (lagrange_gen.status) with out_last at the state concerned, its time
 in out_last[0]:
     SINGULAR_MASS          an evaluation failed; out_last = the state the step started from
-    NON_FINITE, UNSTABLE   the accepted state (or its energy) is non-finite / past
-                           settings.blowup_bound; out_last = that state
+                           (a stage, the dense output) or its end state (the end-point
+                           evaluation of an accepted step)
+    NON_FINITE, UNSTABLE   the accepted state (or the energy of a row) is non-finite / past
+                           settings.blowup_bound; out_last = that state (t_eval: the row's)
     STEP_TOO_SMALL         0.1 |h| <= |t| eps (the step underflowed the time resolution, e.g.
                            a solution blowing up in finite time); NON_FINITE instead when the
                            rejections leading there were non-finite trials; out_last = state at t
@@ -69,8 +72,9 @@ below). dense must run before advance (which reuses the step's stages); the inte
 valid until the next dense call. Without t_eval values inside a step, dense is not called
 (it costs DENSE_EVALS evaluations).
 
-What a method module provides (dop853.py): Workspace/workspace(kern, n), prepare(kern, q, v,
-t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern, q, v, t,
+What a method module provides (dop853.py): workspace(kern, n) (a namedtuple with at least the
+(n,) arrays q_new, v_new (the trial state) and q_int, v_int (interpolation)), prepare(kern, q,
+v, t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern, q, v, t,
 direction, p, settings, ws) -> (status, |h|), attempt(kern, q, v, t, h, p, settings, ws) ->
 (status, err) into ws.q_new, ws.v_new, accept(kern, t_new, p, ws) -> status, dense(kern, q, v,
 t, h, p, ws) -> status, interpolate(ws, t, q_out, v_out), advance(q, v, ws), and the constants
