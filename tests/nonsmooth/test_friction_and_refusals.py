@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen import ModelError, SimulationError, load_model
+from lagrange_gen.errors import SingularNewtonMatrix
 from lagrange_gen.simulation import simulate
 from nonsmooth_util import ns_model  # noqa: F401  (fixture)
 
@@ -27,6 +28,15 @@ def test_coulomb_free_decay_turning_points_and_rest(ns_model):
     # The friction force stays within its bound and balances the spring at rest.
     assert np.all(np.abs(traj.element_state[:, 0]) <= 0.1 + 1e-14)
     assert traj.element_state[-1, 0] == pytest.approx(-0.05, abs=1e-3)
+
+
+def test_singular_newton_matrix_with_friction_is_reported(ns_model):
+    """m = k = 0: the Newton matrix A = m + h^2 k vanishes. The friction path factors A itself
+    (the Delassus problem), and the step must still fail as a singular Newton matrix."""
+    mod = ns_model("coulomb_oscillator")
+    with pytest.raises(SingularNewtonMatrix, match=r"step 1 of 10 .*singular Newton matrix"):
+        simulate(mod, method="implicit_euler", q0=[1.0], v0=[1.0], t_end=0.01, h=1e-3,
+                 params={"m": 0.0, "k": 0.0})
 
 
 @pytest.mark.parametrize("method", ["verlet", "midpoint", "rk4"])

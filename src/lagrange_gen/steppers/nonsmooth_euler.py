@@ -20,7 +20,7 @@ nonsmooth work in the assembly. At the iterate v1 it evaluates the return map (u
 strain; the Saint-Venant states are updated only once the step is accepted) and assembles
 F = R_s(v1), A = dR_s/dv1 (exact for linear strains). Without friction elements that is the
 system newton.solve solves. With friction elements the increment needs A^-1 before the forces
-are known (the Delassus problem), so the assembly factors a copy of A itself, solves the
+are known (the Delassus problem), so the assembly factors A itself, solves the
 Delassus problem (updating r in the element states) and hands newton.solve the Newton system
 premultiplied by that A^-1: F <- -dv = -(X + h A^-1 G^T r) with X = -A^-1 R_s, whose Jacobian at
 the iterate is the identity (A <- I). newton.solve's update x -= I^-1 F is then the Moreau-Jean
@@ -45,20 +45,20 @@ from numba import njit
 
 from ..linalg import lu_inplace, lu_solve_inplace
 from ..nonsmooth.play import return_map
-from ..status import OK
+from ..status import OK, SINGULAR_NEWTON
 from . import newton
-from .base import FAST, max_abs
+from .base import FAST, failed_solve_status, max_abs
 from .spec import NewtonSettings, Spec
 
 _PGS_SWEEPS = 200
 
 #: Scratch of one run. (n,): the Newton unknown v1 = v+, q1 = q+, dv = v+ - v, rhs, residual F,
-#: solver scratch s and pivots piv (also those of Af), the friction-free increment X; (n, n): H,
-#: the Newton matrix A and its factored copy Af for the Delassus problem, d rhs/dq, d rhs/dv,
+#: solver scratch s and pivots piv, the friction-free increment X; (n, n): H, the Newton matrix
+#: A (factored in place for the Delassus problem when there is friction), d rhs/dq, d rhs/dv,
 #: d(H w)/dq, the element Hessian term Hw; (ne,): strains s0 at q and s1 at q1, Saint-Venant
 #: weights we = k u+ and trial states u1; G (ne, n) strain gradients, coef (ne, 3) the
 #: elements' (k or F, eta, kind), Y (ne, n) rows A^-1 G_e^T, W (ne, ne) the Delassus matrix.
-Workspace = namedtuple("Workspace", "v1 q1 dv rhs F s X piv H A Af Jq Jqd dHw Hw "
+Workspace = namedtuple("Workspace", "v1 q1 dv rhs F s X piv H A Jq Jqd dHw Hw "
                                     "s0 s1 we u1 G coef Y W")
 
 
@@ -69,7 +69,7 @@ def workspace(kern, n):
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n, np.int64), np.zeros((n, n)),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)),
                      np.zeros(ne), np.zeros(ne), np.zeros(ne), np.zeros(ne),
                      np.zeros((ne, n)), np.zeros((ne, 3)), np.zeros((ne, n)), np.zeros((ne, ne)))
 
@@ -161,27 +161,29 @@ def _pgs(tol, v1, X, state, G, coef, W):
 
 
 @njit(inline="always")
-def _friction(h, tol, v1, F, A, Af, piv_f, X, scratch, state, G, coef, Y, W):
+def _friction(h, tol, v1, F, A, piv, X, scratch, state, G, coef, Y, W):
     """With friction elements: the Moreau-Jean increment dv = X + h Y^T r (X = -A^-1 F, the
-    forces r from projected Gauss-Seidel, updated in state) on a factored copy Af of A, handed
-    to newton.solve as F <- -dv, A <- I (see the module docstring). Without friction elements,
-    or if A cannot be factored, F and A are left alone (newton.solve then factors the same A and
-    reports SINGULAR_NEWTON or NON_FINITE)."""
+    forces r from projected Gauss-Seidel, updated in state), handed to newton.solve as
+    F <- -dv, A <- I (see the module docstring); A is factored in place on the way. Without
+    friction elements F and A are left alone. If A cannot be factored it is replaced by a
+    matrix newton.solve fails on with the same status (zeros: SINGULAR_NEWTON, NaN:
+    NON_FINITE)."""
     ne, n = G.shape
     friction = False
     for e in range(ne):
         friction = friction or coef[e, 2] == 1.0
     if not friction:
         return
-    for i in range(n):
-        for j in range(n):
-            Af[i, j] = A[i, j]
-    if not lu_inplace(Af, piv_f):
+    if not lu_inplace(A, piv):
+        fill = 0.0 if failed_solve_status(A) == SINGULAR_NEWTON else np.nan
+        for i in range(n):
+            for j in range(n):
+                A[i, j] = fill
         return
     for i in range(n):
         X[i] = -F[i]
-    lu_solve_inplace(Af, piv_f, X, scratch)
-    _delassus(h, Af, piv_f, scratch, G, coef, Y, W)
+    lu_solve_inplace(A, piv, X, scratch)
+    _delassus(h, A, piv, scratch, G, coef, Y, W)
     _pgs(tol, v1, X, state, G, coef, W)
     for e in range(ne):
         if coef[e, 2] == 1.0:
@@ -197,11 +199,11 @@ def _friction(h, tol, v1, F, A, Af, piv_f, X, scratch, state, G, coef, Y, W):
 def assemble(kern, args, v1, F, A):
     """Newton system of the step (newton.solve) at the iterate v1: F (n,) <- R_s(v1) and
     A (n, n) <- dR_s/dv1, or with friction elements the increment form F <- -dv, A <- I."""
-    (q, v, t1, h, p, tol, q1, dv, rhs, H, Jq, Jqd, dHw, Hw, Af, piv_f, X, scratch,
+    (q, v, t1, h, p, tol, q1, dv, rhs, H, Jq, Jqd, dHw, Hw, piv, X, scratch,
      state, s0, s1, we, u1, G, coef, Y, W) = args
     _smooth_and_sliders(kern, q, v, t1, h, p, v1, q1, dv, rhs, F, H, A, Jq, Jqd, dHw, Hw,
                         state, s0, s1, we, u1, G, coef)
-    _friction(h, tol, v1, F, A, Af, piv_f, X, scratch, state, G, coef, Y, W)
+    _friction(h, tol, v1, F, A, piv, X, scratch, state, G, coef, Y, W)
 
 
 @njit(**FAST)
@@ -215,7 +217,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     for i in range(n):
         v1[i] = v[i]
     args = (q, v, t + h, h, p, settings.newton_tol, ws.q1, ws.dv, ws.rhs, ws.H, ws.Jq, ws.Jqd,
-            ws.dHw, ws.Hw, ws.Af, ws.piv, ws.X, ws.s, state, s0, s1, ws.we, ws.u1, G, coef,
+            ws.dHw, ws.Hw, ws.piv, ws.X, ws.s, state, s0, s1, ws.we, ws.u1, G, coef,
             ws.Y, ws.W)
     status, iters, resid = newton.solve(_THIS, kern, args, v1, ws.F, ws.A, ws.piv, ws.s,
                                         settings.newton_tol, settings.max_iter)
