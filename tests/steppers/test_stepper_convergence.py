@@ -11,7 +11,8 @@ from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, INFO, METHODS
 T_END = 1.0
 # Step counts per order: small enough steps to be in the asymptotic regime, errors still far
 # above the reference's accuracy (about 1e-12).
-STEPS = {1: (128, 256, 512, 1024, 2048), 2: (32, 64, 128, 256, 512), 4: (32, 64, 128, 256, 512)}
+STEPS = {1: (128, 256, 512, 1024, 2048), 2: (32, 64, 128, 256, 512), 4: (32, 64, 128, 256, 512),
+         6: (8, 12, 16, 24, 32)}
 CASES = {
     "cart_pendulum": ([0.3, 0.8], [0.2, -0.5]),
     "double_pendulum": ([0.3, 0.8], [0.2, -0.5]),

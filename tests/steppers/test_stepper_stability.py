@@ -12,6 +12,7 @@ import pytest
 
 from stepper_util import model, one_step, params  # model is a fixture
 from lagrange_gen.analysis.stability import CLOSED_FORMS, spectral_radius  # closed forms of case 3
+from lagrange_gen.steppers import registry
 
 TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)
 OMEGA = 3.0        # not 1, so that h and tau differ and a wrong scaling shows
@@ -71,3 +72,56 @@ def test_newton_path_equals_explicit_path_on_linear_system(model, method):
         explicit = step_matrix(mod, method, tau)
         newton = step_matrix(mod, method, tau, settings={"newton_always": True})
         np.testing.assert_allclose(newton, explicit, rtol=1e-12, atol=1e-14)
+
+
+# Kahan-Li p6 s9 (GNI sec. V.3.2), typed here from the paper, not read from composition6.py.
+KAHAN_LI_HALF = (0.39216144400731413927925056, 0.33259913678935943859974864,
+                 -0.70624617255763935980996482, 0.08221359629355080023149045,
+                 0.79854399093482996339895035)
+
+
+def verlet_matrix(tau):
+    """Velocity Verlet on x'' = -x: v* = v - tau/2 x, x+ = x + tau v*, v+ = v* - tau/2 x+."""
+    return np.array([[1 - tau**2 / 2, tau], [-tau * (1 - tau**2 / 4), 1 - tau**2 / 2]])
+
+
+def composition_matrix(half, tau):
+    """Product of velocity Verlet matrices (omega = 1) at g tau for the palindromic coefficients
+    (g_1, ..., g_k, ..., g_1) given by their first half ``half`` (middle one last)."""
+    product = np.eye(2)
+    for g in half + half[-2::-1]:
+        product = verlet_matrix(g * tau) @ product
+    return product
+
+
+def first_unstable_tau(half, top=4.0):
+    """End of the stability interval of the composition: the step matrix has determinant 1, so
+    rho = 1 while |trace / 2| <= 1. Scanned on a grid of 1e-4, then bisected."""
+    def stable(tau):
+        return abs(np.trace(composition_matrix(half, tau)) / 2) <= 1.0
+    grid = np.arange(1, int(top * 1e4)) * 1e-4
+    lo, hi = next((a, b) for a, b in zip(grid, grid[1:]) if not stable(b))
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    return lo
+
+
+def test_composition6_stability_limit_matches_its_derived_value(model):
+    """The step matrix of composition6 is the product of its nine Verlet matrices (checked at
+    several tau, up to round-off), rho = 1 exactly below the derived limit 2.5326 and > 1 above,
+    and its SPEC quotes that limit (stable_tau) and that rho."""
+    mod = model("oscillator")
+    limit = first_unstable_tau(KAHAN_LI_HALF)
+    assert limit == pytest.approx(2.532627, abs=2e-6)
+    spec = registry.spec("composition6")
+    assert spec.stable_tau <= limit < spec.stable_tau + 1e-4
+    for tau in (0.1, 1.0, 2.0, 2.52, 2.55, 2.7):
+        measured = step_matrix(mod, "composition6", tau)
+        # (x, v) -> (x, v / omega) is the frame of verlet_matrix (omega = 1)
+        scaled = np.diag([1.0, 1.0 / OMEGA]) @ measured @ np.diag([1.0, OMEGA])
+        np.testing.assert_allclose(scaled, composition_matrix(KAHAN_LI_HALF, tau),
+                                   rtol=1e-9, atol=1e-12)
+        rho = spectral_radius(measured)
+        assert (abs(rho - 1.0) < 1e-10) == (tau < limit), (tau, rho)
+        assert rho == pytest.approx(spec.rho(tau), rel=1e-9)

@@ -29,7 +29,9 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from ..steppers.base import N_STATS, make_settings
+from ..steppers import registry
+from ..steppers.base import N_STATS
+from ..steppers.spec import make_settings
 from ..analysis.runs import unconstrained_methods
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -254,11 +256,14 @@ def _library_runner(mod, method, n_steps):
     n = mod.N_COORDS
     q0, v0 = np.array(Q0), np.array(V0)
     out = (np.empty(2), np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)),
-           np.empty((2, 0)), np.empty(2 * n + 3))
-    settings = make_settings(newton_tol=TOL)
+           np.empty((2, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
+    spec = registry.spec(method)
+    settings = make_settings(spec, {"newton_tol": TOL} if "newton_tol" in spec.setting_names()
+                             else {})
 
     def go():
-        status, _ = run(q0, v0, 0.0, H_STEP, n_steps, n_steps, mod.DEFAULT_PARAMS, settings, *out)
+        status, _, _ = run(q0, v0, 0.0, H_STEP, n_steps, n_steps, mod.DEFAULT_PARAMS, settings,
+                           *out)
         if status != 0:
             raise RuntimeError(f"bench: {method} failed with status {status}")
         return np.concatenate((out[1][1], out[2][1])), out[3][1, 1] / n_steps
@@ -305,14 +310,17 @@ import numpy as np
 import numba  # noqa: F401
 t1 = time.perf_counter()
 from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers.base import N_STATS, make_settings
+from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.base import N_STATS
+from lagrange_gen.steppers.spec import make_settings
 mod = import_generated(sys.argv[1])
 t2 = time.perf_counter()
 run = getattr(mod, "run_" + sys.argv[2])
 n = mod.N_COORDS
-status, done = run(np.array([0.1, 0.5]), np.zeros(n), 0.0, 1e-3, 1, 1, mod.DEFAULT_PARAMS,
-                   make_settings(), np.empty(2), np.empty((2, n)), np.empty((2, n)),
-                   np.empty((2, N_STATS)), np.empty((2, 0)), np.empty(2 * n + 3))
+status, done, _ = run(np.array([0.1, 0.5]), np.zeros(n), 0.0, 1e-3, 1, 1, mod.DEFAULT_PARAMS,
+                      make_settings(registry.spec(sys.argv[2]), {}), np.empty(2),
+                      np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)),
+                      np.empty((2, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
 t3 = time.perf_counter()
 print(json.dumps({"imports": t1 - t0, "module_import": t2 - t1, "first_step": t3 - t2,
                   "status": int(status), "hits": sum(run.stats.cache_hits.values()),

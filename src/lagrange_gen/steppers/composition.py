@@ -24,6 +24,7 @@ the step is stable only for tau < 1.5734 (|trace / 2| = 1 there), against 2 for 
 """
 
 from collections import namedtuple
+from functools import partial
 
 import numpy as np
 from numba import njit
@@ -45,6 +46,15 @@ def palindrome(*half):
     if abs(sum(coeffs) - 1.0) > 1e-14:
         raise ValueError(f"composition coefficients {coeffs} do not sum to 1")
     return coeffs
+
+
+def linear_radius(coeffs, tau):
+    """rho of the step matrix on x'' = -omega^2 x, tau = h omega: the product of verlet's
+    matrices at g tau for g in coeffs."""
+    product = np.eye(2)
+    for g in coeffs:
+        product = verlet.linear_step_matrix(g * tau) @ product
+    return float(np.max(np.abs(np.linalg.eigvals(product))))
 
 
 @njit
@@ -102,7 +112,7 @@ SPEC = Spec(
     name="composition", order=4, family="partitioned", implicit=True, symplectic=True,
     symmetric=True,
     summary="Yoshida 4th-order triple jump of verlet",
-    stable="stable for tau < 1.57",
+    stable="stable for tau < 1.57", stable_tau=1.5734, rho=partial(linear_radius, COEFFS),
     settings=PartitionedSettings,
     kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate",
              "momentum_rate_jacobian"))

@@ -39,8 +39,8 @@ import importlib
 #: The registry: one line per method, in the order reports list them. Everything else about a
 #: method is declared by its module's SPEC (spec.py).
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
-           "dop853", "composition", "nonsmooth_euler", "rattle", "constrained_midpoint",
-           "constrained_implicit_euler", "spook", "index1")
+           "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
+           "constrained_midpoint", "constrained_implicit_euler", "spook", "index1")
 
 #: {method: its Spec}.
 INFO = {m: importlib.import_module(f"{__package__}.{m}").SPEC for m in METHODS}

@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..status import OK
+from . import verlet
 from .base import (FAST, accel, explicit_path, matvec, momentum_from_velocity,
                    velocity_from_momentum)
 from .partitioned import solve_kick
@@ -83,7 +84,8 @@ SPEC = Spec(
     name="symplectic_euler", order=1, family="partitioned", implicit=True, symplectic=True,
     symmetric=False,
     summary="symplectic Euler A in (q, p = H v)",
-    stable="stable for tau < 2",
+    # Step matrix [[1 - tau^2, tau], [-tau, 1]]: verlet's trace and determinant, so its rho.
+    stable="stable for tau < 2", stable_tau=2.0, rho=verlet.linear_radius,
     settings=PartitionedSettings,
     kernels=("energy", "forward_dynamics", "mass_matrix", "momentum_rate",
              "momentum_rate_jacobian"))

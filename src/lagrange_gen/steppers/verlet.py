@@ -21,6 +21,7 @@ step (the acceleration at the end of a step is cached, workspace ``acc``, for th
     v* = v + h/2 a(q, t),   q+ = q + h v*,   v+ = v* + h/2 a(q+, t + h)
 """
 
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -113,11 +114,24 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return _step_newton(kern, q, v, mom, t, h, p, settings, ws)
 
 
+def linear_step_matrix(tau):
+    """The step matrix (2, 2) on x'' = -omega^2 x acting on (x, v / omega), tau = h omega:
+    trace 2 - tau^2, determinant 1."""
+    return np.array([[1 - tau**2 / 2, tau], [-tau * (1 - tau**2 / 4), 1 - tau**2 / 2]])
+
+
+def linear_radius(tau):
+    """Spectral radius of linear_step_matrix(tau): 1 while |trace / 2| = |1 - tau^2 / 2| <= 1
+    (tau <= 2), else |c| + sqrt(c^2 - 1) with c = trace / 2."""
+    c = 1.0 - tau**2 / 2
+    return 1.0 if abs(c) <= 1.0 else abs(c) + math.sqrt(c * c - 1.0)
+
+
 SPEC = Spec(
     name="verlet", order=2, family="partitioned", implicit=True, symplectic=True,
     symmetric=True,
     summary="velocity Verlet / generalized leapfrog",
-    stable="stable for tau < 2",
+    stable="stable for tau < 2", stable_tau=2.0, rho=linear_radius,
     settings=PartitionedSettings,
     kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate",
              "momentum_rate_jacobian"))
