@@ -111,16 +111,16 @@ def velocity_projection(kern, q1, p, J, Y, H, S, eta, v1, from_momentum):
     return OK
 
 
-@njit(**FAST)
+@njit(inline="always")
 def finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, vel, phi, J, gam, Y, H, S, eta, v1,
-                         extra):
+                         extra, J_next):
     """End of the momentum-form steps (rattle's Newton path, constrained_midpoint), after the
     position stage gave q1 (on Phi = 0) and the momentum pt before the end constraint force:
 
         p+ = pt + J(q1)^T eta  with  J(q1) H(q1)^-1 p+ = 0,   v+ = H(q1)^-1 p+,   q+ = q1
 
-    then lam = eta / hh (the force at the end of the step, eta = hh mu) and the residuals go to
-    extra. ``vel`` is the velocity the constraints kernel gets at q1 (only its gamma output,
+    then lam = eta / hh (the force at the end of the step, eta = hh mu), the residuals go to
+    extra and J(q+) to J_next (m, n), the J(q) of the next step. ``vel`` is the velocity the constraints kernel gets at q1 (only its gamma output,
     unused here, depends on it). phi, gam, eta (m,), J, Y (m, n), H (n, n), S (m, m), v1 (n,)
     are scratch. Status OK or SINGULAR_MASS; on failure q, v, mom are untouched."""
     n, m = q.shape[0], phi.shape[0]
@@ -137,5 +137,7 @@ def finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, vel, phi, J, gam, Y, H,
         q[i], v[i], mom[i] = q1[i], v1[i], s
     for k in range(m):
         extra[k] = eta[k] / hh
+        for j in range(n):
+            J_next[k, j] = J[k, j]
     record(extra, m, phi, J, v)
     return OK

@@ -61,8 +61,10 @@ def workspace(kern, n):
 
 @njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
-    """Carry the momentum p = H(q) v between steps."""
+    """Carry the momentum p = H(q) v between steps, and J(q) in ws.Ja (each step leaves
+    J(q+) there for the next)."""
     momentum_from_velocity(kern, q, v, p, ws.H, mom)
+    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     return OK
 
 
@@ -104,7 +106,6 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
     x, qb, q1, f, pt = ws.x, ws.qb, ws.q1, ws.f, ws.pt
     hh, tm = 0.5 * h, t + 0.5 * h
-    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     for i in range(n):
         x[i] = v[i]
     for k in range(m):
@@ -126,7 +127,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
             s += ws.Ja[k, i] * x[n + k]
         pt[i] = s
     status = finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, vb, ws.phi, ws.Jb, ws.gam,
-                                  ws.Y, ws.H, ws.S, ws.eta, ws.v1, extra)
+                                  ws.Y, ws.H, ws.S, ws.eta, ws.v1, extra, ws.Ja)
     return status, iters, resid
 
 

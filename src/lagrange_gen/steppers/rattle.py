@@ -55,8 +55,9 @@ from .spec import PartitionedSettings, Spec
 #: position z, the new state q1, v1, the force f (n); chol(M) L (n, n), kept for the run.
 #: Newton path: the unknown x = (u, w, nu), residual F, scratch s, pivots (2n + m), matrix K;
 #: the momentum pt (n); H(q), H(q+), df/dq, df/dv, d(H w)/dq at q+ (n, n).
-#: Both: Phi, gamma, the end impulse eta (m); J(q) (kept from step to step on the explicit path),
-#: J(q+), the rows H^-1 J^T Y, T (m, n); Schur S (m, m).
+#: Both: Phi, gamma, the end impulse eta (m); J(q) (from prepare, then J(q+) of the previous
+#: step), J(q+), the rows H^-1 J^T Y, T (m, n) (explicit path: Y = M^-1 J(q)^T, kept the same
+#: way); Schur S (m, m).
 Workspace = namedtuple("Workspace", "kap Fk sk pivk Kk acc vh z q1 v1 f L x F s piv K pt H0 H1 "
                                     "Jq Jqd D phi gam eta Ja Jb Y T S")
 
@@ -77,15 +78,17 @@ def workspace(kern, n):
 
 @njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
-    """Explicit path: factor the constant M once (ws.L), cache a(q, t) in ws.acc and J(q) in
-    ws.Ja. Newton path: carry p = H(q) v."""
+    """J(q) into ws.Ja (then each step leaves J(q+) there for the next). Explicit path: factor
+    the constant M once (ws.L), cache a(q, t) in ws.acc and the rows M^-1 J(q)^T in ws.Y.
+    Newton path: carry p = H(q) v."""
+    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     if explicit_path(kern, settings):
         L, acc = ws.L, ws.acc
         kern.dynamics(q, v, t, p, L, acc)
         if not cholesky_inplace(L):
             return SINGULAR_MASS
         cholesky_solve_inplace(L, acc)
-        kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
+        solve_rows(L, ws.Ja, ws.Y)
         return OK
     momentum_from_velocity(kern, q, v, p, ws.H0, mom)
     return OK
@@ -112,17 +115,16 @@ def assemble_multiplier(kern, args, kap, F, K):
             K[i, k] = s
 
 
-@njit(**FAST)
+@njit(inline="always")
 def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
     L, acc, vh, z, q1, v1, f = ws.L, ws.acc, ws.vh, ws.z, ws.q1, ws.v1, ws.f
-    kap, phi, Ja, Jb, Y = ws.kap, ws.phi, ws.Ja, ws.Jb, ws.Y
+    kap, phi, Ja, Jb, Y, T = ws.kap, ws.phi, ws.Ja, ws.Jb, ws.Y, ws.T
     hh = 0.5 * h
     for i in range(n):
         vh[i] = v[i] + hh * acc[i]
         z[i] = q[i] + h * vh[i]
-    solve_rows(L, Ja, Y)                      # rows M^-1 J(q)_k^T: q+ = z + Y^T kappa
-    for k in range(m):
+    for k in range(m):                        # Y: rows M^-1 J(q)_k^T, q+ = z + Y^T kappa
         kap[k] = hh * h * extra[k]
     status, iters, resid = newton.solve(_MULTIPLIER, kern, (z, vh, p, Y, q1, phi, Jb, ws.gam),
                                         kap, ws.Fk, ws.Kk, ws.pivk, ws.sk,
@@ -141,15 +143,15 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
     cholesky_solve_inplace(L, f)
     for i in range(n):
         v1[i] = vh[i] + hh * f[i]
-    solve_rows(L, Jb, ws.T)
-    if not project(Jb, ws.T, v1, ws.S, ws.eta):        # eta = h/2 mu
+    solve_rows(L, Jb, T)
+    if not project(Jb, T, v1, ws.S, ws.eta):           # eta = h/2 mu
         return SINGULAR_MASS, iters, resid
     for i in range(n):
         q[i], v[i], acc[i] = q1[i], v1[i], f[i]
     for k in range(m):
         extra[k] = ws.eta[k] / hh
         for j in range(n):
-            Ja[k, j] = Jb[k, j]               # J(q) of the next step
+            Ja[k, j], Y[k, j] = Jb[k, j], T[k, j]       # J(q), M^-1 J(q)^T of the next step
     record(extra, m, phi, Jb, v)
     return OK, iters, resid
 
@@ -194,13 +196,12 @@ def assemble_position(kern, args, x, F, K):
             K[2 * n + k, 2 * n + j] = 0.0
 
 
-@njit(**FAST)
+@njit(inline="always")
 def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
     x, q1, f, pt, H0 = ws.x, ws.q1, ws.f, ws.pt, ws.H0
     hh = 0.5 * h
     kern.mass_matrix(q, p, H0)
-    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     for i in range(n):
         x[i] = v[i]
         x[n + i] = v[i]
@@ -222,7 +223,7 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
             s += H0[i, j] * u[j]              # H(q) u = p + h/2 f + J^T nu, exactly
         pt[i] = s
     status = finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, w, ws.phi, ws.Jb, ws.gam,
-                                  ws.Y, ws.H1, ws.S, ws.eta, ws.v1, extra)
+                                  ws.Y, ws.H1, ws.S, ws.eta, ws.v1, extra, ws.Ja)
     return status, iters, resid
 
 
