@@ -120,9 +120,10 @@ def finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, vel, phi, J, gam, Y, H,
         p+ = pt + J(q1)^T eta  with  J(q1) H(q1)^-1 p+ = 0,   v+ = H(q1)^-1 p+,   q+ = q1
 
     then lam = eta / hh (the force at the end of the step, eta = hh mu), the residuals go to
-    extra and J(q+) to J_next (m, n), the J(q) of the next step. ``vel`` is the velocity the constraints kernel gets at q1 (only its gamma output,
-    unused here, depends on it). phi, gam, eta (m,), J, Y (m, n), H (n, n), S (m, m), v1 (n,)
-    are scratch. Status OK or SINGULAR_MASS; on failure q, v, mom are untouched."""
+    extra and J(q+) to J_next (m, n), the J(q) of the next step. ``vel`` is the velocity the
+    constraints kernel gets at q1 (only its gamma output, unused here, depends on it). phi, gam,
+    eta (m,), J, Y (m, n), H (n, n), S (m, m), v1 (n,) are scratch. Status OK or SINGULAR_MASS;
+    on failure q, v, mom are untouched."""
     n, m = q.shape[0], phi.shape[0]
     kern.constraints(q1, vel, p, phi, J, gam)
     for i in range(n):
