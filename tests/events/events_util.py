@@ -25,34 +25,38 @@ _DIR = []
 _MODULES = {}
 
 
-def generated(stem):
-    """tests/events/models/<stem>.py -> its generated module (once per process, temp dir)."""
+def generated(stem, methods=None):
+    """tests/events/models/<stem>.py -> its generated module with the glue of ``methods``
+    (default METHODS), generated once per process into a temp dir."""
     if stem not in _MODULES:
         if not _DIR:
             _DIR.append(Path(tempfile.mkdtemp(prefix="lagrange_gen_event_models_")))
             atexit.register(shutil.rmtree, _DIR[0], True)
-        path = generate_model(MODELS / f"{stem}.py", _DIR[0], methods=METHODS).path
+        path = generate_model(MODELS / f"{stem}.py", _DIR[0], methods=methods or METHODS).path
         _MODULES[stem] = import_generated(path)
     return _MODULES[stem]
 
 
 class Run:
     """The outputs of one glue call: status, steps_done, n_events, t (S,), q, v (S, n),
-    last (2n + 3,), events (E, 3 + 2n) as filled."""
+    last (2n + 3 + n_saved,), events (E, 3 + 2n) as filled. The method's saved fields start
+    at zero (constrained methods: multipliers, the first Newton guess)."""
 
     def __init__(self, mod, method, q0, v0, h, n_steps, t0=0.0, max_events=50, params=None):
         n = mod.N_COORDS
         rows = n_steps + 1
         self.t = np.full(rows, np.nan)
         self.q, self.v = np.full((rows, n), np.nan), np.full((rows, n), np.nan)
-        self.last = np.full(2 * n + 3, np.nan)
+        spec = registry.spec(method)
+        n_saved = spec.n_saved(n, mod.N_CONSTRAINTS, mod.N_ELEMENTS)
+        self.last = np.full(2 * n + 3 + n_saved, np.nan)
         self.events = np.full((max_events, 3 + 2 * n), np.nan)
         p = mod.DEFAULT_PARAMS.copy() if params is None else np.asarray(params, dtype=np.float64)
-        settings = make_settings(registry.spec(method), {})
+        settings = make_settings(spec, {})
         self.status, self.steps, self.n_events = getattr(mod, f"run_{method}")(
             np.asarray(q0, dtype=np.float64), np.asarray(v0, dtype=np.float64), float(t0),
             float(h), n_steps, 1, p, settings, self.t, self.q, self.v,
-            np.empty((rows, N_STATS)), np.empty((rows, 0)), self.last, self.events)
+            np.empty((rows, N_STATS)), np.zeros((rows, n_saved)), self.last, self.events)
         self.names = mod.EVENT_NAMES
 
     def rows(self, name=None):

@@ -148,3 +148,23 @@ def test_events_table_names_the_events():
     assert list(table["direction"]) == [-1, -1]
     assert table["q"].shape == (2, 1)
     np.testing.assert_array_equal(table["v"][:, 0], run.rows()[:, 4])
+
+
+def test_on_a_constrained_model_the_crossing_converges_at_the_order_of_the_method():
+    """rattle (order 2) on the Cartesian pendulum released from rest at theta0 = 0.8: the bob
+    passes the vertical after K(sin^2(theta0 / 2)) / omega (scipy's ellipk takes m = k^2). The
+    interpolant is the cubic one there (multiplier forces: no accelerations from H^-1 rhs)."""
+    from scipy.special import ellipk
+    mod = generated("cartesian_pendulum_events", ["rattle"])
+    theta0, omega = 0.8, math.sqrt(9.81)
+    t_quarter = ellipk(math.sin(theta0 / 2) ** 2) / omega
+    q0 = [-math.sin(theta0), -math.cos(theta0)]
+    errors = []
+    for h in (0.02, 0.01, 0.005):
+        run = Run(mod, "rattle", q0, [0.0, 0.0], h, round(1.0 / h))
+        assert run.status == OK and run.n_events == 1
+        t, _, sense, x, y = run.rows()[0, :5]
+        assert sense == 1.0 and abs(x) <= 1e-12 and y == pytest.approx(-1.0, abs=1e-3)
+        errors.append(abs(t - t_quarter))
+    rates = [math.log2(a / b) for a, b in zip(errors, errors[1:])]
+    assert errors[-1] < 1e-3 and all(abs(r - 2) < 0.25 for r in rates), (errors, rates)
