@@ -97,9 +97,10 @@ def linkage_drift(mod, n_steps):
     return rows, curves
 
 
-def _glue_runner(mod, method, n_steps, q0, v0, constrained):
+def _glue_runner(mod, method, n_steps, q0, v0):
     """A closure running n_steps of run_<method> with only the final state saved."""
     n, m = mod.N_COORDS, mod.N_CONSTRAINTS
+    constrained = spec(method).constraints
     n_saved = spec(method).n_saved(n, m, mod.N_ELEMENTS)
     extra = np.zeros((2, n_saved))
     if constrained:
@@ -126,8 +127,7 @@ def step_costs(mod, free, n_steps, repeats):
     rows = []
     for method in ("verlet", "rattle", "constrained_midpoint", "constrained_implicit_euler",
                    "spook", "index1"):
-        go = (_glue_runner(free, method, n_steps, q0, v0, False) if method == "verlet"
-              else _glue_runner(mod, method, n_steps, q0, v0, True))
+        go = _glue_runner(mod if spec(method).constraints else free, method, n_steps, q0, v0)
         go()                                                     # compile or load
         best, iters = _best_of(go, repeats)
         rows.append(dict(method=method, ns=best / n_steps * 1e9, iters=iters))
@@ -141,8 +141,8 @@ def _pendulum(theta, l=1.0):
 def _spring_run(spring, rigid, method, k, t_end):
     """Trajectory of the stretchable pendulum with stiffness k (spook: the rigid model with
     compliance 1/k); the stiff mode starts at rest (spring at its static stretch, m = l = 1)."""
-    if method == "spook":
-        return simulate(rigid, "spook", _pendulum(STIFF_THETA0), np.zeros(2), t_end=t_end,
+    if "compliance" in spec(method).setting_names():
+        return simulate(rigid, method, _pendulum(STIFF_THETA0), np.zeros(2), t_end=t_end,
                         h=STIFF_H, compliance=1.0 / k)
     q0 = _pendulum(STIFF_THETA0, 1.0 + 9.81 * np.cos(STIFF_THETA0) / k)
     with warnings.catch_warnings():   # the scan looks for where methods break, on purpose

@@ -136,7 +136,7 @@ SPEC = Spec(
     symplectic=False, symmetric=False,
     summary="index-3 backward Euler with velocity projection",
     constraints=True,
-    saved=SAVED,
+    saved=SAVED, constraint_drift="none",
     settings=NewtonSettings,
     kernels=("constraint_dq", "constraints", "dynamics", "energy", "mass_matrix",
              "mass_matvec_dq", "rhs_jacobian"))

@@ -139,7 +139,7 @@ SPEC = Spec(
     symmetric=True,
     summary="midpoint variational integrator with constraints",
     constraints=True,
-    saved=SAVED,
+    saved=SAVED, constraint_drift="none",
     settings=NewtonSettings,
     kernels=("constraints", "energy", "mass_matrix", "mass_matvec_dq", "momentum_rate",
              "momentum_rate_jacobian"))

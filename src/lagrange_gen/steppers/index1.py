@@ -141,7 +141,7 @@ SPEC = Spec(
     symmetric=False,
     summary="rk4 on the acceleration-level KKT form (drifts: the bad example)",
     constraints=True,
-    saved=SAVED,
+    saved=SAVED, constraint_drift="grows",
     limits={"baumgarte": (0.0, True, False)},
     settings=Index1Settings,
     kernels=("constraints", "dynamics", "energy"))

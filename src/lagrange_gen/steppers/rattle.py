@@ -244,7 +244,7 @@ SPEC = Spec(
     symmetric=True,
     summary="constrained Verlet, Newton on the multipliers",
     constraints=True,
-    saved=SAVED,
+    saved=SAVED, constraint_drift="none",
     settings=PartitionedSettings,
     kernels=("constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq",
              "momentum_rate", "momentum_rate_jacobian"))

@@ -114,7 +114,7 @@ SPEC = Spec(
     symmetric=False,
     summary="Lacoursiere's regularized linearly implicit stepper (compliance, relaxation)",
     constraints=True,
-    saved=SAVED,
+    saved=SAVED, constraint_drift="bounded",
     limits={"compliance": (0.0, True, False), "relaxation": (0.0, False, False)},
     settings=SpookSettings,
     kernels=("constraints", "dynamics", "energy"))
