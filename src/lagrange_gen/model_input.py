@@ -120,17 +120,13 @@ class Event:
     """
 
     def __init__(self, expr, terminal=False, direction=0):
-        if not isinstance(terminal, (bool, int)) or terminal not in (0, 1):
-            raise ModelError(f"Event: terminal must be True or False, got {terminal!r}")
-        if isinstance(direction, bool) or direction not in (-1, 0, 1):
-            raise ModelError(f"Event: direction must be +1 (rising), -1 (falling) or 0 (both), "
-                             f"got {direction!r}")
-        self.expr, self.terminal, self.direction = expr, bool(terminal), int(direction)
+        # Checked by the Model (_events), whose messages name the model and the event.
+        self.expr, self.terminal, self.direction = expr, terminal, direction
         self.name = None        # the key of the events dict (set by Model)
 
     def __repr__(self):
         return (f"Event({self.name or ''}: {self.expr}, terminal={self.terminal}, "
-                f"direction={self.direction:+d})")
+                f"direction={self.direction!r})")
 
 
 def _events(model_name, events, replace):
@@ -147,11 +143,18 @@ def _events(model_name, events, replace):
             raise ModelError(f"model {model_name}: event name {name!r} is not a string")
         _check_name("event", name)
         event = given if isinstance(given, Event) else Event(given)
+        terminal, direction = event.terminal, event.direction
+        if not isinstance(terminal, (bool, int)) or terminal not in (0, 1):
+            raise ModelError(f"model {model_name}: event {name}: terminal must be True or False, "
+                             f"got {terminal!r}")
+        if isinstance(direction, bool) or direction not in (-1, 0, 1):
+            raise ModelError(f"model {model_name}: event {name}: direction must be +1 (rising), "
+                             f"-1 (falling) or 0 (both), got {direction!r}")
         try:
             expr = _sympify(event.expr, f"event {name}", replace)
         except ModelError as exc:
             raise ModelError(f"model {model_name}: {exc}") from None
-        named = Event(expr, event.terminal, event.direction)
+        named = Event(expr, bool(terminal), int(direction))
         named.name = name
         out.append(named)
     return out
