@@ -43,6 +43,8 @@ from .base import FAST
 ROOT_RTOL = 1e-12
 #: Iteration cap of the refinement (Illinois converges superlinearly: about 10 are needed).
 ROOT_MAX_ITER = 100
+#: Unit roundoff of float64: the bracket cannot close below a few of it relative to |t|.
+EPS = float(np.finfo(np.float64).eps)
 
 #: g at the start and end of the step and at a trial time (N_EVENTS,); the located crossing
 #: times t_cross (N_EVENTS,) (NaN: none) and directions sense (N_EVENTS,); the interpolated
@@ -109,7 +111,7 @@ def refine(interp, iws, kern, ew, p, k, t_a, g_a, t_b, g_b):
     so that the bracket closes from both sides (superlinear, about 10 evaluations)."""
     if g_b == 0.0:
         return t_b
-    tol = ROOT_RTOL * abs(t_b - t_a) + 4.0 * 2.2e-16 * max(abs(t_a), abs(t_b))
+    tol = ROOT_RTOL * abs(t_b - t_a) + 4.0 * EPS * max(abs(t_a), abs(t_b))
     kept = 0                   # which end was retained last: -1 a, +1 b
     t = t_b
     for _ in range(ROOT_MAX_ITER):
