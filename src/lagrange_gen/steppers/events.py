@@ -6,8 +6,8 @@ constants N_EVENTS, EVENT_NAMES, EVENT_TERMINAL (bool), EVENT_DIRECTION (+1 risi
 0 both), also when the model has none (N_EVENTS = 0, an empty kernel).
 
 How a step loop uses this module (base.run_loop for the fixed-step methods; the adaptive loop
-the same way with its dense output), everything under ``if kern.N_EVENTS > 0`` so that a model
-without events compiles to the loop without them::
+the same way with its dense output as ``interp``), everything under ``if kern.N_EVENTS > 0``,
+so that on a model without events LLVM removes it from the loop (no work, no allocation)::
 
     ew = events.workspace(kern, n)
     events.start(kern, ew, q, v, t0, p)                  # g at the initial state
