@@ -78,11 +78,12 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
 
 
 def _warm_up(task, q, v, initial, last, events):
-    """Compile (or load from numba's cache) the glue with a call that stops at t0."""
+    """Compile (or load from numba's cache) the glue with a call that stops at t0 (the glue
+    needs two rows at least)."""
     n = q.shape[0]
     start = time.perf_counter()
-    extra = initial.reshape(1, -1).copy()
-    task.run(q, v, task.t0, task.t0, task.p, task.settings, np.zeros(0), np.empty(1),
-             np.empty((1, n)), np.empty((1, n)), np.empty((1, N_STATS)), extra, last, events,
+    extra = np.vstack((initial, initial))
+    task.run(q, v, task.t0, task.t0, task.p, task.settings, np.zeros(0), np.empty(2),
+             np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra, last, events,
              np.zeros(4))
     return time.perf_counter() - start

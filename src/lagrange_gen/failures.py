@@ -53,6 +53,12 @@ def raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
         raise SingularNewtonMatrix(
             f"{where}: singular Newton matrix ({system}; H(q) is not what failed) in the step "
             f"from {state}{_constraint_hint(module, method, q, p)}; reduce h", **kwargs)
+    if code == st.STEP_TOO_SMALL:
+        raise BlowUp(f"{where}: the step size fell below the time resolution at {state} (the "
+                     f"solution blows up in finite time, or a singularity?)", **kwargs)
+    if code == st.TOO_MANY_STEPS:
+        raise SimulationError(f"{where}: max_steps step attempts without reaching the end, at "
+                              f"{state}; raise max_steps or loosen rtol/atol", **kwargs)
     if code == st.UNSTABLE:
         raise BlowUp(f"{where}: the state grew past the blow-up bound (unstable at this h?): "
                      f"{state}", **kwargs)

@@ -14,7 +14,7 @@ from lagrange_gen.codegen.needs import method_needs
 from lagrange_gen.loader import import_generated
 from lagrange_gen.status import NON_FINITE, OK, UNSTABLE
 from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.adaptive import STEP_TOO_SMALL, TOO_MANY_STEPS
+from lagrange_gen.status import STEP_TOO_SMALL, TOO_MANY_STEPS
 from lagrange_gen.steppers.base import N_STATS, STAT_ITERS, STAT_RESIDUAL
 from lagrange_gen.steppers.spec import make_settings
 

@@ -86,12 +86,9 @@ import math
 import numpy as np
 from numba import njit
 
-from ..status import NON_FINITE, OK
+from ..status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 from .base import FAST, _last, _save, check_state
 
-# TODO(integrator): move these two into lagrange_gen.status (with NAMES entries).
-STEP_TOO_SMALL = 6    # the adaptive step size underflowed (0.1 |h| <= |t| eps)
-TOO_MANY_STEPS = 7    # settings.max_steps attempted steps in one call
 
 SAFETY = 0.9          # Hairer's safe
 FAC_MIN = 0.333       # Hairer's fac1: smallest step ratio
