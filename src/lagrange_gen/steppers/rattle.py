@@ -49,17 +49,18 @@ from .base import FAST, explicit_path, momentum_from_velocity
 from .constrained import SAVED, finish_momentum_step, project, record, solve_rows
 from .spec import PartitionedSettings, Spec
 
-#: Scratch of one run (n coordinates, m constraints).
-#: Explicit path: the Newton unknown kappa, its residual Fk, solver scratch sk and pivots (m),
-#: matrix Kk (m, m); the cached acceleration acc, the half-step velocity vh, the unconstrained
-#: position z, the new state q1, v1, the force f (n); chol(M) L (n, n), kept for the run.
+#: Scratch of one run (n coordinates, m constraints); every array costs a little in each call of
+#: step (numba passes the workspace's arrays one by one), so the two paths share where they can.
+#: Explicit path: the Newton unknown kappa and its residual Fk (m) (the Newton matrix is S, the
+#: scratch and pivots those of the Newton path, longer than m); the cached acceleration acc, the
+#: half-step velocity vh, the unconstrained position z (n); M: chol(M), kept for the run.
 #: Newton path: the unknown x = (u, w, nu), residual F, scratch s, pivots (2n + m), matrix K;
-#: the momentum pt (n); H(q), H(q+), df/dq, df/dv, d(H w)/dq at q+ (n, n).
-#: Both: Phi, gamma, the end impulse eta (m); J(q) (from prepare, then J(q+) of the previous
-#: step), J(q+), the rows H^-1 J^T Y, T (m, n) (explicit path: Y = M^-1 J(q)^T, kept the same
-#: way); Schur S (m, m).
-Workspace = namedtuple("Workspace", "kap Fk sk pivk Kk acc vh z q1 v1 f L x F s piv K pt H0 H1 "
-                                    "Jq Jqd D phi gam eta Ja Jb Y T S")
+#: the momentum pt (n); M: H(q); H(q+), df/dq, df/dv, d(H w)/dq at q+ (n, n).
+#: Both: the new state q1, v1, the force f (n); Phi, gamma, the end impulse eta (m); J(q) (from
+#: prepare, then J(q+) of the previous step), J(q+), the rows H^-1 J^T Y, T (m, n) (explicit
+#: path: Y = M^-1 J(q)^T, kept the same way); S (m, m) the Schur complement J H^-1 J^T.
+Workspace = namedtuple("Workspace", "kap Fk acc vh z x F s piv K pt M H1 Jq Jqd D q1 v1 f phi gam "
+                                    "eta Ja Jb Y T S")
 
 
 @njit
@@ -67,30 +68,30 @@ def workspace(kern, n):
     """Allocated once per run by base.run_loop."""
     m = kern.N_CONSTRAINTS
     N = 2 * n + m
-    return Workspace(np.zeros(m), np.zeros(m), np.zeros(m), np.zeros(m, np.int64),
-                     np.zeros((m, m)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
-                     np.zeros(n), np.zeros(n), np.zeros((n, n)), np.zeros(N), np.zeros(N),
-                     np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)), np.zeros(n),
-                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros(m), np.zeros((m, n)),
-                     np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, m)))
+    return Workspace(np.zeros(m), np.zeros(m), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N, np.int64),
+                     np.zeros((N, N)), np.zeros(n), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros(n),
+                     np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(m), np.zeros(m),
+                     np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, n)),
+                     np.zeros((m, m)))
 
 
 @njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """J(q) into ws.Ja (then each step leaves J(q+) there for the next). Explicit path: factor
-    the constant M once (ws.L), cache a(q, t) in ws.acc and the rows M^-1 J(q)^T in ws.Y.
+    the constant M once (ws.M), cache a(q, t) in ws.acc and the rows M^-1 J(q)^T in ws.Y.
     Newton path: carry p = H(q) v."""
     kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
     if explicit_path(kern, settings):
-        L, acc = ws.L, ws.acc
+        L, acc = ws.M, ws.acc
         kern.dynamics(q, v, t, p, L, acc)
         if not cholesky_inplace(L):
             return SINGULAR_MASS
         cholesky_solve_inplace(L, acc)
         solve_rows(L, ws.Ja, ws.Y)
         return OK
-    momentum_from_velocity(kern, q, v, p, ws.H0, mom)
+    momentum_from_velocity(kern, q, v, p, ws.M, mom)
     return OK
 
 
@@ -118,7 +119,7 @@ def assemble_multiplier(kern, args, kap, F, K):
 @njit(inline="always")
 def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    L, acc, vh, z, q1, v1, f = ws.L, ws.acc, ws.vh, ws.z, ws.q1, ws.v1, ws.f
+    L, acc, vh, z, q1, v1, f = ws.M, ws.acc, ws.vh, ws.z, ws.q1, ws.v1, ws.f
     kap, phi, Ja, Jb, Y, T = ws.kap, ws.phi, ws.Ja, ws.Jb, ws.Y, ws.T
     hh = 0.5 * h
     for i in range(n):
@@ -127,7 +128,7 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
     for k in range(m):                        # Y: rows M^-1 J(q)_k^T, q+ = z + Y^T kappa
         kap[k] = hh * h * extra[k]
     status, iters, resid = newton.solve(_MULTIPLIER, kern, (z, vh, p, Y, q1, phi, Jb, ws.gam),
-                                        kap, ws.Fk, ws.Kk, ws.pivk, ws.sk,
+                                        kap, ws.Fk, ws.S, ws.piv, ws.s,
                                         settings.newton_tol, settings.max_iter)
     if status != OK:
         return status, iters, resid
@@ -139,7 +140,7 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
         vh[i] += s / h
     kern.constraints(q1, vh, p, phi, Jb, ws.gam)
     # Velocity stage: forces are velocity-free here, so a(q+) does not depend on vh.
-    kern.dynamics(q1, vh, t + h, p, ws.H0, f)
+    kern.dynamics(q1, vh, t + h, p, ws.H1, f)
     cholesky_solve_inplace(L, f)
     for i in range(n):
         v1[i] = vh[i] + hh * f[i]
@@ -199,7 +200,7 @@ def assemble_position(kern, args, x, F, K):
 @njit(inline="always")
 def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
-    x, q1, f, pt, H0 = ws.x, ws.q1, ws.f, ws.pt, ws.H0
+    x, q1, f, pt, H0 = ws.x, ws.q1, ws.f, ws.pt, ws.M
     hh = 0.5 * h
     kern.mass_matrix(q, p, H0)
     for i in range(n):
