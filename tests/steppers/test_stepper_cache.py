@@ -17,15 +17,19 @@ SCRIPT = """
 import json, sys
 import numpy as np
 from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers.base import N_STATS, make_settings
+from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.base import N_STATS
+from lagrange_gen.steppers.spec import make_settings
 mod = import_generated(sys.argv[1])
 out = dict()
 for method in sys.argv[2].split(","):
     run = getattr(mod, "run_" + method)
     rows = 11
-    status, done = run(np.array([0.1, 0.5]), np.zeros(2), 0.0, 1e-3, 10, 1, mod.DEFAULT_PARAMS,
-                       make_settings(), np.empty(rows), np.empty((rows, 2)), np.empty((rows, 2)),
-                       np.empty((rows, N_STATS)), np.empty((rows, 0)), np.empty(7))
+    status, done, _ = run(np.array([0.1, 0.5]), np.zeros(2), 0.0, 1e-3, 10, 1,
+                          mod.DEFAULT_PARAMS, make_settings(registry.spec(method), {}),
+                          np.empty(rows), np.empty((rows, 2)), np.empty((rows, 2)),
+                          np.empty((rows, N_STATS)), np.empty((rows, 0)), np.empty(7),
+                          np.empty((0, 7)))
     out[method] = dict(status=int(status), hits=sum(run.stats.cache_hits.values()),
                        misses=sum(run.stats.cache_misses.values()))
 print(json.dumps(out))

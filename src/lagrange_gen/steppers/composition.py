@@ -31,7 +31,7 @@ from numba import njit
 
 from ..status import OK
 from . import verlet
-from .base import FAST, copy_into
+from .base import FAST, copy_into, explicit_path
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run: verlet's workspace (its cached acceleration included) and the state at
@@ -70,11 +70,12 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     return verlet.prepare(kern, q, v, mom, t, p, settings, ws.verlet, extra)
 
 
-@njit(**FAST)
-def composed_step(kern, q, v, mom, t, h, p, settings, ws, extra, coeffs):
+@njit(inline="always")
+def composed_step(kern, q, v, mom, t, h, p, settings, ws, coeffs):
     """The verlet substeps g h for g in ``coeffs`` (a tuple of floats) from (q, v, mom) at t, in
     place. Returns (status, Newton iterations summed, largest residual). On a failing substep
-    the state (and verlet's cached acceleration) is restored to the start of the step."""
+    the state (and verlet's cached acceleration) is restored to the start of the step.
+    Inlined into each composition's step (one workspace pass less per step, see verlet.py)."""
     copy_into(ws.q, q)
     copy_into(ws.v, v)
     copy_into(ws.mom, mom)
@@ -82,9 +83,14 @@ def composed_step(kern, q, v, mom, t, h, p, settings, ws, extra, coeffs):
     iters = 0
     resid = 0.0
     t_sub = t
+    explicit = explicit_path(kern, settings)
     for g in coeffs:
-        status, it, res = verlet.step(kern, q, v, mom, t_sub, g * h, p, settings, ws.verlet,
-                                      extra)
+        # verlet.step's two paths, inlined here (see verlet.py: no workspace passed per substep)
+        if explicit:
+            status, it, res = verlet.step_explicit(kern, q, v, t_sub, g * h, p, ws.verlet), 0, 0.0
+        else:
+            status, it, res = verlet.step_newton(kern, q, v, mom, t_sub, g * h, p, settings,
+                                                 ws.verlet)
         iters += it
         resid = max(resid, res)
         if status != OK:
@@ -105,7 +111,7 @@ COEFFS = palindrome(G1, 1.0 - 2.0 * G1)
 @njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
-    return composed_step(kern, q, v, mom, t, h, p, settings, ws, extra, COEFFS)
+    return composed_step(kern, q, v, mom, t, h, p, settings, ws, COEFFS)
 
 
 SPEC = Spec(

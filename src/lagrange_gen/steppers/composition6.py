@@ -42,7 +42,7 @@ COEFFS = palindrome(0.39216144400731413927925056, 0.33259913678935943859974864,
 @njit(**FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
-    return composed_step(kern, q, v, mom, t, h, p, settings, ws, extra, COEFFS)
+    return composed_step(kern, q, v, mom, t, h, p, settings, ws, COEFFS)
 
 
 SPEC = Spec(

@@ -58,8 +58,12 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     return OK
 
 
-@njit(**FAST)
-def _step_explicit(kern, q, v, t, h, p, ws):
+# step_explicit and step_newton are inlined into step (and into composition.composed_step's
+# loop): as separate functions, each call passes the 15 arrays of the workspace, which cost
+# 30 ns per call on the pendulum (step 79 against 49 ns; composition 225 against 115 ns).
+@njit(inline="always")
+def step_explicit(kern, q, v, t, h, p, ws):
+    """The explicit path's step (velocity Verlet, cached acceleration); returns status."""
     n = q.shape[0]
     acc, v_half, q_new, acc_new = ws.acc, ws.u, ws.q_new, ws.f
     for i in range(n):
@@ -76,8 +80,9 @@ def _step_explicit(kern, q, v, t, h, p, ws):
     return OK
 
 
-@njit(**FAST)
-def _step_newton(kern, q, v, mom, t, h, p, settings, ws):
+@njit(inline="always")
+def step_newton(kern, q, v, mom, t, h, p, settings, ws):
+    """The Newton path's step; returns (status, Newton iterations, residual)."""
     n = q.shape[0]
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
@@ -110,8 +115,8 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, ws):
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
-        return _step_explicit(kern, q, v, t, h, p, ws), 0, 0.0
-    return _step_newton(kern, q, v, mom, t, h, p, settings, ws)
+        return step_explicit(kern, q, v, t, h, p, ws), 0, 0.0
+    return step_newton(kern, q, v, mom, t, h, p, settings, ws)
 
 
 def linear_step_matrix(tau):
