@@ -65,9 +65,9 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
             wanted = wanted[filled - 1:]
         if bar:
             bar.update(int(1000 * (t - t0) / max(t_end - t0, 1e-300)))
-        # Done at t_end, when every requested time is filled, or when the call stopped before
-        # filling its rows (the end, or a terminal event).
-        if t >= t_end or (t_eval is not None and not len(wanted)) or filled < rows:
+        # Done at t_end, when every requested time is filled, or at a terminal event.
+        if t >= t_end or (t_eval is not None and not len(wanted)) or _stopped(m, events,
+                                                                                n_events, t):
             break
     wall = time.perf_counter() - start
     if bar:
@@ -75,6 +75,13 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
     out = {k: np.concatenate([part[k] for part in parts]) for k in parts[0]}
     out.update(events=events, n_events=n_events, last=last, counters=counters)
     return out, compile_time, wall
+
+
+def _stopped(module, events, n_events, t):
+    """Did a terminal event end the call at time t (the last recorded event is terminal and
+    at t)?"""
+    row = min(n_events, events.shape[0]) - 1
+    return row >= 0 and bool(module.EVENT_TERMINAL[int(events[row, 1])]) and events[row, 0] == t
 
 
 def _warm_up(task, q, v, initial, last, events):

@@ -211,6 +211,7 @@ def _kernel_args(module):
         "elements": (q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))),
         "elements_hessian": (q, we, p, A),
         "forward_dynamics": (q, q, 0.0, p, A, v),
+        "events": (q, q, 0.0, p, np.empty(getattr(module, "N_EVENTS", 0))),
     }
 
 

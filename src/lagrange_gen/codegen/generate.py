@@ -159,7 +159,7 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None, progre
         source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
         text = render_module(dyn, texts, sources=module_sources(methods), options=options,
                              source_rel=source_rel, methods=methods,
-                             glue="\n\n".join(glue_source(m, _n_saved(m, dyn)) for m in methods),
+                             glue="\n\n".join(glue_source(m, _n_saved(m, dyn), len(dyn.model.events)) for m in methods),
                              why=selected)
     seconds = {"derive": derived - start, "emit": time.perf_counter() - derived}
     return GenerationParts(text, key_of_text(text), target, dyn, texts, seconds)

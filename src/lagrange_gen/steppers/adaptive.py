@@ -2,7 +2,7 @@
 
 The generated glue of an adaptive method (registry.ADAPTIVE_GLUE_ARGS) calls::
 
-    run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
+    run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, settings, t_eval,
                  out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters)
         -> (status, rows, n_events)
 
@@ -13,7 +13,7 @@ The generated glue of an adaptive method (registry.ADAPTIVE_GLUE_ARGS) calls::
                 S >= 2 (ValueError otherwise, like the buffer check of base.run_loop)
     out_last    (2n + 3 + n_saved,) [t, q, v, accepted steps since the last row, last accepted
                 error norm, saved fields] of the state reached (see below)
-    out_events  (E', 3 + 2n): not written yet (n_events = 0; see "Events" below)
+    out_events  (E', 3 + 2n): located events (see "Events" below)
     counters    (4,) float64, in/out: [h, accepted, rejected, evaluations]. In: counters[0] =
                 the first step size to try (its sign is ignored; 0: Hairer's automatic starting
                 step); out: the next step size proposed, signed (pass it back in to continue).
@@ -65,10 +65,14 @@ in out_last[0]:
     TOO_MANY_STEPS         settings.max_steps attempts in this call; out_last = state at t
 ``rows`` = the rows written before the failure (0: the initial state was refused).
 
-Events: after each accepted step, before ``method.advance``, the step from (t, q, v) to
-(t_new, ws.q_new, ws.v_new) is complete and ``method.dense`` + ``method.interpolate(ws, s,
-q_out, v_out)`` give the state at any s in [t, t_new]: an event locator goes there (marked
-below). dense must run before advance (which reuses the step's stages); the interpolant stays
+Events (n_event_fns > 0, see events.py): after each accepted step the event functions are
+evaluated at the new state; on a sign change the dense output of the step is built and the
+crossing refined on ``method.interpolate``; located events go to out_events (E, 3 + 2n) rows
+[t, event index, direction, q, v] while there is room (n_events counts them all). A terminal
+event ends the call at the event: every-step mode saves the event state as the last row, t_eval
+mode the t_eval values before it; out_last holds the event state, status OK, and out_last[0]
+(the event time) is before t_end: the driver must not continue (it tells a terminal stop from
+full buffers by the last recorded event). dense must run before advance (which reuses the step's stages); the interpolant stays
 valid until the next dense call. Without t_eval values inside a step, dense is not called
 (it costs DENSE_EVALS evaluations).
 
@@ -87,6 +91,7 @@ import numpy as np
 from numba import njit
 
 from ..status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
+from . import events
 from .base import FAST, _last, _save, check_state
 
 
@@ -206,9 +211,40 @@ def _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j, rows, since,
 
 
 @njit(inline="always")
-def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
+def _terminal(method, kern, ws, ew, q, v, t, h, err, p, t_eval, j, rows, since, extra, out_t,
+              out_q, out_v, out_stats, out_extra, out_last, counters):
+    """A terminal event at ew.stop[0] inside the accepted step from t (dense output built): the
+    rows up to the event (every-step mode: the event state; t_eval: the values before it, from
+    the dense output), then the call ends there (out_last = the event state). Returns
+    (status, rows)."""
+    t_stop = ew.stop[0]
+    direction = 1.0 if h > 0.0 else -1.0
+    if t_eval.shape[0] == 0:
+        if not _save_row(kern, rows, t_stop, ew.q, ew.v, p, since, err, out_t, out_q, out_v,
+                         out_stats, extra, out_extra):
+            _stop(out_last, counters, t_stop, ew.q, ew.v, since, err, extra, h)
+            return NON_FINITE, rows
+        rows += 1
+        since = 0.0
+    while j < t_eval.shape[0] and (t_eval[j] - t_stop) * direction <= 0.0:
+        method.interpolate(ws, t_eval[j], ws.q_int, ws.v_int)
+        if not _save_row(kern, rows, t_eval[j], ws.q_int, ws.v_int, p, since, err, out_t,
+                         out_q, out_v, out_stats, extra, out_extra):
+            _stop(out_last, counters, t_eval[j], ws.q_int, ws.v_int, since, err, extra, h)
+            return NON_FINITE, rows
+        rows += 1
+        since = 0.0
+        j += 1
+    _stop(out_last, counters, t_stop, ew.q, ew.v, since, err, extra, h)
+    return OK, rows
+
+
+@njit(inline="always")
+def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, settings, t_eval,
                  out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters):
-    """Integrate from (q0, v0) at t0 to t_end with error control; see the module docstring."""
+    """Integrate from (q0, v0) at t0 to t_end with error control; see the module docstring.
+    n_event_fns: the model's number of event functions, a literal of the glue (0: the event
+    branches are pruned before compiling)."""
     n = q0.shape[0]
     size = out_t.shape[0]
     if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved or size < 2:
@@ -236,13 +272,17 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
     direction = 1.0 if t_end >= t0 else -1.0
     j = points_in(t_eval, 0, t0, direction, t_eval.shape[0])     # skip values <= t0
     t, rows, since, err_last = t0, 1, 0.0, 0.0
+    n_events = 0
+    if n_event_fns > 0:          # (ew exists only on a model with events)
+        ew = events.workspace(kern, n)
+        events.start(kern, ew, q, v, t0, p)
     attempts, rejected, nonfinite_retry = 0, False, False
     while t != t_end:
         if attempts >= settings.max_steps or 0.1 * abs(h) <= abs(t) * UROUND:
             _stop(out_last, counters, t, q, v, since, err_last, extra, h)
             if attempts >= settings.max_steps:
-                return TOO_MANY_STEPS, rows, 0
-            return (NON_FINITE if nonfinite_retry else STEP_TOO_SMALL), rows, 0
+                return TOO_MANY_STEPS, rows, n_events
+            return (NON_FINITE if nonfinite_retry else STEP_TOO_SMALL), rows, n_events
         last = (t + 1.01 * h - t_end) * direction > 0.0
         if last:
             h = t_end - t
@@ -250,7 +290,7 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
             fits, h_room = _room(t_eval, j, t, h, rows, size)
             if not fits:
                 _stop(out_last, counters, t, q, v, since, err_last, extra, h)
-                return OK, rows, 0
+                return OK, rows, n_events
             last = last and h_room == h
             h = h_room
         status, err = method.attempt(kern, q, v, t, h, p, settings, ws)
@@ -258,7 +298,7 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
         counters[3] += method.STAGE_EVALS
         if status != OK:
             _stop(out_last, counters, t, q, v, since, err_last, extra, h)
-            return status, rows, 0
+            return status, rows, n_events
         if not err <= 1.0:
             counters[2] += 1
             nonfinite_retry = not math.isfinite(err)
@@ -272,19 +312,33 @@ def run_adaptive(method, kern, n_saved, q0, v0, t0, t_end, p, settings, t_eval,
             status = check_state(ws.q_new, ws.v_new, settings.blowup_bound)
         if status != OK:
             _stop(out_last, counters, t_new, ws.q_new, ws.v_new, since, err, extra, h)
-            return status, rows, 0
+            return status, rows, n_events
         counters[1] += 1
         since += 1.0
         err_last = err
-        # Event location goes here: method.dense, then method.interpolate on [t, t_new].
+        if n_event_fns > 0:
+            if events.crossed(kern, ew, ws.q_new, ws.v_new, t_new, p):
+                status = method.dense(kern, q, v, t, h, p, ws)
+                counters[3] += method.DENSE_EVALS
+                if status != OK:
+                    _stop(out_last, counters, t, q, v, since, err, extra, h)
+                    return status, rows, n_events
+                n_events, stopped = events.locate(method, ws, kern, ew, p, t, t_new,
+                                                  out_events, n_events)
+                if stopped:
+                    status, rows = _terminal(method, kern, ws, ew, q, v, t, h, err, p, t_eval,
+                                             j, rows, since, extra, out_t, out_q, out_v,
+                                             out_stats, out_extra, out_last, counters)
+                    return status, rows, n_events
+            events.advance(ew)
         status, rows, j, since = _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j,
                                          rows, since, extra, out_t, out_q, out_v, out_stats,
                                          out_extra, out_last, counters)
         if status != OK:
-            return status, rows, 0
+            return status, rows, n_events
         h = next_step(h, err, method.ERROR_EXPONENT, settings.h_max, rejected)
         rejected = False
         method.advance(q, v, ws)
         t = t_new
     _stop(out_last, counters, t, q, v, since, err_last, extra, h)
-    return OK, rows, 0
+    return OK, rows, n_events

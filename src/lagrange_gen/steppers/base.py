@@ -255,13 +255,14 @@ from . import events, hermite  # noqa: E402
 
 
 @njit(inline="always")
-def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, settings,
-             out_t, out_q, out_v, out_stats, out_extra, out_last, out_events):
+def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_every, p,
+             settings, out_t, out_q, out_v, out_stats, out_extra, out_last, out_events):
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
 
     ``method`` is a stepper module (its workspace, prepare and step are called), ``kern`` the
     generated module, ``settings`` the method's settings record (spec.py), n_saved the width
-    of the method's saved fields on this model (the glue passes it as a literal).
+    of the method's saved fields on this model and n_event_fns its number of event functions
+    (N_EVENTS; the glue passes both as literals).
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
@@ -278,9 +279,9 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     later are not saved), out_last = [t of the event, q, v there (interpolated), iterations,
     residual, saved fields after step i]. With events, each step costs a copy of (q, v) (the
     start of the interpolant) and one evaluation of the event functions; the end accelerations
-    and the root refinement only a step where some g changed sign. Without events (N_EVENTS = 0,
-    a constant of the generated module) the branches are dead code that LLVM removes: no work
-    and no allocation (numba still types them, about 2.5 s of compile time once per module).
+    and the root refinement only a step where some g changed sign. Without events the literal
+    n_event_fns = 0 lets numba prune the event branches before typing them: no work, no
+    allocation and no compile time (typing them cost about 2.5 s per module).
     Returns (status, steps_done, n_events): steps_done = n_steps, or the index of the failing
     step on failure (or of the step in which a terminal event stopped the run), -1 when the
     initial state itself is refused (non-finite or past the bound, its energy non-finite, or
@@ -311,7 +312,7 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     if status != OK:
         return status, -1, 0
     _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
-    if kern.N_EVENTS > 0:       # (ew, iw exist only on a model with events)
+    if n_event_fns > 0:       # (ew, iw exist only on a model with events)
         ew = events.workspace(kern, n)
         iw = hermite.workspace(n)
         events.start(kern, ew, q, v, t0, p)
@@ -321,7 +322,7 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
     since = 0
     for i in range(n_steps):
         t = t0 + i * h       # not accumulated: no drift of t over millions of steps
-        if kern.N_EVENTS > 0:
+        if n_event_fns > 0:
             hermite.begin(iw, q, v)
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
         iters_acc += iters
@@ -334,7 +335,7 @@ def run_loop(method, kern, n_saved, q0, v0, t0, h, n_steps, save_every, p, setti
         if status != OK:
             _last(out_last, t_new, q, v, iters_acc, resid, extra)
             return status, i, n_events
-        if kern.N_EVENTS > 0:
+        if n_event_fns > 0:
             if events.crossed(kern, ew, q, v, t_new, p):
                 hermite.fit(kern, iw, t, t_new, q, v, p)
                 n_events, stopped = events.locate(hermite, iw, kern, ew, p, t, t_new,

@@ -113,7 +113,7 @@ def run_{method}({wrapped}):
     """Integrate with {method} ({summary}); returns (status, steps_done, n_events).
 
     Argument shapes: see lagrange_gen.steppers.registry; lagrange_gen.simulate wraps this."""
-    return _{loop}(_stepper_{method}, _THIS_MODULE, {n_saved}, {wrapped_call})'''
+    return _{loop}(_stepper_{method}, _THIS_MODULE, {n_saved}, {n_events}, {wrapped_call})'''
 
 #: The jitted loop each kind of method runs in: (module, function).
 LOOPS = {False: ("base", "run_loop"), True: ("adaptive", "run_adaptive")}
@@ -124,9 +124,11 @@ def glue_args(method: str) -> str:
     return ADAPTIVE_GLUE_ARGS if spec(method).adaptive else GLUE_ARGS
 
 
-def glue_source(method: str, n_saved: int) -> str:
+def glue_source(method: str, n_saved: int, n_events: int) -> str:
     """Source text of ``run_<method>`` to append to a generated module whose model gives the
-    method n_saved saved fields (SPEC.n_saved); deterministic."""
+    method n_saved saved fields (SPEC.n_saved) and has n_events event functions; deterministic.
+    Both are passed to the loop as literals: numba prunes the event branches of a model without
+    events before compiling them (a module constant would only be folded later, by LLVM)."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
     indent = " " * (len(f"def run_{method}("))
@@ -135,4 +137,4 @@ def glue_source(method: str, n_saved: int) -> str:
     wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
                         summary=spec(method).summary, loop_module=loop_module, loop=loop,
-                        n_saved=n_saved)
+                        n_saved=n_saved, n_events=n_events)
