@@ -160,7 +160,7 @@ def test_non_finite_parameter_on_the_command_line_is_named(cart, capsys, value, 
     (dict(blowup_bound=math.nan), r"blowup_bound must be a number > 0 .*got nan"),
     (dict(blowup_bound=-1.0), r"blowup_bound must be a number > 0"),
     (dict(blowup_bound="big"), r"blowup_bound must be a number > 0"),
-    (dict(newton_tol=0.0), r"newton_tol must be a number > 0, got 0.0"),
+    (dict(newton_tol=0.0), r"newton_tol must be a finite number > 0, got 0.0"),
     (dict(newton_always=True), r"method 'midpoint' has no setting 'newton_always'; its "
                                r"settings: newton_tol, max_iter, blowup_bound"),
     (dict(h=None), r"method 'midpoint' has a fixed step: give h"),

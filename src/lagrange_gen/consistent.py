@@ -103,7 +103,7 @@ def check_rank(module, q, p, where="at q0"):
 
 def scaled_violation(phi, J, q):
     """max_i |Phi_i| / max_j |J_ij| relative to max(1, max|q|): the distance to the manifold
-    in the units of the Newton tolerance (see steppers.constrained.phi_small)."""
+    in the units of the Newton tolerance (relative to max(1, |q|), like the steppers')."""
     g = np.abs(J).max(axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         d = np.where(g > 0, np.abs(phi) / np.where(g > 0, g, 1.0), np.where(phi == 0, 0.0, np.inf))
@@ -210,10 +210,13 @@ def check_method(module, method):
         return
     if m and not registry.spec(method).constraints:
         names = "; ".join(constraint_label(module, i) for i in range(m))
-        choices = "; ".join(f"{s.name} (order {s.order}, {s.summary})"
-                            for s in map(registry.spec, registry.CONSTRAINED_METHODS))
+        about = "; ".join(f"{s.name}: order {s.order}, {s.summary}"
+                          for s in map(registry.spec, registry.CONSTRAINED_METHODS))
         raise SimulationError(f"{module.NAME}: method {method!r} ignores the model's constraints "
-                              f"({names}); use a constrained method: {choices}")
+                              f"({names}); use a constrained method: "
+                              f"{', '.join(registry.CONSTRAINED_METHODS)} ({about})")
+    if why.startswith("it "):
+        raise SimulationError(f"{module.NAME}: method {method!r} {why[3:]}")
     raise SimulationError(f"{module.NAME}: method {method!r} does not apply: {why}")
 
 

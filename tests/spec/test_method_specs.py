@@ -75,7 +75,7 @@ def test_settings_are_typed_and_validated():
         make_settings(spec, {"compliance": 1.0})
     with pytest.raises(SimulationError, match="max_iter must be a positive integer, got 2.5"):
         make_settings(spec, {"max_iter": 2.5})
-    with pytest.raises(SimulationError, match="newton_tol must be a number > 0, got -1"):
+    with pytest.raises(SimulationError, match="newton_tol must be a finite number > 0, got -1"):
         make_settings(spec, {"newton_tol": -1})
     with pytest.raises(SimulationError, match="blowup_bound must be a number > 0, got nan"):
         make_settings(spec, {"blowup_bound": math.nan})
@@ -84,9 +84,9 @@ def test_settings_are_typed_and_validated():
 
 def test_constrained_settings_limits():
     spook = registry.spec("spook")
-    with pytest.raises(SimulationError, match="compliance must be a number >= 0"):
+    with pytest.raises(SimulationError, match="compliance must be a finite number >= 0"):
         make_settings(spook, {"compliance": -1.0})
-    with pytest.raises(SimulationError, match="relaxation must be a number > 0"):
+    with pytest.raises(SimulationError, match="relaxation must be a finite number > 0"):
         make_settings(spook, {"relaxation": 0.0})
     index1 = registry.spec("index1")
     assert make_settings(index1, {"baumgarte": [1, 2]}).baumgarte == (1.0, 2.0)

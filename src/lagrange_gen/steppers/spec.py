@@ -179,10 +179,11 @@ def _checked(spec, name, value, default):
 def _describe(limit, integer=False):
     if limit is None:
         return "a finite number"
-    low, inclusive, _ = limit
+    low, inclusive, allow_inf = limit
     if integer:
         return "a positive integer" if (low, inclusive) == (1, True) else f"an integer >= {low:g}"
-    return f"a number {'>=' if inclusive else '>'} {low:g}"
+    bound = f"{'>=' if inclusive else '>'} {low:g}"
+    return f"a number {bound} (math.inf: no bound)" if allow_inf else f"a finite number {bound}"
 
 
 def _check_number(name, x, limit, shown, integer=False):
