@@ -19,13 +19,21 @@ _PACKAGE = Path(__file__).resolve().parent.parent     # src/lagrange_gen
 _KERN = "kern"                                         # the parameter naming the generated module
 
 
-def method_needs(method: str) -> frozenset:
-    """Names ``kern.<name>`` used by ``steppers/<method>.py`` and everything it calls."""
+def method_needs(method: str, with_loop: bool = True) -> frozenset:
+    """Names ``kern.<name>`` used by ``steppers/<method>.py`` and everything it calls, and
+    (with_loop) by the run loop its glue calls (base.run_loop or adaptive.run_adaptive: the
+    energy, events, ...). SPEC.kernels declares the method's own (with_loop=False)."""
     from ..steppers.registry import LOOPS, spec
     module = f"steppers.{method}"
-    loop_module, loop = LOOPS[spec(method).adaptive]
     roots = [(module, name) for name in _parse(module).functions]
-    roots.append((f"steppers.{loop_module}", loop))     # the loop the glue runs the method in
+    if with_loop:
+        loop_module, loop = LOOPS[spec(method).adaptive]
+        roots.append((f"steppers.{loop_module}", loop))
+    return _reached(roots)
+
+
+def _reached(roots) -> frozenset:
+    """kern attributes reached from the (module, function) roots through calls."""
     seen, needs = set(), set()
     while roots:
         key = roots.pop()
