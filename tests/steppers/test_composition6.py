@@ -1,12 +1,24 @@
 """The sixth-order composition of verlet (steppers/composition6.py) over long runs: its energy
-error stays bounded (no drift) and is of its order's size. Its fitted order is in
+error stays bounded (no drift) and is of its order's size; a failing substep of a composition
+restores the state the step started from. Its fitted order is in
 test_stepper_convergence.py, symmetry and symplecticity in test_stepper_geometry.py, its
 stability limit in test_stepper_stability.py."""
+
+import atexit
+import shutil
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from stepper_util import model, params, run  # model is a fixture
+from lagrange_gen.codegen import generate_model
+from lagrange_gen.loader import import_generated
+from lagrange_gen.status import OK
+from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.base import N_STATS
+from lagrange_gen.steppers.spec import make_settings
+from stepper_util import HERE, model, params, run  # model is a fixture
 
 # (model, q0, v0, h, steps, bound on the energy error over the first fifth): the double
 # pendulum runs verlet's Newton path (H depends on q), the pendulum its explicit path; both
@@ -39,3 +51,39 @@ def test_energy_error_falls_as_h_to_the_sixth(model):
     coarse, _ = energy_error_fifths(mod, "composition6", [2.5], [0.0], 0.2, 5_000)
     fine, _ = energy_error_fifths(mod, "composition6", [2.5], [0.0], 0.1, 10_000)
     assert 40 < coarse / fine < 100, (coarse, fine)
+
+
+@pytest.mark.parametrize("method", ["composition", "composition6"])
+def test_a_failing_substep_leaves_the_state_at_the_start_of_the_step(method):
+    """V = c sqrt(x) on verlet's Newton path: from x = 0.8 h moving left at unit speed, a later
+    substep of the composition (composition6: its fifth, at 0.90 h) drives x below 0, where
+    sqrt(x) is NaN. The run reports the failure with the state the step started from (the last
+    saved row), not the one the earlier substeps reached."""
+    mod = generated_model_for(method)
+    h = 0.01
+    n = 1
+    rows = 3
+    out = (np.empty(rows), np.empty((rows, n)), np.empty((rows, n)), np.empty((rows, N_STATS)),
+           np.empty((rows, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
+    settings = make_settings(registry.spec(method), {"newton_always": True})
+    status, done, _ = getattr(mod, f"run_{method}")(
+        np.array([0.8 * h]), np.array([-1.0]), 0.0, h, 2, 1, np.array([1.0, 1e-6]), settings,
+        *out)
+    assert status != OK and done == 0, (status, done)
+    last = out[5]
+    assert last[0] == 0.0
+    assert last[1] == 0.8 * h and last[2] == -1.0, last
+
+
+_FAILING = {}
+
+
+def generated_model_for(method):
+    """The sqrt potential, generated once with the compositions' glue only."""
+    if not _FAILING:
+        out = Path(tempfile.mkdtemp(prefix="lagrange_gen_composition_"))
+        atexit.register(shutil.rmtree, out, True)
+        _FAILING["mod"] = import_generated(generate_model(
+            HERE / "models" / "sqrt_potential.py", out,
+            methods=["composition", "composition6"]).path)
+    return _FAILING["mod"]
