@@ -79,7 +79,7 @@ def test_settings_are_typed_and_validated():
         make_settings(spec, {"max_iter": 2.5})
     with pytest.raises(SimulationError, match="newton_tol must be a finite number > 0, got -1"):
         make_settings(spec, {"newton_tol": -1})
-    with pytest.raises(SimulationError, match="blowup_bound must be a number > 0, got nan"):
+    with pytest.raises(SimulationError, match=r"blowup_bound must be a number > 0 \(math.inf: no bound\), got nan"):
         make_settings(spec, {"blowup_bound": math.nan})
     assert make_settings(spec, {"blowup_bound": math.inf}).blowup_bound == math.inf
 

@@ -16,6 +16,7 @@ import warnings
 import numpy as np
 
 from ..errors import EnergyWarning
+from ..steppers import registry
 from . import runs
 
 OMEGA = 3.0        # not 1, so that h and tau differ and a wrong scaling would show
@@ -52,50 +53,10 @@ def phase_per_step(A):
     return float(np.max(np.abs(np.angle(np.linalg.eigvals(A)))))
 
 
-# Closed forms of HARD_CASES case 3 (Lacoursiere's slides) and of the other methods.
-
-def verlet_radius(tau):
-    """Trace 2 - tau^2, determinant 1: rho = 1 while |1 - tau^2 / 2| <= 1 (tau <= 2)."""
-    half_trace = 1.0 - tau**2 / 2
-    if abs(half_trace) <= 1.0:
-        return 1.0
-    return abs(half_trace) + math.sqrt(half_trace**2 - 1.0)
-
-
-def verlet_matrix(tau):
-    """Step matrix (2, 2) of velocity Verlet on x'' = -omega^2 x, in units where omega = 1."""
-    return np.array([[1 - tau**2 / 2, tau], [-tau * (1 - tau**2 / 4), 1 - tau**2 / 2]])
-
-
-def composition_radius(tau):
-    """Yoshida's triple jump: the product of three Verlet matrices with g1 tau, g2 tau, g1 tau."""
-    g1 = 1 / (2 - 2 ** (1 / 3))
-    g2 = 1 - 2 * g1
-    outer, inner = verlet_matrix(g1 * tau), verlet_matrix(g2 * tau)
-    return spectral_radius(outer @ inner @ outer)
-
-
-def rk4_radius(tau):
-    """|1 + z + z^2/2 + z^3/6 + z^4/24| at z = i tau."""
-    z = 1j * tau
-    return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
-
-
-def midpoint_phase(tau):
-    """Phase per step of the implicit midpoint rule: 2 atan(tau / 2) (its rho is 1)."""
-    return 2 * math.atan(tau / 2)
-
-
-#: rho(tau) of each method's step matrix: method name -> f(tau) -> float.
-CLOSED_FORMS = {
-    "explicit_euler": lambda tau: math.sqrt(1 + tau**2),
-    "symplectic_euler": verlet_radius,          # same trace and determinant as Verlet
-    "verlet": verlet_radius,
-    "midpoint": lambda tau: 1.0,
-    "implicit_euler": lambda tau: 1 / math.sqrt(1 + tau**2),
-    "rk4": rk4_radius,
-    "composition": composition_radius,
-}
+#: rho(tau) of each method's step matrix, method name -> f(tau) -> float: the closed forms the
+#: methods declare (SPEC.rho, in their modules; HARD_CASES case 3 and Lacoursiere's slides).
+CLOSED_FORMS = {m: registry.spec(m).rho for m in registry.METHODS
+                if registry.spec(m).rho is not None}
 
 
 def stability_limit(taus, rho, tol=1e-10):

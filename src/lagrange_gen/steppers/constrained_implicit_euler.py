@@ -138,5 +138,5 @@ SPEC = Spec(
     constraints=True,
     saved=SAVED, constraint_drift="none",
     settings=NewtonSettings,
-    kernels=("constraint_dq", "constraints", "dynamics", "energy", "mass_matrix",
+    kernels=("constraint_dq", "constraints", "dynamics", "mass_matrix",
              "mass_matvec_dq", "rhs_jacobian"))

@@ -358,4 +358,4 @@ SPEC = Spec(
     settings=Settings,
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False)},
-    kernels=("energy", "forward_dynamics"))
+    kernels=("forward_dynamics",))

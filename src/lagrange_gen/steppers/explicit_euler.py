@@ -8,6 +8,7 @@ radius is sqrt(1 + tau^2) > 1 for every h: energy grows geometrically, however s
 One force evaluation (one Cholesky solve) per step.
 """
 
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -48,10 +49,16 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return OK, 0, 0.0
 
 
+def linear_radius(tau):
+    """rho of the step matrix [[1, tau], [-tau, 1]] on x'' = -omega^2 x: sqrt(1 + tau^2)."""
+    return math.sqrt(1.0 + tau * tau)
+
+
 SPEC = Spec(
     name="explicit_euler", order=1, family="explicit", implicit=False, symplectic=False,
     symmetric=False,
     summary="forward Euler (what not to do)",
     stable="unstable for every tau > 0 (rho = sqrt(1 + tau^2))",
+    stable_tau=0.0, rho=linear_radius,
     settings=ExplicitSettings,
-    kernels=("energy", "forward_dynamics"))
+    kernels=("forward_dynamics",))

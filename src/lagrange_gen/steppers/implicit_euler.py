@@ -13,6 +13,7 @@ Newton uses the exact Jacobian
 from ``mass_matvec_dq`` and ``rhs_jacobian``.
 """
 
+import math
 import sys
 from collections import namedtuple
 
@@ -82,10 +83,17 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
 # This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
+def linear_radius(tau):
+    """rho of the step matrix (inverse of [[1, -tau], [tau, 1]]) on x'' = -omega^2 x:
+    1 / sqrt(1 + tau^2) (L-stable: -> 0 as tau -> inf)."""
+    return 1.0 / math.sqrt(1.0 + tau * tau)
+
+
 SPEC = Spec(
     name="implicit_euler", order=1, family="implicit", implicit=True, symplectic=False,
     symmetric=False,
     summary="backward Euler (L-stable)",
     stable="stable for every tau, damping (rho = 1/sqrt(1 + tau^2))",
+    stable_tau=math.inf, rho=linear_radius,
     settings=NewtonSettings,
-    kernels=("dynamics", "energy", "mass_matvec_dq", "rhs_jacobian"))
+    kernels=("dynamics", "mass_matvec_dq", "rhs_jacobian"))

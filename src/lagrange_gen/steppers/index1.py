@@ -144,4 +144,4 @@ SPEC = Spec(
     saved=SAVED, constraint_drift="grows",
     limits={"baumgarte": (0.0, True, False)},
     settings=Index1Settings,
-    kernels=("constraints", "dynamics", "energy"))
+    kernels=("constraints", "dynamics"))

@@ -33,7 +33,7 @@ import types
 from numba import njit
 
 from ..status import NEWTON_DIVERGED, NON_FINITE, OK
-from .base import FAST, max_abs, newton_converged, newton_solve
+from .base import max_abs, newton_converged, newton_solve
 
 
 def problem(name, assemble):

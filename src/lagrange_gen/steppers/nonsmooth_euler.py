@@ -242,4 +242,4 @@ SPEC = Spec(
     summary="implicit Euler with Saint-Venant return map and Moreau-Jean friction",
     elements=True, stands_in_for=("implicit_euler",), saved=(("element_state", "ne"),),
     settings=NewtonSettings,
-    kernels=("dynamics", "elements", "elements_hessian", "energy", "mass_matvec_dq", "rhs_jacobian"))
+    kernels=("dynamics", "elements", "elements_hessian", "mass_matvec_dq", "rhs_jacobian"))

@@ -247,5 +247,5 @@ SPEC = Spec(
     constraints=True,
     saved=SAVED, constraint_drift="none",
     settings=PartitionedSettings,
-    kernels=("constraints", "dynamics", "energy", "mass_matrix", "mass_matvec_dq",
+    kernels=("constraints", "dynamics", "mass_matrix", "mass_matvec_dq",
              "momentum_rate", "momentum_rate_jacobian"))

@@ -13,6 +13,7 @@ x'' = -omega^2 x the stability polynomial is 1 + z + z^2/2 + z^3/6 + z^4/24 at z
 stable for tau <= 2 sqrt(2).
 """
 
+import math
 import sys
 from collections import namedtuple
 
@@ -60,10 +61,17 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
 # This module as a value for rk_step (see base.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
+def linear_radius(tau):
+    """|1 + z + z^2/2 + z^3/6 + z^4/24| at z = i tau (x'' = -omega^2 x)."""
+    z = 1j * tau
+    return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+
 SPEC = Spec(
     name="rk4", order=4, family="explicit", implicit=False, symplectic=False,
     symmetric=False,
     summary="classical Runge-Kutta 4",
     stable="stable for tau <= 2.83 (2 sqrt(2))",
+    stable_tau=2.0 * math.sqrt(2.0), rho=linear_radius,
     settings=ExplicitSettings,
-    kernels=("energy", "forward_dynamics"))
+    kernels=("forward_dynamics",))

@@ -117,4 +117,4 @@ SPEC = Spec(
     saved=SAVED, constraint_drift="bounded",
     limits={"compliance": (0.0, True, False), "relaxation": (0.0, False, False)},
     settings=SpookSettings,
-    kernels=("constraints", "dynamics", "energy"))
+    kernels=("constraints", "dynamics"))
