@@ -21,10 +21,10 @@ The rules every method module (``steppers/<method>.py``) follows:
   between steps (the momentum ``mom = H(q) v``, a cached acceleration in its workspace);
   ``step`` advances (q, v, mom) from t to t + h in place. On failure ``step`` leaves q, v and
   mom at the start of the step, so the driver reports the state it could not step from.
-* ``run(kern, q0, v0, t0, h, n_steps, save_every, p, settings, out_t, out_q, out_v, out_stats,
-  out_extra, out_last)`` is ``run_loop`` over the module's workspace, prepare and step; the
-  generated glue ``run_<method>`` calls it (see registry.py for why the glue exists).
-* No allocation per step: work arrays are allocated once per ``run`` and passed to ``step``.
+* No ``run`` function: the generated glue ``run_<method>`` calls ``run_loop`` with the method's
+  module (see registry.py for why the glue exists); adaptive methods have their own loop
+  (adaptive.py) and their own set of functions (see there).
+* No allocation per step: the workspace is allocated once per run and passed to ``step``.
 * Failures are status codes (lagrange_gen.status), never garbage and never exceptions.
 
 How the kernels reach the cores: ``kern`` is the generated module itself. numba types a module
@@ -33,9 +33,9 @@ call and ``kern.MASS_IS_CONSTANT`` a constant; likewise ``run_loop`` receives th
 and calls ``method.step``. Passing the dispatchers themselves as values would make numba embed
 process-specific addresses ("dynamic globals") and refuse to cache the glue. None of the
 functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
-generated module's glue. The two thin layers ``run`` and ``run_loop`` are ``inline="always"``
-(inlined at numba-IR level into the glue): every separately compiled layer re-optimizes
-everything below it, about 0.5 s of compile time per layer, per method and per model.
+generated module's glue. ``run_loop`` is ``inline="always"`` (inlined at numba-IR level into
+the glue): every separately compiled layer re-optimizes everything below it, about 0.5 s of
+compile time per layer, per method and per model.
 
 Speed: everything called once or more per step is compiled with ``_nrt=False`` (numba's switch
 for "no reference counting"; none of these functions allocates). With reference counting on,
@@ -62,17 +62,6 @@ from ..status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
 #: failed_solve_status) instead of raising ZeroDivisionError from inside the jitted loop, and
 #: numba drops its zero-divisor checks on every division.
 FAST = dict(_nrt=False, error_model="numpy")
-
-# TRANSITIONAL (removed once every method reads its settings record and workspace by name).
-S_TOL, S_MAX_ITER, S_BOUND, S_MODE, N_SETTINGS = 0, 1, 2, 3, 4
-N_WORK, N_MAT, W_ACC = 12, 6, 11
-W_SAVE_Q, W_SAVE_V, W_SAVE_MOM = 8, 9, 10
-
-
-def make_settings(newton_tol=1e-12, max_iter=50, bound=1e150, mode=0):
-    """TRANSITIONAL: the old float64 settings array."""
-    return np.array([newton_tol, max_iter, bound, mode], dtype=np.float64)
-
 
 # Columns of ``out_stats`` (n_saves, N_STATS), one row per saved state.
 STAT_ENERGY = 0     # E = T + V at the saved state
