@@ -120,5 +120,5 @@ SPEC = Spec(
     summary="Yoshida 4th-order triple jump of verlet",
     stable="stable for tau < 1.57", stable_tau=1.5734, rho=partial(linear_radius, COEFFS),
     settings=PartitionedSettings,
-    kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate",
-             "momentum_rate_jacobian"))
+    kernels=("forward_dynamics", "mass_matrix", "mass_matvec_dq",
+             "momentum_rate", "momentum_rate_jacobian"))

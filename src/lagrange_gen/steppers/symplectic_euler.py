@@ -87,5 +87,4 @@ SPEC = Spec(
     # Step matrix [[1 - tau^2, tau], [-tau, 1]]: verlet's trace and determinant, so its rho.
     stable="stable for tau < 2", stable_tau=2.0, rho=verlet.linear_radius,
     settings=PartitionedSettings,
-    kernels=("energy", "forward_dynamics", "mass_matrix", "momentum_rate",
-             "momentum_rate_jacobian"))
+    kernels=("forward_dynamics", "mass_matrix", "momentum_rate", "momentum_rate_jacobian"))

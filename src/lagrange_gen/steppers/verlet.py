@@ -138,5 +138,5 @@ SPEC = Spec(
     summary="velocity Verlet / generalized leapfrog",
     stable="stable for tau < 2", stable_tau=2.0, rho=linear_radius,
     settings=PartitionedSettings,
-    kernels=("energy", "forward_dynamics", "mass_matrix", "mass_matvec_dq", "momentum_rate",
-             "momentum_rate_jacobian"))
+    kernels=("forward_dynamics", "mass_matrix", "mass_matvec_dq",
+             "momentum_rate", "momentum_rate_jacobian"))
