@@ -80,7 +80,8 @@ def test_singular_mass_matrix_is_an_error_not_nan(model):
     (dict(h=math.nan), "h must be a finite number"),
     (dict(t_end=-1.0), "t_end = -1.0 is before t0"),
     (dict(save_every=0), "save_every must be a positive integer"),
-    (dict(max_iter=0), "max_iter must be a positive integer"),
+    (dict(method="implicit_euler", max_iter=0), "max_iter must be a positive integer"),
+    (dict(max_iter=3), "method 'rk4' has no setting 'max_iter'"),
     (dict(params={"nope": 1.0}), "unknown parameter 'nope'"),
     (dict(method="leapfrog"), "unknown method 'leapfrog'"),
 ])
