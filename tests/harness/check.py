@@ -45,6 +45,7 @@ CONTRACT = {
     "constraint_dq": (("q", "w", "lam", "p"), (("dJw", "mn"), ("dJTlam", "nn")), ("dJw_dq", "dJTlam_dq")),
     "elements": (("q", "p"), (("s", "e"), ("G", "en"), ("coef", "e3")), ("s", "G", "coef")),
     "elements_hessian": (("q", "we", "p"), (("out_mat", "nn"),), ("hess_w",)),
+    "events": (_QQTP, (("out", "g"),), ("events",)),
 }
 
 
@@ -115,8 +116,9 @@ def compare(label, got, expected, rtol=RTOL, floor=FLOOR):
     return f"{label}{[int(i) for i in worst]}: got {float(got[worst])!r}, expected {float(expected[worst])!r}"
 
 
-def _shape(key, n, m, ne):
-    return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n), "e3": (ne, 3)}[key]
+def _shape(key, n, m, ne, ng=0):
+    return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n),
+            "e3": (ne, 3), "g": (ng,)}[key]
 
 
 def call_kernel(kern, name, state, sizes):
@@ -152,7 +154,7 @@ def _check_kernel(mod, kern, name, ref, state, mode):
     actual = list(inspect.signature(getattr(mod, name).py_func).parameters)
     if actual != documented:
         return [f"{name}: arguments {actual}, documented {documented}"]
-    values = call_kernel(kern, name, state, (ref.n, ref.m, ref.ne))
+    values = call_kernel(kern, name, state, (ref.n, ref.m, ref.ne, len(ref.drawn.events)))
     # counted for coverage only where it computes something: constraint and element kernels
     # of a model without constraints or elements fill empty or zero arrays
     if all(np.size(v) for v in values.values()) and (ref.m or "lam" not in inputs) and (ref.ne or "we" not in inputs):

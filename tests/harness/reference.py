@@ -23,7 +23,7 @@ from lagrange_gen import t
 _MODULES = [{"DiracDelta": lambda *args: 0.0}, "numpy"]
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
-VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "gamma", "s"}
+VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "gamma", "s", "events"}
 
 
 def _vector(exprs):
@@ -99,6 +99,9 @@ class Reference:
 
     def _dHw_dq(self):
         return (self.expr("H") * self.w).jacobian(self.q)
+
+    def _events(self):
+        return _vector(self.drawn.events) if self.drawn.events else sp.zeros(0, 1)
 
     def _Phi(self):
         return _vector(self.drawn.constraints)

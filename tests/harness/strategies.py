@@ -86,6 +86,7 @@ class DrawnModel:
     dissipation: sp.Expr = sp.S.Zero
     constraints: list = field(default_factory=list)
     elements: list = field(default_factory=list)
+    events: list = field(default_factory=list)
 
     @property
     def defaults(self):
@@ -102,7 +103,8 @@ class DrawnModel:
             else:
                 elements.append(DryFriction(rate_of=strain, bound=coef))
         return Model(self.name, coords=self.coords, T=self.T, V=self.V, forces=forces,
-                     dissipation=self.dissipation, constraints=self.constraints, elements=elements)
+                     dissipation=self.dissipation, constraints=self.constraints, elements=elements,
+                     events={f"g{i}": g for i, g in enumerate(self.events)})
 
 
 def sample_state(drawn, rng):
@@ -210,6 +212,20 @@ def _rayleigh(g):
     return D
 
 
+def _events(g):
+    """1-2 event functions g(q, qd, t) from the grammar: a term minus a constant, possibly times
+    a speed or a time factor (every drawn model has some: kepler() and the event tests cover
+    models without)."""
+    out = []
+    speeds = [c.d for c in g.coords]
+    for _ in range(g.draw(st.integers(1, 2))):
+        e = g.term() - g.pick(COEFFS)
+        if g.draw(st.booleans()):
+            e *= g.speed_time(g.pick(speeds))
+        out.append(e)
+    return out
+
+
 def _elements(g):
     """One or two SaintVenant / DryFriction elements on strains s(q) from the grammar."""
     out = []
@@ -234,13 +250,15 @@ def models(draw, constant_mass=False, constrained=False, elements=False):
     if draw(st.integers(0, 3)) == 0:
         V += g.term() * g.pick(TIME)(g.pick(g.params))
     forces, point_forces = _forces(g)
+    events = _events(g)
     constraints = []
     if constrained:
         constraints = [g.sum(1, 2) - g.pick(COEFFS) for _ in range(draw(st.integers(1, len(coords) - 1)))]
     return DrawnModel(
         name=f"harness_{tag}", coords=coords, radial=radial, params=params,
         T=_kinetic(g, constant_mass), V=V, forces=forces, point_forces=point_forces,
-        dissipation=_rayleigh(g), constraints=constraints, elements=_elements(g) if elements else [])
+        dissipation=_rayleigh(g), constraints=constraints, elements=_elements(g) if elements else [],
+        events=events)
 
 
 def kepler():
