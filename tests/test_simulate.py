@@ -45,7 +45,8 @@ def test_t_end_not_a_multiple_of_h_is_rounded_up_to_a_whole_step(cart):
 def test_chunked_run_equals_one_call(cart, monkeypatch):
     whole = {m: simulate(cart, m, Q0, V0, t_end=1.0, h=0.01, save_every=3)
              for m in ("rk4", "midpoint")}
-    monkeypatch.setattr(simulate_module, "CHUNK_STEPS", 9)
+    import lagrange_gen.fixed_run as fixed_run      # where the chunk size lives
+    monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 9)
     for method, ref in whole.items():
         chunked = simulate(cart, method, Q0, V0, t_end=1.0, h=0.01, save_every=3)
         np.testing.assert_allclose(chunked.q, ref.q, rtol=0, atol=1e-13)

@@ -60,8 +60,6 @@ def load_module(module_or_path, out_dir="generated", method=None, force=False):
 
 
 def _runner(module, method):
-    if method not in registry.METHODS:
-        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     run = getattr(module, f"run_{method}", None)
     if run is None:
         have = ", ".join(getattr(module, "METHODS", ())) or "none"
@@ -130,6 +128,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     energy_check.ENERGY_FRACTION of its energy scale warns (EnergyWarning, the line also in
     Trajectory.warnings).
     """
+    if method not in registry.METHODS:
+        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     module = load_module(module_or_path, out_dir, method, force)
     method = _element_method(module, method)
     from .consistent import check_method

@@ -40,11 +40,11 @@ ELL = PARAMS["m"] * math.sqrt(PARAMS["k"] * RADIUS)
 
 # Steps per period, per order, in the asymptotic range (rk4's trajectory slope is 4.3 from 50 to
 # 100 steps) and above roundoff for composition's order-8 energy error (2e-13 at 256 steps).
-STEPS = {1: (800, 1600, 3200), 2: (100, 200, 400), 4: (64, 128, 256)}
+STEPS = {1: (800, 1600, 3200), 2: (100, 200, 400), 4: (64, 128, 256), 6: (32, 64, 128)}
 SAVES_PER_PERIOD = 32
 # Methods with an explicit path on constant H and velocity-free forces, which
 # simulate(newton_always=True) replaces by their Newton path: both paths are checked.
-EXPLICIT_PATH_METHODS = ("symplectic_euler", "verlet", "composition")
+EXPLICIT_PATH_METHODS = ("symplectic_euler", "verlet", "composition", "composition6")
 CASES = [(m, False) for m in UNCONSTRAINED_METHODS]
 CASES += [(m, True) for m in UNCONSTRAINED_METHODS if m in EXPLICIT_PATH_METHODS]
 

@@ -99,7 +99,7 @@ def test_steady_precession_rate_cancels_the_theta_acceleration(top):
 
 # Nutation: one second is about 1.2 nutation periods (w = sqrt(a^2 - 2 beta u0) = 7.4 rad/s).
 NUTATION_T = 1.0
-STEPS = {1: (800, 1600, 3200), 2: (200, 400, 800), 4: (100, 200, 400)}
+STEPS = {1: (800, 1600, 3200), 2: (200, 400, 800), 4: (100, 200, 400), 6: (50, 100, 200)}
 
 
 def lowest_point():

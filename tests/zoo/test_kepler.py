@@ -34,7 +34,7 @@ PERIOD = 2 * math.pi * A**1.5 / math.sqrt(PARAMS["k"])
 
 # Steps per period, per order: in the asymptotic range of every method of that order (the return
 # error of implicit Euler is still pre-asymptotic at 3200 steps, e = 0.6: slope 1.6 to 6400).
-STEPS = {1: (6400, 12800, 25600), 2: (400, 800, 1600), 4: (200, 400, 800)}
+STEPS = {1: (6400, 12800, 25600), 2: (400, 800, 1600), 4: (200, 400, 800), 6: (100, 200, 400)}
 SAVES_PER_PERIOD = 100
 
 
@@ -109,7 +109,7 @@ def test_one_period_errors_have_the_method_order(kepler, method):
 
 
 PERIODS_LONG = 10
-STEPS_LONG = {1: 3200, 2: 400, 4: 200}
+STEPS_LONG = {1: 3200, 2: 400, 4: 200, 6: 100}
 # The per-period mean of E - E0 changes over the run by at most this fraction of its first
 # period's swing (max - min) for a symplectic method, and by at least DRIFTING for the others.
 # A symplectic method keeps a modified energy to exponentially small terms, so its mean moves only
