@@ -96,6 +96,56 @@ def lu_inplace(A, piv):
 
 
 @njit(cache=True, _nrt=False)
+def lu_solve_system(A, piv, b):
+    """Solve A x = b by Gaussian elimination with partial pivoting, in one pass: the row swaps
+    and eliminations are applied to b as they are made (no separate forward substitution), then
+    back substitution; A (n, n) is left holding its LU factors and piv (n,) int64 the
+    permutation (as lu_inplace), b (n,) is overwritten by x. Returns False, like lu_inplace,
+    when a pivot is zero relative to the largest entry (A's scale not finite included)."""
+    n = A.shape[0]
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale = max(scale, abs(A[i, j]))
+    if not (scale > 0.0) or not math.isfinite(scale):
+        return False
+    for i in range(n):
+        piv[i] = i
+    for k in range(n):
+        p = k
+        big = abs(A[k, k])
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > big:
+                big = abs(A[i, k])
+                p = i
+        if not (big > SINGULAR_RTOL * scale):
+            return False
+        if p != k:
+            for j in range(n):
+                tmp = A[k, j]
+                A[k, j] = A[p, j]
+                A[p, j] = tmp
+            tmp = b[k]
+            b[k] = b[p]
+            b[p] = tmp
+            tmpi = piv[k]
+            piv[k] = piv[p]
+            piv[p] = tmpi
+        for i in range(k + 1, n):
+            A[i, k] /= A[k, k]
+            f = A[i, k]
+            for j in range(k + 1, n):
+                A[i, j] -= f * A[k, j]
+            b[i] -= f * b[k]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for k in range(i + 1, n):
+            s -= A[i, k] * b[k]
+        b[i] = s / A[i, i]
+    return True
+
+
+@njit(cache=True, _nrt=False)
 def lu_solve_inplace(LU, piv, b, work):
     """Solve A x = b from lu_inplace's output; b (n,) is overwritten by x, work (n,) is scratch."""
     n = LU.shape[0]

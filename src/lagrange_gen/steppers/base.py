@@ -127,7 +127,7 @@ def copy_into(dst, src):
         dst[i] = src[i]
 
 
-@njit(cache=True, **FAST)
+@njit(**FAST)
 def matvec(A, x, out):
     """out = A x for A (n, n), x (n,)."""
     n = x.shape[0]
@@ -141,8 +141,7 @@ def matvec(A, x, out):
 # lagrange_gen.linalg is compiled without reference counting too: plain calls.
 _cholesky = linalg.cholesky_inplace
 _cholesky_solve = linalg.cholesky_solve_inplace
-_lu = linalg.lu_inplace
-_lu_solve = linalg.lu_solve_inplace
+_lu_solve_system = linalg.lu_solve_system
 
 
 @njit(**FAST)
@@ -169,11 +168,12 @@ def failed_solve_status(A):
 
 @njit(**FAST)
 def newton_solve(A, piv, b, scratch):
-    """Overwrite b by A^-1 b for a Newton matrix A (general, factored in place by LU).
-    Returns OK, SINGULAR_NEWTON, or NON_FINITE (see failed_solve_status)."""
-    if not _lu(A, piv):
+    """Overwrite b by A^-1 b for a Newton matrix A (general: Gaussian elimination with partial
+    pivoting applied to b as it goes, A left holding its LU factors). Returns OK,
+    SINGULAR_NEWTON, or NON_FINITE (see failed_solve_status). scratch (n,) is not needed by
+    the one-pass elimination; it stays in the signature of the Newton loop's solve."""
+    if not _lu_solve_system(A, piv, b):
         return failed_solve_status(A)
-    _lu_solve(A, piv, b, scratch)
     return OK
 
 
