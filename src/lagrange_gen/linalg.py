@@ -58,10 +58,13 @@ def cholesky_solve_inplace(L, b):
 
 
 @njit(cache=True, _nrt=False)
-def lu_inplace(A, piv):
-    """LU factorization with partial pivoting of A (n, n) in place; piv (n,) int64 receives the
-    row permutation. Returns False when a pivot is zero relative to the largest entry."""
+def _eliminate(A, piv, b):
+    """Gaussian elimination with partial pivoting of A (n, n) in place, leaving its LU factors
+    and the row permutation in piv (n,) int64; the swaps and eliminations are applied to b as
+    they are made when b has n entries (an empty b: factor only). Returns False when a pivot is
+    zero relative to the largest entry (A's scale not finite included)."""
     n = A.shape[0]
+    with_b = b.shape[0] == n
     scale = 0.0
     for i in range(n):
         for j in range(n):
@@ -84,6 +87,10 @@ def lu_inplace(A, piv):
                 tmp = A[k, j]
                 A[k, j] = A[p, j]
                 A[p, j] = tmp
+            if with_b:
+                tmp = b[k]
+                b[k] = b[p]
+                b[p] = tmp
             tmpi = piv[k]
             piv[k] = piv[p]
             piv[p] = tmpi
@@ -92,51 +99,28 @@ def lu_inplace(A, piv):
             f = A[i, k]
             for j in range(k + 1, n):
                 A[i, j] -= f * A[k, j]
+            if with_b:
+                b[i] -= f * b[k]
     return True
 
 
 @njit(cache=True, _nrt=False)
+def lu_inplace(A, piv):
+    """LU factorization with partial pivoting of A (n, n) in place; piv (n,) int64 receives the
+    row permutation (solve with lu_solve_inplace). Returns False when a pivot is zero relative
+    to the largest entry."""
+    return _eliminate(A, piv, A[0, :0])
+
+
+@njit(cache=True, _nrt=False)
 def lu_solve_system(A, piv, b):
-    """Solve A x = b by Gaussian elimination with partial pivoting, in one pass: the row swaps
-    and eliminations are applied to b as they are made (no separate forward substitution), then
-    back substitution; A (n, n) is left holding its LU factors and piv (n,) int64 the
-    permutation (as lu_inplace), b (n,) is overwritten by x. Returns False, like lu_inplace,
-    when a pivot is zero relative to the largest entry (A's scale not finite included)."""
-    n = A.shape[0]
-    scale = 0.0
-    for i in range(n):
-        for j in range(n):
-            scale = max(scale, abs(A[i, j]))
-    if not (scale > 0.0) or not math.isfinite(scale):
+    """Solve A x = b in one pass: elimination with the right-hand side carried along (no
+    separate forward substitution), then back substitution; A (n, n) is left holding its LU
+    factors and piv (n,) the permutation (as lu_inplace), b (n,) is overwritten by x. Returns
+    False, like lu_inplace, when a pivot is zero relative to the largest entry."""
+    if not _eliminate(A, piv, b):
         return False
-    for i in range(n):
-        piv[i] = i
-    for k in range(n):
-        p = k
-        big = abs(A[k, k])
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > big:
-                big = abs(A[i, k])
-                p = i
-        if not (big > SINGULAR_RTOL * scale):
-            return False
-        if p != k:
-            for j in range(n):
-                tmp = A[k, j]
-                A[k, j] = A[p, j]
-                A[p, j] = tmp
-            tmp = b[k]
-            b[k] = b[p]
-            b[p] = tmp
-            tmpi = piv[k]
-            piv[k] = piv[p]
-            piv[p] = tmpi
-        for i in range(k + 1, n):
-            A[i, k] /= A[k, k]
-            f = A[i, k]
-            for j in range(k + 1, n):
-                A[i, j] -= f * A[k, j]
-            b[i] -= f * b[k]
+    n = A.shape[0]
     for i in range(n - 1, -1, -1):
         s = b[i]
         for k in range(i + 1, n):

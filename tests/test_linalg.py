@@ -1,0 +1,45 @@
+"""lagrange_gen.linalg, the factorizations every stepper's solves go through, against numpy and
+by their defining identities (P A = L U, L L^T = A), including the singular and non-finite
+matrices the steppers must report instead of dividing by."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lagrange_gen import linalg
+
+
+def _matrices(seed=0):
+    rng = np.random.default_rng(seed)
+    for n in (1, 2, 3, 5, 8, 13):
+        yield rng.normal(size=(n, n)), rng.normal(size=n)
+    # a row swap needed at the first column, and an ill-scaled but regular matrix
+    yield np.array([[0.0, 1.0, 2.0], [3.0, 4.0, 5.0], [6.0, 7.0, 9.0]]), np.array([1.0, 2.0, 3.0])
+    yield np.diag([1e-8, 1.0, 1e8]) + 0.1, np.array([1.0, -1.0, 2.0])
+
+
+@pytest.mark.parametrize("A, b", list(_matrices()))
+def test_one_pass_solve_equals_factor_then_substitute_and_numpy(A, b):
+    n = len(b)
+    x = np.linalg.solve(A, b)
+    A1, b1, piv1 = A.copy(), b.copy(), np.zeros(n, np.int64)
+    assert linalg.lu_solve_system(A1, piv1, b1)
+    A2, b2, piv2 = A.copy(), b.copy(), np.zeros(n, np.int64)
+    assert linalg.lu_inplace(A2, piv2)
+    linalg.lu_solve_inplace(A2, piv2, b2, np.zeros(n))
+    cond = np.linalg.cond(A)
+    assert np.abs(b1 - x).max() <= 1e-14 * cond * max(1.0, np.abs(x).max())
+    np.testing.assert_array_equal(A1, A2)          # the same factors ...
+    np.testing.assert_array_equal(piv1, piv2)      # ... and permutation
+    L, U = np.tril(A1, -1) + np.eye(n), np.triu(A1)
+    np.testing.assert_allclose(L @ U, A[piv1], rtol=1e-13, atol=1e-13 * np.abs(A).max())
+
+
+@pytest.mark.parametrize("A", [np.zeros((2, 2)), np.array([[1.0, 2.0], [2.0, 4.0]]),
+                               np.array([[1.0, math.nan], [0.0, 1.0]]),
+                               np.array([[math.inf, 0.0], [0.0, 1.0]])])
+def test_singular_or_non_finite_matrices_are_refused(A):
+    piv = np.zeros(2, np.int64)
+    assert not linalg.lu_solve_system(A.copy(), piv, np.ones(2))
+    assert not linalg.lu_inplace(A.copy(), piv)
