@@ -124,9 +124,11 @@ def test_structural_zeros_are_written_not_computed(generated, derived):
     mod, dyn = generated("spring_mass_chain"), derived("spring_mass_chain")
     n = dyn.n
     zero = [i * n + j for i in range(n) for j in range(n) if dyn.H[i, j] == 0]
-    assert zero and list(mod._ZEROS_MASS_MATRIX_H) == zero
     source = inspect.getsource(mod.mass_matrix.py_func)
-    assert not any(f"H_f[{k}] =" in source for k in zero)
+    # n = 4: a small output, stored as H[i, j] (codegen.emit.FLAT_VIEW_MIN): each zero entry is
+    # stored once, as the constant, and never computed
+    assert zero and all(source.count(f"H[{k // n}, {k % n}]") == 1 and
+                        f"H[{k // n}, {k % n}] = 0.0" in source for k in zero)
     H = np.full((n, n), np.nan)                        # whatever the caller's array held
     mod.mass_matrix(np.zeros(n), mod.DEFAULT_PARAMS, H)
     assert np.all(H.ravel()[zero] == 0.0) and np.all(np.isfinite(H))
@@ -172,3 +174,23 @@ def test_needs_follow_newton_assemblies_bound_at_module_level():
     assert newton | {"mass_matvec_dq"} <= method_needs("verlet")  # and the drift's
     assert newton | {"mass_matvec_dq"} <= method_needs("composition")
     assert newton <= method_needs("symplectic_euler")
+
+
+def test_large_outputs_go_through_the_flat_view_with_a_zero_loop(tmp_path):
+    """A 5 x 5 diagonal H (25 entries > FLAT_VIEW_MIN): stored through H_f, its 20 structural
+    zeros by a loop over a module constant of flat indices (codegen.emit)."""
+    model = tmp_path / "five_masses.py"
+    model.write_text(
+        "from lagrange_gen import Model, coordinates, parameters\n"
+        "xs = coordinates('x0 x1 x2 x3 x4')\n"
+        "k = parameters('k', defaults=(2.0,))\n"
+        "T = sum((i + 1) * x.d**2 / 2 for i, x in enumerate(xs))\n"
+        "V = sum(k * (a - b)**2 / 2 for a, b in zip(xs, xs[1:])) + k * xs[0]**2 / 2\n"
+        "model = Model('five_masses', coords=list(xs), T=T, V=V)\n")
+    mod = import_generated(generate_model(model, tmp_path / "out", methods=["rk4"]).path)
+    zero = [i * 5 + j for i in range(5) for j in range(5) if i != j]
+    assert list(mod._ZEROS_MASS_MATRIX_H) == zero
+    assert "H_f = H.reshape(25)" in inspect.getsource(mod.mass_matrix.py_func)
+    H = np.full((5, 5), np.nan)
+    mod.mass_matrix(np.zeros(5), mod.DEFAULT_PARAMS, H)
+    np.testing.assert_array_equal(H, np.diag([1.0, 2.0, 3.0, 4.0, 5.0]))

@@ -7,9 +7,14 @@ pendulum (dynamics kernel, 850 lines: 17.4 s to compile as first emitted, 4.9 s 
   LLVM cannot prove that the output arrays do not alias the inputs, so an expression reading
   ``q[3]`` after a store must reload it, and memory-dependence analysis over hundreds of
   interleaved loads and stores was most of LLVM's time (9.9 s -> 1.6 s).
-* 2-D outputs are written through a flat view (``H_f = H.reshape(n * n)``): one store per entry
-  instead of numba's 2-D index arithmetic (LLVM 1.6 s -> 0.7 s). Outputs must therefore be
-  C-contiguous, which every caller in the package passes.
+* Large 2-D outputs (more than FLAT_VIEW_MIN entries) are written through a flat view
+  (``H_f = H.reshape(n * n)``): one store per entry instead of numba's 2-D index arithmetic
+  (LLVM 1.6 s -> 0.7 s). Outputs must therefore be C-contiguous, which every caller in the
+  package passes. Small ones are written as ``H[i, j]``: the reshape is a run-time call
+  (numba_attempt_nocopy_reshape) on every kernel call, about 7 ns each, which on the cart
+  pendulum was a third of symplectic Euler's step (271 -> 191 ns with direct stores). At
+  n = 8 the direct stores gained nothing at run time and cost 10 % more compile time (kernels
+  4.9 -> 5.4 s), hence the threshold (n <= 4 direct).
 * Structurally zero entries (zero for every state, decided symbolically) are not computed: a
   few are stored as ``0.0``; more are written by a loop over a module constant of flat indices.
 * Symmetric outputs compute the upper triangle and store each value to both places.
@@ -25,6 +30,8 @@ from .spec import KernelSpec
 
 #: More structural zeros than this in one output are written by a loop, fewer as statements.
 ZERO_LOOP_MIN = 8
+#: 2-D outputs with more entries than this are written through a flat view (module docstring).
+FLAT_VIEW_MIN = 16
 
 
 @dataclass
@@ -66,6 +73,12 @@ def _flat_name(out):
     return out.name if out.is_vector else f"{out.name}_f"
 
 
+def _through_view(out):
+    """A 2-D output written through its flat view (large), rather than as out[i, j]."""
+    rows, cols = out.matrix.shape
+    return not out.is_vector and rows * cols > FLAT_VIEW_MIN
+
+
 def _flat(entry):
     """Flat indices an entry is stored at (two for an off-diagonal symmetric entry)."""
     out, i, j = entry.out, entry.i, entry.j
@@ -74,8 +87,13 @@ def _flat(entry):
 
 
 def _targets(entry):
-    """Store targets of an entry: rhs[3] for a vector, H_f[7] (flat view) for a matrix."""
-    return [f"{_flat_name(entry.out)}[{k}]" for k in _flat(entry)]
+    """Store targets of an entry: rhs[3] for a vector, H[1, 2] for a small matrix, H_f[7]
+    (flat view) for a large one; two for an off-diagonal symmetric entry."""
+    out = entry.out
+    if out.is_vector or _through_view(out):
+        return [f"{_flat_name(out)}[{k}]" for k in _flat(entry)]
+    cols = out.matrix.shape[1]
+    return [f"{out.name}[{k // cols}, {k % cols}]" for k in _flat(entry)]
 
 
 def _zero_lines(spec, zeros):
@@ -86,7 +104,10 @@ def _zero_lines(spec, zeros):
         if not index:
             continue
         size = out.matrix.shape[0] * out.matrix.shape[1]
-        if len(index) < ZERO_LOOP_MIN:
+        if not out.is_vector and not _through_view(out):
+            cols = out.matrix.shape[1]
+            lines += [f"    {out.name}[{k // cols}, {k % cols}] = 0.0" for k in index]
+        elif len(index) < ZERO_LOOP_MIN:
             lines += [f"    {_flat_name(out)}[{k}] = 0.0" for k in index]
         elif len(index) == size:
             lines += [f"    for k in range({size}):", f"        {_flat_name(out)}[k] = 0.0"]
@@ -130,7 +151,7 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
         used |= {s.name for s in expr.free_symbols}
     zero_lines, constants = _zero_lines(spec, zeros)
     views = [f"    {o.name}_f = {o.name}.reshape({o.matrix.shape[0] * o.matrix.shape[1]})"
-             for o in spec.outputs if not o.is_vector and o.matrix.shape[0] * o.matrix.shape[1]]
+             for o in spec.outputs if _through_view(o)]
     args = ", ".join(spec.signature)
     lines = ['@njit(cache=True, _nrt=False, error_model="numpy")', f"def {spec.name}({args}):",
              f'    """{_doc(spec, zeros, entries)}"""']
