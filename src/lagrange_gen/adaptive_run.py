@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from . import status as st
+from .compile_notice import first_use_notice
 from .failures import raise_for_status
 from .fixed_run import EVENT_ROWS, ProgressBar
 from .steppers.base import N_STATS
@@ -86,11 +87,12 @@ def _stopped(module, events, n_events, t):
 
 def _warm_up(task, q, v, initial, last, events):
     """Compile (or load from numba's cache) the glue with a call that stops at t0 (the glue
-    needs two rows at least)."""
+    needs two rows at least); a call longer than a second prints a notice (compile_notice)."""
     n = q.shape[0]
     start = time.perf_counter()
     extra = np.vstack((initial, initial))
-    task.run(q, v, task.t0, task.t0, task.p, task.settings, np.zeros(0), np.empty(2),
-             np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra, last, events,
-             np.zeros(4))
+    with first_use_notice(f"run_{task.method} for {task.module.NAME}"):
+        task.run(q, v, task.t0, task.t0, task.p, task.settings, np.zeros(0), np.empty(2),
+                 np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra, last,
+                 events, np.zeros(4))
     return time.perf_counter() - start

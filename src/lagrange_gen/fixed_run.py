@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from . import status as st
+from .compile_notice import first_use_notice
 from .failures import raise_for_status
 from .steppers.base import N_STATS, STAT_ITERS
 
@@ -56,7 +57,8 @@ def integrate_fixed(task, q, v, out, progress):
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     last = np.empty(2 * n + 3 + out["extra"].shape[1])
     compile_time = warm_up(task.run, q, v, t0, h, task.p, task.settings,
-                           out["extra"][:1].copy(), last.copy(), out["events"][:0])
+                           out["extra"][:1].copy(), last.copy(), out["events"][:0],
+                           label=f"run_{task.method} for {m.NAME}")
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
@@ -96,14 +98,16 @@ def integrate_fixed(task, q, v, out, progress):
     return compile_time, wall
 
 
-def warm_up(run, q, v, t0, h, p, settings, extra, last, events):
+def warm_up(run, q, v, t0, h, p, settings, extra, last, events, label="run"):
     """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
     measured wall time is integration only. extra (1, n_saved) and last are scratch copies with
-    the method's sizes. Returns the seconds it took."""
+    the method's sizes; label ("run_verlet for cart_pendulum") names the glue in the notice a
+    call longer than a second prints (compile_notice). Returns the seconds it took."""
     n = q.shape[0]
     start = time.perf_counter()
-    run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
-        np.empty((1, N_STATS)), extra, last, events)
+    with first_use_notice(label):
+        run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
+            np.empty((1, N_STATS)), extra, last, events)
     return time.perf_counter() - start
 
 

@@ -59,6 +59,11 @@ def _scale(args):
     run_scale_bench(args.models, args.reports, quick=args.quick)
 
 
+def _speed(args):
+    from .speed import run_speed_bench
+    print(run_speed_bench(args.models, reports_dir=args.reports, quick=args.quick)["report"])
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -74,6 +79,8 @@ SUITES = {
     "report": ("precision + stability + hard, and the method-choice summary", _report),
     "constraints": ("linkage drift per method, rattle vs verlet cost, breaking stiffness", _constraints),
     "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
+    "speed": ("the speed goals in one run: vs PyDy at equal error, hand loops, MuJoCo, cold start",
+              _speed),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

@@ -1,0 +1,155 @@
+"""`lagrange-gen bench speed`: the rows of the speed issue measured side by side in one run.
+
+1. Cart pendulum, T = 10 from q0 = (0.1, 1.0): wall time to final-state error 1e-8 (the sweeps
+   and the log-log interpolation of bench/precision.py) of our fastest method, dop853 included,
+   against PyDy (cython right-hand side when it compiles) + scipy DOP853.
+2. Cart pendulum, ns per step of every method that has a closed-form hand-written numba loop
+   (bench/steppers.py) against that loop.
+3. 16-link chain (models/n_link_pendulum.py, n = 16): ns per step of symplectic_euler, verlet
+   and rk4 against MuJoCo's Euler and RK4 on the same chain (bench/mujoco_chain.py).
+4. First simulate of a model just written: a new process with a fresh NUMBA_CACHE_DIR that
+   generates the model into a fresh directory and simulates a few steps (seconds beyond the
+   interpreter's imports); then a new process to its first step with everything cached.
+
+Ratios inside one run, not absolute times: the machine is shared. A peer that is not installed
+is named in the report and its rows are left unmeasured.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis import reference as ref
+from ..analysis import runs
+from ..steppers import registry
+from . import common, mujoco_chain, peers, precision
+from .steppers import HAND_CLOSED_FORM, measure_new_process, measure_step_times
+
+CASE = precision.Case("cart_pendulum", (0.1, 1.0), (0.0, 0.0), 10.0, 100, 100)
+CHAIN_N, CHAIN_H = 16, 1e-3
+CHAIN_METHODS = ("symplectic_euler", "verlet", "rk4")
+#: (label, model stem, build options, method, q0, goal seconds) of the cold-cache rows
+COLD = (("cart pendulum, midpoint", "cart_pendulum", {}, "midpoint", [0.1, 1.0], 3.0),
+        ("cart pendulum, verlet", "cart_pendulum", {}, "verlet", [0.1, 1.0], 3.0),
+        ("cart pendulum, rk4", "cart_pendulum", {}, "rk4", [0.1, 1.0], 3.0),
+        ("Cartesian pendulum, rattle", "cartesian_pendulum", {}, "rattle",
+         [math.sin(0.5), -math.cos(0.5)], 5.0),
+        ("10-link chain, verlet", "n_link_pendulum", {"n": 10}, "verlet",
+         list(0.3 * np.sin(np.arange(1, 11))), 10.0))
+WARM_GOAL_S, PEER_GOAL, HAND_GOAL, MUJOCO_RK4_GOAL = 0.5, 100.0, 1.5, 3.0
+
+
+def measure_precision(models_dir, gen_dir, quick, progress):
+    """Seconds to final error 1e-8 per method: {"ours": {method: s or None}, "peers": {name:
+    s or None}, "pydy": generator name or None}."""
+    settings = replace(precision.QUICK if quick else precision.FULL, floor=precision.TARGET / 10)
+    mod = runs.load_module(models_dir, CASE.stem, gen_dir)
+    p = runs.params_of(mod)
+    reference = precision._reference(mod, CASE, p, settings)
+    ours = {}
+    for method in precision._ours(CASE, None):
+        sweep = precision.sweep_adaptive if registry.spec(method).adaptive else \
+            precision.sweep_ours
+        ours[method] = precision.time_at(sweep(mod, method, CASE, p, reference, settings,
+                                               progress))
+    found = {"scipy DOP853 on our right-hand side": ref.ode_rhs(mod, p)}
+    pydy = peers.pydy_rhs(Path(models_dir) / f"{CASE.stem}.py", mod.PARAMS, p)
+    if pydy is not None:
+        found["PyDy + scipy DOP853"] = pydy[0]
+    peer_times = {name: precision.time_at(precision.sweep_peer(
+        name, f, None, "DOP853", settings.dop_rtols, mod, CASE, p, reference, settings, progress))
+        for name, f in found.items()}
+    return {"ours": ours, "peers": peer_times, "pydy": pydy and pydy[2]}
+
+
+def measure_chain(models_dir, gen_dir, quick):
+    """ns per step on the 16-link chain: {"ours": {method: ns}, "mujoco": {integrator: {c_loop,
+    python_loop}} or None, "equivalence": max abs state difference of the two rk4 runs}."""
+    from ..loader import load
+    from ..simulation import simulate
+    mod = load(Path(models_dir) / "n_link_pendulum.py", out_dir=gen_dir,
+               methods=list(CHAIN_METHODS), options={"n": CHAIN_N})
+    th0, v0 = 0.3 * np.sin(np.arange(1, CHAIN_N + 1)), np.zeros(CHAIN_N)
+    steps, repeats = (5_000, 2) if quick else (20_000, 3)
+    ours = {}
+    for method in CHAIN_METHODS:
+        walls = [simulate(mod, method, th0, v0, t_end=steps * CHAIN_H, h=CHAIN_H,
+                          save_every=steps).wall_time for _ in range(repeats)]
+        ours[method] = 1e9 * min(walls) / steps
+    if not mujoco_chain.available():
+        return {"ours": ours, "mujoco": None, "equivalence": None}
+    params = runs.params_of(mod)                          # (m, l, g)
+    theirs = {name: mujoco_chain.ns_per_step(CHAIN_N, CHAIN_H, name, params, th0, v0, steps,
+                                             repeats) for name in ("Euler", "RK4")}
+    return {"ours": ours, "mujoco": theirs,
+            "equivalence": mujoco_chain.equivalence(mod, params, th0, CHAIN_H)}
+
+
+_COLD_CHILD = r"""
+import json, sys, time
+t0 = time.perf_counter()
+import numba, numpy  # noqa: F401
+from lagrange_gen.loader import load
+from lagrange_gen.simulation import simulate
+t1 = time.perf_counter()
+path, out_dir, method, options, q0 = sys.argv[1], sys.argv[2], sys.argv[3], \
+    json.loads(sys.argv[4]), json.loads(sys.argv[5])
+mod = load(path, out_dir=out_dir, methods=[method], options=options)
+t2 = time.perf_counter()
+simulate(mod, method, q0, None, t_end=0.01, h=1e-3)
+t3 = time.perf_counter()
+print(json.dumps({"imports": t1 - t0, "generate": t2 - t1, "first_simulate": t3 - t2,
+                  "path": mod.__file__}))
+"""
+
+
+def measure_cold(models_dir, work):
+    """Per COLD row: {label, method, generate, first_simulate, total (beyond imports), goal,
+    path, cache}: a new process, fresh numba cache, model generated into a fresh directory."""
+    rows = []
+    for i, (label, stem, options, method, q0, goal) in enumerate(COLD):
+        cache, out_dir = Path(work) / f"cache{i}", Path(work) / f"gen{i}"
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+        done = subprocess.run([sys.executable, "-c", _COLD_CHILD,
+                               str(Path(models_dir) / f"{stem}.py"), str(out_dir), method,
+                               json.dumps(options), json.dumps(q0)],
+                              env=env, capture_output=True, text=True)
+        if done.returncode != 0:
+            last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+            raise RuntimeError(f"bench speed: cold child for {label} failed: {last}")
+        data = json.loads(done.stdout.strip().splitlines()[-1])
+        rows.append({"label": label, "method": method, "goal": goal, "cache": cache, **data,
+                     "total": data["generate"] + data["first_simulate"]})
+        print(f"cold {label}: {rows[-1]['total']:.1f} s", flush=True)
+    return rows
+
+
+def run_speed_bench(models_dir="models", gen_dir="generated", reports_dir="reports",
+                    quick=False):
+    """Measure every row, write reports_dir/speed.md; returns {"results", "report"}."""
+    from .speed_report import markdown
+    common.precompile(models_dir, gen_dir, [(CASE.stem, {})])
+    mod = runs.load_module(models_dir, CASE.stem, gen_dir)
+    results = {"quick": quick, "mujoco": mujoco_chain.available()}
+    with tempfile.TemporaryDirectory() as tmp:
+        results["cold"] = measure_cold(models_dir, tmp)
+        rk4 = next(r for r in results["cold"] if r["method"] == "rk4")
+        results["warm"] = measure_new_process(rk4["path"], "rk4", rk4["cache"])
+    bar = common.Progress(0, "speed", enabled=False)
+    results["precision"] = measure_precision(models_dir, gen_dir, quick, bar)
+    steps, repeats = (20_000, 2) if quick else (100_000, 5)
+    results["steps"] = [r for r in measure_step_times(mod, steps, repeats)
+                        if r["method"] in HAND_CLOSED_FORM]
+    results["chain"] = measure_chain(models_dir, gen_dir, quick)
+    lines = markdown(results)
+    path = common.write_report(Path(reports_dir) / "speed.md", lines)
+    return {"results": results, "report": path}

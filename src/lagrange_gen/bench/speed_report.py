@@ -1,0 +1,141 @@
+"""Markdown of `lagrange-gen bench speed` (bench/speed.py): the headline table (each row: the
+number of this run, the issue's goal, met or not) and the details behind it."""
+
+from __future__ import annotations
+
+from .speed import (CASE, CHAIN_N, HAND_GOAL, MUJOCO_RK4_GOAL, PEER_GOAL, WARM_GOAL_S)
+
+PYDY = "PyDy + scipy DOP853"
+
+
+def _met(ok):
+    return "-" if ok is None else ("met" if ok else "not met")
+
+
+def _fastest(times):
+    """(method, seconds) of the fastest method that reached the target, or (None, None)."""
+    reached = {m: t for m, t in times.items() if t is not None}
+    if not reached:
+        return None, None
+    best = min(reached, key=reached.get)
+    return best, reached[best]
+
+
+def _precision_row(res):
+    method, ours = _fastest(res["ours"])
+    pydy = res["peers"].get(PYDY)
+    work = "cart pendulum, wall time to final-state error 1e-8, against PyDy + scipy DOP853"
+    if res["pydy"] is None:
+        return [work, "PyDy not installed: not measured", ">= 100x", "-"]
+    if ours is None or pydy is None:
+        return [work, f"target not reached (ours {method}, PyDy {pydy})", ">= 100x", "-"]
+    ratio = pydy / ours
+    return [work, f"{ratio:.0f}x faster ({method} {ours * 1e3:.2f} ms, PyDy "
+                  f"({res['pydy']}) {pydy * 1e3:.1f} ms)", f">= {PEER_GOAL:.0f}x",
+            _met(ratio >= PEER_GOAL)]
+
+
+def _hand_row(steps):
+    ratios = {r["method"]: r["ours_ns"] / r["hand_ns"] for r in steps}
+    text = ", ".join(f"{m} {x:.1f}x" for m, x in ratios.items()) + " slower"
+    return ["cart pendulum, ns per step against a closed-form hand-written numba loop",
+            text, f"<= {HAND_GOAL}x for every method that has a hand version",
+            _met(all(x <= HAND_GOAL for x in ratios.values()))]
+
+
+def _chain_rows(chain):
+    ours, theirs = chain["ours"], chain["mujoco"]
+    se, vv, rk = (ours[m] / 1e3 for m in ("symplectic_euler", "verlet", "rk4"))
+    if theirs is None:
+        return [[f"{CHAIN_N}-link chain against MuJoCo", f"mujoco not installed: not measured "
+                 f"(ours: symplectic_euler {se:.1f} us, verlet {vv:.1f} us, rk4 {rk:.1f} us)",
+                 "-", "-"]]
+    euler, rk4 = theirs["Euler"]["c_loop"] / 1e3, theirs["RK4"]["c_loop"] / 1e3
+    return [[f"{CHAIN_N}-link chain, ns per step against MuJoCo's Euler ({euler:.1f} us)",
+             f"symplectic_euler {se:.1f} us, verlet {vv:.1f} us",
+             "both faster than MuJoCo Euler", _met(se < euler and vv < euler)],
+            [f"{CHAIN_N}-link chain, rk4 against MuJoCo's RK4 ({rk4:.1f} us)",
+             f"{rk:.1f} us ({rk4 / rk:.1f}x faster)" if rk < rk4 else
+             f"{rk:.1f} us ({rk / rk4:.1f}x slower)", f"keep >= {MUJOCO_RK4_GOAL:.0f}x",
+             _met(rk4 / rk >= MUJOCO_RK4_GOAL)]]
+
+
+def _cold_rows(cold):
+    """One row per cold case: derive + generate + load + compile + first steps."""
+    return [[f"first simulate of a model just written (cold numba cache), beyond imports: "
+             f"{r['label']}", f"{r['total']:.1f} s", f"<= {r['goal']:.0f} s",
+             _met(r["total"] <= r["goal"])] for r in cold]
+
+
+def _warm_row(warm):
+    beyond = warm["module_import"] + warm["first_step"]
+    return ["warm cache, new process to the first step (beyond imports)",
+            f"{beyond:.2f} s (total wall {warm['wall']:.2f} s with the interpreter)",
+            f"keep < {WARM_GOAL_S} s", _met(beyond < WARM_GOAL_S)]
+
+
+def markdown(results):
+    """Lines of reports/speed.md."""
+    rows = [_precision_row(results["precision"]), _hand_row(results["steps"]),
+            *_chain_rows(results["chain"]), *_cold_rows(results["cold"]),
+            _warm_row(results["warm"])]
+    quick = " --quick" if results["quick"] else ""
+    lines = ["# Speed", "",
+             f"`lagrange-gen bench speed{quick}`: every row measured in this one run on a shared "
+             f"2-core machine; compare the ratios, not the absolute times.", "",
+             "| work | this run | goal | |", "|---|---|---|---|"]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return lines + ["", *_precision_details(results["precision"]),
+                    *_step_details(results["steps"]), *_chain_details(results["chain"]),
+                    *_cold_details(results["cold"], results["warm"])]
+
+
+def _ms(t):
+    return "not reached" if t is None else f"{t * 1e3:.2f} ms"
+
+
+def _precision_details(res):
+    lines = ["## Wall time to final-state error 1e-8", "",
+             f"{CASE.stem}, T = {CASE.t_end:g}, q0 = {CASE.q0}, v0 = {CASE.v0} (sweeps and "
+             f"interpolation of bench/precision.py; dop853 over rtol).",
+             "PyDy: " + (f"installed, {res['pydy']} right-hand side." if res["pydy"] else
+                         "not installed (pip install 'lagrange-gen[peers]')."), "",
+             "| method | wall time to 1e-8 |", "|---|---|"]
+    lines += [f"| {m} | {_ms(t)} |" for m, t in res["ours"].items()]
+    lines += [f"| {name} | {_ms(t)} |" for name, t in res["peers"].items()]
+    return lines + [""]
+
+
+def _step_details(steps):
+    lines = ["## ns per step against the hand-written loops (bench/steppers.py)", "",
+             "| method | library | hand, closed form | ratio | Newton it./step |",
+             "|---|---|---|---|---|"]
+    lines += [f"| {r['method']} | {r['ours_ns']:.0f} | {r['hand_ns']:.0f} | "
+              f"{r['ours_ns'] / r['hand_ns']:.2f} | {r['iters']:.2f} |" for r in steps]
+    return lines + [""]
+
+
+def _chain_details(chain):
+    lines = [f"## {CHAIN_N}-link chain, ns per step", ""]
+    lines += [f"- ours {m}: {ns:.0f} ns" for m, ns in chain["ours"].items()]
+    if chain["mujoco"] is None:
+        return lines + ["- MuJoCo: not installed (pip install 'lagrange-gen[peers]').", ""]
+    lines += [f"- MuJoCo {name}: {t['c_loop']:.0f} ns in a C loop (mujoco.rollout), "
+              f"{t['python_loop']:.0f} ns per mj_step from a Python loop"
+              for name, t in chain["mujoco"].items()]
+    return lines + [f"- the MJCF chain is the model's chain: MuJoCo RK4 and our rk4 agree to "
+                    f"{chain['equivalence']:.1g} after 1000 steps of 1 ms.", ""]
+
+
+def _cold_details(cold, warm):
+    lines = ["## First simulate, cold numba cache (seconds)", "",
+             "New process, fresh NUMBA_CACHE_DIR, model generated into a fresh directory, "
+             "10 steps of 1 ms.", "",
+             "| model, method | interpreter imports | derive + generate | load, compile, first "
+             "steps | total beyond imports | goal |", "|---|---|---|---|---|---|"]
+    lines += [f"| {r['label']} | {r['imports']:.2f} | {r['generate']:.2f} | "
+              f"{r['first_simulate']:.2f} | {r['total']:.2f} | <= {r['goal']:.0f} |"
+              for r in cold]
+    return lines + ["", f"Warm cache (cart pendulum, rk4): interpreter + numpy/numba imports "
+                        f"{warm['imports']:.2f} s, module import {warm['module_import']:.2f} s, "
+                        f"run_rk4 load + first step {warm['first_step']:.3f} s.", ""]
