@@ -59,6 +59,11 @@ def _scale(args):
     run_scale_bench(args.models, args.reports, quick=args.quick)
 
 
+def _ensemble(args):
+    from .ensemble import run_ensemble_bench
+    run_ensemble_bench(Path(args.reports) / "ensemble.md", models_dir=args.models, quick=args.quick)
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -74,6 +79,7 @@ SUITES = {
     "report": ("precision + stability + hard, and the method-choice summary", _report),
     "constraints": ("linkage drift per method, rattle vs verlet cost, breaking stiffness", _constraints),
     "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
+    "ensemble": ("members per second of lagrange_gen.ensemble on 1 and 2 threads vs a simulate loop", _ensemble),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

@@ -1,0 +1,110 @@
+"""Ensemble throughput: members per second of lagrange_gen.ensemble on the cart pendulum (rk4,
+T = 10, h = 1e-3, 10,000 steps per member) on 1 and 2 numba threads, against a Python loop of
+simulate() measured on a subset of the members (reported per member).
+
+Members differ in q0, v0 and the spring stiffness k. Each timing is the best of REPEATS runs
+(the machine may be shared: the best run is the one least disturbed by others). The report also
+states whether the 1- and 2-thread results are identical and whether the subset equals simulate
+bitwise.
+
+Run: ``lagrange-gen bench ensemble [--quick]`` (writes reports/ensemble.md).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .common import write_report
+
+T_END, H_STEP, SAVE_EVERY = 10.0, 1e-3, 100
+REPEATS = 3
+
+
+def _members(M, seed=0):
+    rng = np.random.default_rng(seed)
+    q0 = rng.uniform(-0.5, 0.5, (M, 2))
+    v0 = rng.uniform(-1.0, 1.0, (M, 2))
+    return q0, v0, rng.uniform(5.0, 15.0, M)
+
+
+def _time_ensemble(module, q0, v0, k, threads):
+    """(best seconds over REPEATS, the last result) of one ensemble call on ``threads``."""
+    import numba
+
+    from ..ensemble import ensemble
+    before = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        best, result = float("inf"), None
+        for _ in range(REPEATS):
+            result = ensemble(module, "rk4", q0=q0, v0=v0, params={"k": k}, t_end=T_END,
+                              h=H_STEP, save_every=SAVE_EVERY)
+            best = min(best, result.wall_time)
+    finally:
+        numba.set_num_threads(before)
+    return best, result
+
+
+def _time_simulate_loop(module, q0, v0, k, result):
+    """(best seconds per member of a Python loop of simulate over the subset, all members
+    bitwise equal to the ensemble's)."""
+    from ..simulation import simulate
+    best, equal = float("inf"), True
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        trajs = [simulate(module, "rk4", q0[i], v0[i], params={"k": k[i]}, t_end=T_END,
+                          h=H_STEP, save_every=SAVE_EVERY) for i in range(len(k))]
+        best = min(best, (time.perf_counter() - start) / len(k))
+    for i, traj in enumerate(trajs):
+        equal &= np.array_equal(traj.q, result.q[i]) and np.array_equal(traj.v, result.v[i])
+    return best, equal
+
+
+def run_ensemble_bench(report_path, models_dir="models", quick=False):
+    """Measure and write the report; returns {name: number}."""
+    import numba
+
+    from ..codegen import generate_model
+    from ..loader import import_generated
+    M, subset = (1_000, 20) if quick else (10_000, 100)
+    with tempfile.TemporaryDirectory() as tmp:
+        result = generate_model(Path(models_dir) / "cart_pendulum.py", tmp, methods=["rk4"])
+        module = import_generated(result.path)
+        q0, v0, k = _members(M)
+        threads = sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)})
+        timed = {t: _time_ensemble(module, q0, v0, k, t) for t in threads}
+        per_member, equal = _time_simulate_loop(module, q0[:subset], v0[:subset], k[:subset],
+                                                timed[1][1])
+    one = timed[1][0]
+    two = timed[threads[-1]][0]
+    same = all(np.array_equal(timed[1][1].q, r.q, equal_nan=True) for _, r in timed.values())
+    numbers = dict(members=M, rate_1=M / one, rate_2=M / two, ratio=one / two,
+                   simulate_per_member=per_member, simulate_rate=1.0 / per_member)
+    lines = [
+        "# Ensemble throughput (cart pendulum, rk4)", "",
+        f"Members: {M}, each T = {T_END:g} with h = {H_STEP:g} ({int(T_END / H_STEP)} steps), "
+        f"save_every = {SAVE_EVERY}; members differ in q0, v0 and k. Best of {REPEATS} runs. "
+        f"Machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the end "
+        f"(shared: other processes may run).", "",
+        "| run | wall (s) | members / s | steps / s |", "|---|---|---|---|",
+    ]
+    steps = M * int(T_END / H_STEP)
+    for t, (sec, _) in timed.items():
+        lines.append(f"| ensemble, {t} thread{'s' if t > 1 else ''} | {sec:.3f} | "
+                     f"{M / sec:,.0f} | {steps / sec:.3g} |")
+    lines.append(f"| Python loop of simulate ({subset} members) | {per_member * M:.3f} "
+                 f"(extrapolated) | {1 / per_member:,.0f} | "
+                 f"{int(T_END / H_STEP) / per_member:.3g} |")
+    lines += ["", f"2 threads / 1 thread: **{one / two:.2f}x** (goal >= 1.8x).",
+              f"Ensemble (2 threads) / simulate loop: {per_member * M / two:.1f}x; simulate "
+              f"costs {per_member * 1e3:.3f} ms per member.",
+              f"1- and 2-thread results identical: {same}. The {subset} simulate runs equal "
+              f"their ensemble members bitwise: {equal}."]
+    write_report(report_path, lines)
+    print("\n".join(lines))
+    return numbers
