@@ -22,7 +22,7 @@ _LAZY = {
     "Event": "model",
     "import_generated": "loader", "load": "loader",
     "simulate": "simulation", "Trajectory": "trajectory",
-    "ensemble": "ensemble", "grid": "ensemble_inputs", "EnsembleResult": "ensemble",
+    "ensemble": "ensemble_run", "grid": "ensemble_inputs", "EnsembleResult": "ensemble_run",
 }
 
 __all__ = sorted(_LAZY) + [

@@ -28,6 +28,11 @@ Glue signature of the fixed-step methods::
     status     lagrange_gen.status code; steps_done = index of the failing step on failure, -1
                when the initial state is refused (see base.run_loop)
 
+Fixed-step methods also get ``ensemble_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
+out_q, out_v, out_stats, out_extra, out_last, out_status)``: the same loop for M members at once
+(a numba prange over members; member arrays with a leading M axis, see ensemble_glue_source and
+lagrange_gen.ensemble).
+
 The glue is compiled with error_model="numpy", like the kernels and the cores: non-finite
 arithmetic gives inf/NaN, which the run loop reports as NON_FINITE, never a Python exception.
 """
