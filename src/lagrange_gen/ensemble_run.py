@@ -84,7 +84,8 @@ class EnsembleResult:
 
 
 def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
-             save_every=1, t0=0.0, progress=False, out_dir="generated", **settings):
+             save_every=1, t0=0.0, progress=False, out_dir="generated", client=None,
+             worker_threads=1, **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
     q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
@@ -92,7 +93,9 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     by name (as simulate), shared. M comes from the per-member inputs, which must agree.
     Constrained models: each member's (q0, v0) is made consistent first (lagrange_gen.consistent;
     one warning counts the members moved). Raises SimulationError (one line) on bad input or
-    when the saved output would not fit in memory; failing members do not raise (failures())."""
+    when the saved output would not fit in memory; failing members do not raise (failures()).
+    client: a dask.distributed Client: the members run as Dask tasks in chunks on its workers,
+    each on ``worker_threads`` numba threads (ensemble_dask.py); the result is the same."""
     from .simulation import _check_times, _element_method, load_module
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
@@ -122,9 +125,17 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     out = _allocate(M, rows, n, n_saved)
     if spec.constraints:
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
-    compile_time = _warm_up(run, q, v, p, t0, h, save_every, config, out)
+    if client is None:
+        compile_time = _warm_up(run, q, v, p, t0, h, save_every, config, out)
+    else:
+        compile_time = 0.0          # done by each worker, inside its first task
     start = time.perf_counter()
-    _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress)
+    if client is None:
+        _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress)
+    else:
+        from .ensemble_dask import run_on_client
+        run_on_client(client, module, method, q, v, p, t0, h, n_steps, save_every, config, out,
+                      progress, worker_threads)
     wall = time.perf_counter() - start
     return _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time,
                    getattr(config, "max_iter", 0))
