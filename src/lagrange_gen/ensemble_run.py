@@ -38,7 +38,7 @@ __all__ = ["ensemble", "grid", "EnsembleResult"]
 
 #: With a progress bar, members run in batches of at least this many per thread (a batch ends
 #: when its slowest member does, so batches of one member per thread would idle threads).
-MEMBERS_PER_THREAD = 8
+MEMBERS_PER_THREAD = 32
 
 
 @dataclass
@@ -213,14 +213,14 @@ def _warm_up(run, q, v, p, t0, h, save_every, config, out):
 
 
 def _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress):
-    """One call for all members, or with a progress bar batches of about 1 % of them (at least
+    """One call for all members, or with a progress bar batches of about 2 % of them (at least
     MEMBERS_PER_THREAD per thread)."""
     M = q.shape[0]
     if not progress:
         _call(run, q, v, p, t0, h, n_steps, save_every, config, out, slice(0, M))
         return
     import numba
-    batch = max(MEMBERS_PER_THREAD * numba.get_num_threads(), math.ceil(M / 100))
+    batch = max(MEMBERS_PER_THREAD * numba.get_num_threads(), math.ceil(M / 50))
     bar = ProgressBar(M)
     for start in range(0, M, batch):
         members = slice(start, min(M, start + batch))
