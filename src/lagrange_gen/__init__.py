@@ -4,6 +4,7 @@ Public API (explicit re-exports)::
 
     from lagrange_gen import Model, coordinates, parameters, t, PointForce, Event, load_model
     from lagrange_gen import load, import_generated, simulate
+    from lagrange_gen import ensemble, grid, EnsembleResult
 
 The modelling names load sympy on first use only, so that importing a generated module (which
 imports lagrange_gen for its runtime helpers) stays fast.
@@ -21,6 +22,7 @@ _LAZY = {
     "Event": "model",
     "import_generated": "loader", "load": "loader",
     "simulate": "simulation", "Trajectory": "trajectory",
+    "ensemble": "ensemble_run", "grid": "ensemble_inputs", "EnsembleResult": "ensemble_run",
 }
 
 __all__ = sorted(_LAZY) + [

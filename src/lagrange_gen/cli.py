@@ -12,7 +12,7 @@ import time
 
 from .errors import LagrangeGenError
 
-SUBCOMMANDS = ("simulate", "bench", "identify")
+SUBCOMMANDS = ("simulate", "sweep", "bench", "identify")
 
 _EPILOG = """\
 examples:
@@ -23,6 +23,8 @@ examples:
   lagrange-gen --methods verlet,midpoint models/double_pendulum.py
   lagrange-gen --freeze g=9.81,l=1 models/n_link_pendulum.py --set n=16
   lagrange-gen simulate models/cart_pendulum.py --method midpoint --h 1e-3 --t-end 10
+  lagrange-gen sweep models/cart_pendulum.py --method rk4 --h 1e-3 --t-end 10 \\
+      --grid k=1:100:50 --grid m=0.1:1:20 --out sweep.npz --plot sweep.png
   lagrange-gen bench --help
   lagrange-gen identify cycle.csv --kind prandtl --elements 3
 
@@ -136,6 +138,8 @@ def _subcommand_parser(name):
     sub = p.add_subparsers(dest="command", required=True)
     if name == "simulate":
         from .cli_simulate import add_parser
+    elif name == "sweep":
+        from .cli_sweep import add_parser
     elif name == "identify":
         from .identify.cli import add_parser
     else:
@@ -147,6 +151,8 @@ def _subcommand_parser(name):
 def _run_subcommand(args) -> int:
     if args.command == "simulate":
         from .cli_simulate import run
+    elif args.command == "sweep":
+        from .cli_sweep import run
     elif args.command == "identify":
         from .identify.cli import run
     else:

@@ -64,6 +64,11 @@ def _speed(args):
     print(run_speed_bench(args.models, reports_dir=args.reports, quick=args.quick)["report"])
 
 
+def _ensemble(args):
+    from .ensemble import run_ensemble_bench
+    run_ensemble_bench(Path(args.reports) / "ensemble.md", models_dir=args.models, quick=args.quick)
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -81,6 +86,8 @@ SUITES = {
     "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
     "speed": ("the speed goals in one run: vs PyDy at equal error, hand loops, MuJoCo, cold start",
               _speed),
+    "ensemble": ("members per second of lagrange_gen.ensemble on 1 and 2 threads vs a simulate loop",
+                 _ensemble),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

@@ -137,7 +137,6 @@ class GenerationParts:
 
 def generate_parts(model, out_dir="generated", methods=None, freeze=None, progress=None) -> GenerationParts:
     """Derive and emit a loaded Model (nothing is written); see generate_text."""
-    from ..steppers.registry import glue_source
     progress = progress or Progress(model.source_path or model.name)
     methods, freeze = resolve_methods(methods, model), dict(sorted((freeze or {}).items()))
     options = generation_options(model.build_options, methods, freeze)
@@ -159,10 +158,22 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None, progre
         source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
         text = render_module(dyn, texts, sources=module_sources(methods), options=options,
                              source_rel=source_rel, methods=methods,
-                             glue="\n\n".join(glue_source(m, _n_saved(m, dyn), len(dyn.model.events)) for m in methods),
+                             glue=_glue(methods, dyn),
                              why=selected)
     seconds = {"derive": derived - start, "emit": time.perf_counter() - derived}
     return GenerationParts(text, key_of_text(text), target, dyn, texts, seconds)
+
+
+def _glue(methods, dyn):
+    """The glue of every method: run_<method>, then (fixed-step methods) ensemble_<method>."""
+    from ..steppers.registry import ensemble_glue_source, glue_source, spec
+    blocks = []
+    for m in methods:
+        counts = (_n_saved(m, dyn), len(dyn.model.events))
+        blocks.append(glue_source(m, *counts))
+        if not spec(m).adaptive:
+            blocks.append(ensemble_glue_source(m, *counts))
+    return "\n\n".join(blocks)
 
 
 def _n_saved(method, dyn):

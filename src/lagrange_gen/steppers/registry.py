@@ -28,6 +28,11 @@ Glue signature of the fixed-step methods::
     status     lagrange_gen.status code; steps_done = index of the failing step on failure, -1
                when the initial state is refused (see base.run_loop)
 
+Fixed-step methods also get ``ensemble_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
+out_q, out_v, out_stats, out_extra, out_last, out_status)``: the same loop for M members at once
+(a numba prange over members; member arrays with a leading M axis, see ensemble_glue_source and
+lagrange_gen.ensemble).
+
 The glue is compiled with error_model="numpy", like the kernels and the cores: non-finite
 arithmetic gives inf/NaN, which the run loop reports as NON_FINITE, never a Python exception.
 """
@@ -115,6 +120,68 @@ def run_{method}({wrapped}):
     Argument shapes: see lagrange_gen.steppers.registry; lagrange_gen.simulate wraps this."""
     return _{loop}(_stepper_{method}, _THIS_MODULE, {n_saved}, {n_events}, {wrapped_call})'''
 
+#: Arguments of the ensemble glue of a fixed-step method (lagrange_gen.ensemble wraps it).
+ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
+                      "out_q, out_v, out_stats, out_extra, out_last, out_status")
+
+# ensemble_<method> runs member i in _member_<method>: base.run_loop as run_<method> runs it, on
+# the member's rows of the (M, S, ...) outputs. The member is a separate (cached) function
+# because numba parallelizes a prange loop only when its body has one exit, and run_loop, once
+# inlined, has several (early returns, a raise). S = saved_rows: the final state gets a row when
+# n_steps is not a multiple of save_every or a terminal event stopped the member, written as
+# simulate's _trajectory writes it, so a member equals simulate's Trajectory. Time rows and
+# events are per-member scratch (the times are the same for every member; events are counted).
+_ENSEMBLE_GLUE = '''import math as _math
+
+from numba import prange as _prange
+
+from lagrange_gen.status import NON_FINITE as _NON_FINITE
+
+
+@njit(cache=True, error_model="numpy")
+def _member_{method}(q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last):
+    """One member of ensemble_{method}: (status, steps_done, n_events) as run_{method}."""
+    n = q0.shape[0]
+    saves = n_steps // save_every + 1
+    out_t = np.empty(saves)
+    events = np.empty((0, 3 + 2 * n))
+    status, steps, n_events = _run_loop(
+        _stepper_{method}, _THIS_MODULE, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
+        save_every, p, settings, out_t, q[:saves], v[:saves], stats[:saves], extra[:saves],
+        last, events)
+    if status == 0 and (steps % save_every != 0 or steps < n_steps):
+        row = steps // save_every + 1
+        for k in range(n):
+            q[row, k] = last[1 + k]
+            v[row, k] = last[1 + n + k]
+        energy = _THIS_MODULE.energy(q[row], v[row], last[0], p)
+        stats[row, 0] = energy
+        stats[row, 1] = last[1 + 2 * n]
+        stats[row, 2] = last[2 + 2 * n]
+        for k in range(extra.shape[1]):
+            extra[row, k] = last[3 + 2 * n + k]
+        if not _math.isfinite(energy):
+            status, steps = _NON_FINITE, steps - 1
+    return status, steps, n_events
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def ensemble_{method}({wrapped}):
+    """Integrate members i = 0..M-1 with {method} in one parallel loop; nothing returned.
+
+    q0, v0 (M, n); p (M, n_params); out_q, out_v (M, S, n); out_stats (M, S, N_STATS);
+    out_extra (M, S, n_saved) (row 0: the initial saved fields); out_last (M, 2 n + 3 +
+    n_saved); out_status (M, 3) int64 receives (status, steps_done, n_events) per member.
+    See lagrange_gen.steppers.registry; lagrange_gen.ensemble wraps this."""
+    for i in _prange(q0.shape[0]):
+        status, steps, n_events = _member_{method}(
+            q0[i], v0[i], t0, h, n_steps, save_every, p[i], settings, out_q[i], out_v[i],
+            out_stats[i], out_extra[i], out_last[i])
+        out_status[i, 0] = status
+        out_status[i, 1] = steps
+        out_status[i, 2] = n_events'''
+
+
 #: The jitted loop each kind of method runs in: (module, function).
 LOOPS = {False: ("base", "run_loop"), True: ("adaptive", "run_adaptive")}
 
@@ -138,3 +205,14 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
                         summary=spec(method).summary, loop_module=loop_module, loop=loop,
                         n_saved=n_saved, n_events=n_events)
+
+
+def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:
+    """Source text of ``ensemble_<method>`` (fixed-step methods only), appended after
+    ``run_<method>`` (whose block imports the stepper and run_loop); deterministic."""
+    if spec(method).adaptive:
+        raise ValueError(f"{method} chooses its own steps: no ensemble glue (fixed-step only)")
+    indent = " " * len(f"def ensemble_{method}(")
+    wrapped = ENSEMBLE_GLUE_ARGS.replace("settings, ", "settings,\n" + indent)
+    return _ENSEMBLE_GLUE.format(method=method, wrapped=wrapped, n_saved=n_saved,
+                                 n_events=n_events)
