@@ -159,17 +159,12 @@ def ensemble_bytes(M, rows, n, n_saved):
 
 def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved):
     """Refuse, before allocating, an ensemble whose saved rows do not fit in the memory available
-    now (run_checks.available_memory), saying how much it needs and which save_every fits."""
+    now (run_checks.check_memory with the ensemble's bytes), saying how much it needs and which
+    save_every fits."""
     rows = run_checks.saved_rows(n_steps, save_every)
-    need = ensemble_bytes(M, rows, n, n_saved)
-    free = run_checks.available_memory()
-    if free is None or need <= free:
-        return
-    suggest = save_every * math.ceil(need / (0.5 * free))
-    raise SimulationError(
-        f"{model}: an ensemble of {M} members saving {rows} states each needs "
-        f"{need / 1e9:.3g} GB of memory and {free / 1e9:.3g} GB is available; use "
-        f"save_every >= {suggest} or fewer members")
+    run_checks.check_memory(model, n_steps, save_every, n, n_saved,
+                            need=ensemble_bytes(M, rows, n, n_saved),
+                            what=f"an ensemble of {M} members saving {rows} states each")
 
 
 def _allocate(M, rows, n, n_saved):

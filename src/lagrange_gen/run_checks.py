@@ -193,19 +193,21 @@ def saved_bytes(rows, n, n_saved):
     return rows * 8 * (2 * n + 2 * n_saved + _ROW_COLUMNS)
 
 
-def check_memory(model, n_steps, save_every, n, n_saved):
+def check_memory(model, n_steps, save_every, n, n_saved, need=None, what=None):
     """Refuse, before allocating, a run whose saved rows do not fit in the available memory,
-    suggesting the save_every that would leave half of it free."""
+    suggesting the save_every that would leave half of it free. need: the bytes the caller
+    holds at its peak (default saved_bytes of one run), what: the run named in the message
+    (default "saving S states (N steps, save_every = K)")."""
     rows = saved_rows(n_steps, save_every)
-    need = saved_bytes(rows, n, n_saved)
+    need = saved_bytes(rows, n, n_saved) if need is None else need
     free = available_memory()
     if free is None or need <= free:
         return
     suggest = save_every * math.ceil(need / (0.5 * free))
+    what = what or f"saving {rows} states ({n_steps} steps, save_every = {save_every})"
     raise SimulationError(
-        f"{model}: saving {rows} states ({n_steps} steps, save_every = {save_every}) needs "
-        f"{_gb(need)} of memory and {_gb(free)} is available; use save_every >= {suggest} "
-        f"(--save-every {suggest})")
+        f"{model}: {what} needs {_gb(need)} of memory and {_gb(free)} is available; use "
+        f"save_every >= {suggest} (--save-every {suggest})")
 
 
 def _gb(nbytes):
