@@ -42,10 +42,6 @@ class Trajectory:
     events: tuple = ()          # located events (steppers/events.py events_table), in time order
     step_counts: dict = field(default_factory=dict)  # adaptive runs: accepted, rejected, evaluations
 
-    def field(self, name):
-        """The saved field ``name`` (S, width), or None when the method does not save it."""
-        return self.saved.get(name)
-
     @property
     def multipliers(self) -> np.ndarray:
         """(S, m): the constraint forces lam (H qdd = rhs + J^T lam) at each saved state, from a
