@@ -43,3 +43,41 @@ def test_singular_or_non_finite_matrices_are_refused(A):
     piv = np.zeros(2, np.int64)
     assert not linalg.lu_solve_system(A.copy(), piv, np.ones(2))
     assert not linalg.lu_inplace(A.copy(), piv)
+
+
+def _two_by_two(seed=1):
+    """2 x 2 matrices for the scalar paths: random (both pivot orders), SPD, near-singular,
+    exactly singular, zero, NaN and inf entries."""
+    rng = np.random.default_rng(seed)
+    mats = [rng.normal(size=(2, 2)) for _ in range(40)]
+    mats += [m @ m.T + 1e-3 * np.eye(2) for m in mats[:20]]
+    mats += [np.array([[1.0, 2.0], [2.0, 4.0 + 1e-14]]), np.array([[1e-300, 1.0], [1.0, 0.0]]),
+             np.zeros((2, 2)), np.array([[1.0, 2.0], [2.0, 4.0]]),
+             np.array([[math.nan, 1.0], [1.0, 1.0]]), np.array([[1.0, math.nan], [0.0, 1.0]]),
+             np.array([[1.0, 0.0], [math.inf, 1.0]]), np.array([[0.0, 1.0], [1.0, 0.0]])]
+    return mats
+
+
+def _same(a, b):
+    np.testing.assert_array_equal(np.asarray(a), np.asarray(b))   # NaN == NaN here
+
+
+@pytest.mark.parametrize("A", _two_by_two())
+def test_two_by_two_scalar_paths_are_bitwise_the_loops(A):
+    """The n = 2 paths on scalars (linalg module docstring) give the loops' results bit for bit:
+    the return value, the factors left in A, the permutation and the solution."""
+    b = np.array([0.7, -1.3])
+    A1, b1, p1 = A.copy(), b.copy(), np.zeros(2, np.int64)
+    A2, b2, p2 = A.copy(), b.copy(), np.zeros(2, np.int64)
+    assert linalg.lu_solve_system(A1, p1, b1) == linalg._lu_solve_system_loops(A2, p2, b2)
+    for x, y in ((A1, A2), (p1, p2), (b1, b2)):
+        _same(x, y)
+    L1, L2 = A.copy(), A.copy()
+    ok = linalg.cholesky_inplace(L1)
+    assert ok == linalg._cholesky_loops(L2)
+    _same(L1, L2)
+    if ok:
+        c1, c2 = b.copy(), b.copy()
+        linalg.cholesky_solve_inplace(L1, c1)
+        linalg._cholesky_solve_loops(L2, c2)
+        _same(c1, c2)

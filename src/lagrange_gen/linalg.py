@@ -2,6 +2,13 @@
 
 Compiled without numba's reference counting (``_nrt=False``): none of these functions allocates,
 and with it every call pays atomic increments per array argument (see steppers/base.py).
+
+2 x 2 systems (the cart pendulum, every two-coordinate model, and its Newton matrices) take a
+path on scalars: the same operations in the same order as the loops, so bitwise the same
+result (tests/test_linalg.py), but held in registers instead of re-read from the array after
+every store. The loops over a run-time n cost 17 ns per 2 x 2 LU solve and 19 ns per Cholesky
+factor-and-solve; the scalar paths 4 ns (10^7 solves, /work/scratch/lu2.py in the issue-13
+note).
 """
 
 import math
@@ -19,6 +26,14 @@ def cholesky_inplace(A):
 
     Returns True on success, False when a pivot is not positive relative to the diagonal scale.
     """
+    if A.shape[0] == 2:
+        return _cholesky_2(A)
+    return _cholesky_loops(A)
+
+
+@njit(cache=True, _nrt=False)
+def _cholesky_loops(A):
+    """cholesky_inplace for any n."""
     n = A.shape[0]
     scale = 0.0
     for i in range(n):
@@ -44,6 +59,20 @@ def cholesky_inplace(A):
 @njit(cache=True, _nrt=False)
 def cholesky_solve_inplace(L, b):
     """Solve (L L^T) x = b with L from cholesky_inplace; b (n,) is overwritten by x."""
+    if L.shape[0] == 2:
+        l00, l10, l11 = L[0, 0], L[1, 0], L[1, 1]
+        y0 = b[0] / l00
+        y1 = (b[1] - l10 * y0) / l11
+        x1 = y1 / l11
+        b[0] = (y0 - l10 * x1) / l00
+        b[1] = x1
+    else:
+        _cholesky_solve_loops(L, b)
+
+
+@njit(cache=True, _nrt=False)
+def _cholesky_solve_loops(L, b):
+    """cholesky_solve_inplace for any n."""
     n = L.shape[0]
     for i in range(n):
         s = b[i]
@@ -105,6 +134,56 @@ def _eliminate(A, piv, b):
 
 
 @njit(cache=True, _nrt=False)
+def _cholesky_2(A):
+    """cholesky_inplace of a 2 x 2 A on scalars (same operations, same test)."""
+    a00, a10, a11 = A[0, 0], A[1, 0], A[1, 1]
+    scale = max(max(0.0, abs(a00)), abs(a11))      # the loop's fold, NaN handling included
+    if not (scale > 0.0) or not math.isfinite(scale):
+        return False
+    if not (a00 > SINGULAR_RTOL * scale):
+        return False
+    l00 = math.sqrt(a00)
+    l10 = a10 / l00
+    A[0, 0], A[1, 0] = l00, l10
+    d = a11 - l10 * l10
+    if not (d > SINGULAR_RTOL * scale):
+        return False
+    A[1, 1] = math.sqrt(d)
+    return True
+
+
+@njit(cache=True, _nrt=False)
+def _lu_solve_system_2(A, piv, b):
+    """lu_solve_system of a 2 x 2 A on scalars: the same pivot choice (swap only for a strictly
+    larger entry), singularity test, factors left in A and permutation in piv."""
+    a00, a01, a10, a11 = A[0, 0], A[0, 1], A[1, 0], A[1, 1]
+    scale = max(max(max(max(0.0, abs(a00)), abs(a01)), abs(a10)), abs(a11))   # the loop's fold
+    if not (scale > 0.0) or not math.isfinite(scale):
+        return False
+    b0, b1 = b[0], b[1]
+    piv[0], piv[1] = 0, 1
+    swap = abs(a10) > abs(a00)
+    big = abs(a10) if swap else abs(a00)
+    if not (big > SINGULAR_RTOL * scale):
+        return False                            # the loop tests before it swaps
+    if swap:
+        a00, a01, a10, a11 = a10, a11, a00, a01
+        b0, b1 = b1, b0
+        piv[0], piv[1] = 1, 0
+    f = a10 / a00
+    a11 -= f * a01
+    b1 -= f * b0
+    A[0, 0], A[0, 1], A[1, 0], A[1, 1] = a00, a01, f, a11
+    if not (abs(a11) > SINGULAR_RTOL * scale):
+        b[0], b[1] = b0, b1                     # where the loop leaves them
+        return False
+    x1 = b1 / a11
+    b[0] = (b0 - a01 * x1) / a00
+    b[1] = x1
+    return True
+
+
+@njit(cache=True, _nrt=False)
 def lu_inplace(A, piv):
     """LU factorization with partial pivoting of A (n, n) in place; piv (n,) int64 receives the
     row permutation (solve with lu_solve_inplace). Returns False when a pivot is zero relative
@@ -118,6 +197,14 @@ def lu_solve_system(A, piv, b):
     separate forward substitution), then back substitution; A (n, n) is left holding its LU
     factors and piv (n,) the permutation (as lu_inplace), b (n,) is overwritten by x. Returns
     False, like lu_inplace, when a pivot is zero relative to the largest entry."""
+    if A.shape[0] == 2:
+        return _lu_solve_system_2(A, piv, b)
+    return _lu_solve_system_loops(A, piv, b)
+
+
+@njit(cache=True, _nrt=False)
+def _lu_solve_system_loops(A, piv, b):
+    """lu_solve_system for any n."""
     if not _eliminate(A, piv, b):
         return False
     n = A.shape[0]

@@ -40,3 +40,11 @@ def test_bench_stability_quick_writes_its_report(tmp_path, gen_dir, monkeypatch)
     # Scenes whose model is not in the directory are reported, not crashed on.
     assert "four-bar linkage" in text and "not available in this build" in text
     assert png_has_pixels(tmp_path / "reports" / "stability_tau.png")
+
+
+def test_scale_report_names_the_dominant_stage():
+    from lagrange_gen.bench.scale_report import dominant_stage
+    row = {"derive": 0.5, "emit": 1.5, "kernels_compile": 6.0, "glue_compile": 2.0}
+    assert dominant_stage(row) == "kernel compile (60 %)"
+    row["glue_compile"] = 12.0
+    assert dominant_stage(row) == "glue compile (60 %)"

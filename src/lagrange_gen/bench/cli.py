@@ -69,6 +69,11 @@ def _ensemble(args):
     run_ensemble_bench(Path(args.reports) / "ensemble.md", models_dir=args.models, quick=args.quick)
 
 
+def _stepapi(args):
+    from .stepapi import run_stepapi_bench
+    run_stepapi_bench(Path(args.reports) / "stepapi.md", models_dir=args.models, quick=args.quick)
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -88,6 +93,8 @@ SUITES = {
               _speed),
     "ensemble": ("members per second of lagrange_gen.ensemble on 1 and 2 threads vs a simulate loop",
                  _ensemble),
+    "stepapi": ("us per Stepper.step call on the cart pole vs simulate per step; controller hook cost",
+                _stepapi),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

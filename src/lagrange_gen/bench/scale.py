@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-SIZES = (1, 2, 4, 8, 12, 16, 20)
+SIZES = (1, 2, 4, 8, 12, 16, 20, 24, 32)
 QUICK_SIZES = (1, 2, 4)
 METHODS = ("verlet", "midpoint")
 BUDGET_S, QUICK_BUDGET_S = 150.0, 20.0       # per LagrangesMethod case

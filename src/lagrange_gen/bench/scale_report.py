@@ -16,15 +16,29 @@ def _ours(row):
     return row["derive"] + row["emit"] + row["module_import"] + row["kernels_compile"]
 
 
+#: The stages of a first simulate of a new model, as (label, row key).
+STAGES = (("derive", "derive"), ("emit", "emit"), ("kernel compile", "kernels_compile"),
+          ("glue compile", "glue_compile"))
+
+
+def dominant_stage(row):
+    """'glue compile (62 %)': the stage of derive, emit, kernel and glue compile that takes the
+    largest share of their sum in this row."""
+    times = {label: row[key] for label, key in STAGES}
+    label = max(times, key=times.get)
+    return f"{label} ({100 * times[label] / sum(times.values()):.0f} %)"
+
+
 def _table(rows, lm, budget):
     head = ("| n | derive s | emit s | lines | ops (CSE'd) | kernels 1st compile s | glue 1st compile s "
-            "| cached import + 1st step s | ns / forward dyn. | ns / verlet step | ns / midpoint step "
-            "| sympy LagrangesMethod s |")
-    lines = [head, "|" + "---|" * 12]
+            "| dominant stage | cached import + 1st step s | ns / forward dyn. | ns / verlet step "
+            "| ns / midpoint step | sympy LagrangesMethod s |")
+    lines = [head, "|" + "---|" * 13]
     for r in rows:
         ref = lm.get(r["n"])
         lines.append(f"| {r['n']} | {_fmt(r['derive'])} | {_fmt(r['emit'])} | {r['lines']} | {r['ops']} | "
-                     f"{_fmt(r['kernels_compile'])} | {_fmt(r['glue_compile'])} | {_fmt(r['cached_first_step'], 3)} | "
+                     f"{_fmt(r['kernels_compile'])} | {_fmt(r['glue_compile'])} | {dominant_stage(r)} | "
+                     f"{_fmt(r['cached_first_step'], 3)} | "
                      f"{r['ns_forward']:.0f} | {r['ns_verlet']:.0f} | {r['ns_midpoint']:.0f} | "
                      f"{_fmt(ref) if ref is not None else f'> {budget:.0f} (skipped)'} |")
     return lines

@@ -1,8 +1,12 @@
 """Forward dynamics and the Python convenience `accelerations` of a generated module.
 
-Two variants, chosen from the model:
+Three variants, chosen from the model:
 
-* H(q) depends on q: every call fills H and factors it (Cholesky, in numba).
+* H(q) depends on q and n is small (n <= UNROLL_MAX): one kernel computes the entries of H and
+  rhs into local variables (one CSE pass over both) and solves H qdd = rhs by an unrolled
+  LDL^T factorization written out for this n, with the same singularity test as
+  linalg.cholesky_inplace. No array is written but qdd.
+* H(q) depends on q, larger n: every call fills H and factors it (Cholesky, in numba).
 * H is constant: it is factored once, at import, for the default values of the parameters it
   depends on (MASS_FACTOR, lower Cholesky factor L with H = L L^T); a call evaluates only
   rhs = Q - h - g and does two triangular solves, unless the caller passes other values for
@@ -10,6 +14,13 @@ Two variants, chosen from the model:
 """
 
 from __future__ import annotations
+
+from .emit import local_name, render_kernel
+from .printer import Inputs
+from .spec import KernelSpec, Output
+
+#: Largest n whose forward dynamics is emitted as an unrolled LDL^T solve (module docstring).
+UNROLL_MAX = 4
 
 _GENERAL = '''@njit(cache=True, _nrt=False)
 def forward_dynamics(q, qd, t, p, H, qdd):
@@ -25,7 +36,7 @@ def forward_dynamics(q, qd, t, p, H, qdd):
 _CONSTANT = '''def _factor_mass_matrix(p):
     """Lower Cholesky factor (n, n) of the constant H at parameters p (ValueError if not SPD)."""
     L = np.empty((N_COORDS, N_COORDS))
-    mass_matrix(np.zeros(N_COORDS), p, L)
+    mass_matrix(np.zeros(N_COORDS), 0.0, p, L)
     if not cholesky_inplace(L):
         raise ValueError(f"{{NAME}}: the constant mass matrix is not positive definite at the defaults")
     return np.tril(L)          # the upper triangle still held H
@@ -45,7 +56,7 @@ def forward_dynamics(q, qd, t, p, H, qdd):
     if {test}:
         cholesky_solve_inplace(MASS_FACTOR, qdd)
         return OK
-    mass_matrix(q, p, H)
+    mass_matrix(q, t, p, H)
     if not cholesky_inplace(H):
         return SINGULAR_MASS
     cholesky_solve_inplace(H, qdd)
@@ -79,9 +90,51 @@ def factor_at_import(dyn) -> bool:
     return all(d is not None for s, d in zip(dyn.params, dyn.model.defaults()) if s.name in used)
 
 
+def unrolled_solve_lines(n, H="H", b="rhs", out="qdd"):
+    """Statements solving H x = b (n x n, SPD) by LDL^T written out for this n, reading the
+    locals H_j_k (upper triangle, j <= k) and b_i, writing out[i]. They return SINGULAR_MASS
+    exactly where linalg.cholesky_inplace fails: diagonal scale not positive and finite, or a
+    pivot d_j <= SINGULAR_RTOL * scale (d_j is the square of Cholesky's pivot)."""
+    def Hu(j, k):
+        return local_name(H, min(j, k), max(j, k))
+    diag = ", ".join(f"abs({Hu(i, i)})" for i in range(n))
+    lines = [f"scale = {f'max({diag})' if n > 1 else diag}",
+             "if not (scale > 0.0 and scale < math.inf):", "    return SINGULAR_MASS",
+             "tiny = SINGULAR_RTOL * scale"]
+    for j in range(n):
+        for k in range(j):                       # e_j_k = L_j_k d_k, used by row j and below
+            lines.append(f"e_{j}_{k} = L_{j}_{k} * d_{k}")
+        lines.append(f"d_{j} = {Hu(j, j)}" + "".join(f" - L_{j}_{k} * e_{j}_{k}" for k in range(j)))
+        lines += [f"if not (d_{j} > tiny):", "    return SINGULAR_MASS"]
+        for i in range(j + 1, n):
+            num = Hu(i, j) + "".join(f" - L_{i}_{k} * e_{j}_{k}" for k in range(j))
+            lines.append(f"L_{i}_{j} = ({num}) / d_{j}" if j else f"L_{i}_{j} = {num} / d_{j}")
+    for i in range(n):                           # L y = b, then y / d, then L^T x = y / d
+        lines.append(f"y_{i} = {local_name(b, i)}" + "".join(f" - L_{i}_{k} * y_{k}" for k in range(i)))
+    for i in reversed(range(n)):
+        lines.append(f"x_{i} = y_{i} / d_{i}" + "".join(f" - L_{k}_{i} * x_{k}" for k in range(i + 1, n)))
+    lines += [f"{out}[{i}] = x_{i}" for i in range(n)]
+    return lines + ["return OK"]
+
+
+def unrolled_forward_text(dyn) -> str:
+    """forward_dynamics as one kernel: H and rhs into locals, then the unrolled solve."""
+    nat = dyn.native
+    spec = KernelSpec(
+        "forward_dynamics", ["q", "qd", "t", "p"],
+        [Output("H", nat["H"], symmetric=True, local=True), Output("rhs", nat["rhs"], local=True)],
+        doc=("Solve H(q) qdd = rhs = Q - h - g by LDL^T written out for n = "
+             f"{dyn.n}; H (n, n) is not used (kept for the common signature), qdd (n,) the "
+             "output. Returns OK, or SINGULAR_MASS when H is not numerically positive definite"),
+        out_args=["H", "qdd"], epilogue=unrolled_solve_lines(dyn.n))
+    return render_kernel(spec, Inputs(dyn)).function
+
+
 def forward_source(dyn) -> str:
     """Source of forward_dynamics and accelerations for this model (see the module docstring)."""
     if not factor_at_import(dyn):
+        if not dyn.mass_is_constant and dyn.n <= UNROLL_MAX:
+            return unrolled_forward_text(dyn) + "\n" + _ACCELERATIONS
         return _GENERAL + _ACCELERATIONS
     used = {str(s) for s in dyn.native["H"].free_symbols}
     checks = [f"p[{k}] == {float(d)!r}" for k, (s, d) in enumerate(zip(dyn.params, dyn.model.defaults()))
