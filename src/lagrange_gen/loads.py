@@ -19,12 +19,30 @@ class PointForce:
     ``point``: position of the application point, 2 or 3 expressions in q (and t).
     ``force``: the force vector, same length, expressions in q, qdot and t.
     Q_j = sum_k force_k * d point_k / d q_j.
+
+    Or, with sympy.physics.mechanics: ``point`` a mechanics Point and ``force`` a Vector; the
+    Model (given its inertial ``frame=``) converts it through the partial velocities of the
+    point (lagrange_gen.mechanics; ``mechanics`` is then True).
     """
 
     point: tuple
     force: tuple
+    mechanics: bool = False
 
     def __init__(self, point, force):
+        if "sympy.physics" in type(point).__module__ or "sympy.physics" in type(force).__module__:
+            from .mechanics import is_mechanics_load
+            if not is_mechanics_load((point, force)):
+                raise ModelError(f"PointForce: with sympy.physics.mechanics give a Point and a "
+                                 f"Vector, got {type(point).__name__} and {type(force).__name__}")
+            for key, value in (("point", point), ("force", force), ("mechanics", True)):
+                object.__setattr__(self, key, value)
+            return
+        try:
+            point, force = tuple(point), tuple(force)
+        except TypeError:
+            raise ModelError(f"PointForce: point and force must be sequences of 2 or 3 expressions "
+                             f"(or a mechanics Point and Vector), got {point!r} and {force!r}") from None
         point = tuple(sp.sympify(e) for e in point)
         force = tuple(sp.sympify(e) for e in force)
         if len(point) != len(force):

@@ -104,7 +104,8 @@ def test_one_broken_model_does_not_stop_the_others(tmp_path):
     assert result.returncode != 0
     assert "Traceback" not in result.stderr
     err = result.stderr.strip().splitlines()
-    assert len(err) == 2 and "broken.py" in err[0] and "exits.py" in err[1], result.stderr
+    assert len(err) == 3 and "broken.py" in err[0] and "exits.py" in err[1], result.stderr
+    assert err[2] == f"lagrange-gen: 2 of 3 model files failed: {files[0]}, {files[1]}"
     assert (out / "good.py").is_file()
     check = run(CLI, "--check", *files, "-o", out, *ONE_METHOD)
     assert check.returncode != 0 and "Traceback" not in check.stderr
