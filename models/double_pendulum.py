@@ -2,7 +2,7 @@
 on massless rods l1, l2."""
 import sympy as sp
 
-from lagrange_gen import Model, coordinates, parameters
+from lagrange_gen import Drawing, Model, coordinates, parameters
 
 th1, th2 = coordinates("th1 th2")
 m1, m2, l1, l2, g = parameters("m1 m2 l1 l2 g", defaults=(1.0, 1.0, 1.0, 1.0, 9.81))
@@ -16,4 +16,6 @@ T = m1 * v1sq / 2 + m2 * v2sq / 2
 V = m1 * g * y1 + m2 * g * y2
 
 model = Model("double_pendulum", coords=[th1, th2], T=T, V=V,
-              description="Planar double pendulum in absolute angles.")
+              description="Planar double pendulum in absolute angles.",
+              draw=Drawing(points={"pivot": (0, 0), "m1": (x1, y1), "m2": (x2, y2)},
+                           segments=[("pivot", "m1"), ("m1", "m2")]))

@@ -9,7 +9,7 @@ so rattle runs its Newton path here.
 """
 import sympy as sp
 
-from lagrange_gen import Model, coordinates, parameters
+from lagrange_gen import Drawing, Model, coordinates, parameters
 
 th1, th2, th3 = coordinates("th1 th2 th3")
 a, b, c, d, m1, m2, m3, g = parameters("a b c d m1 m2 m3 g",
@@ -26,4 +26,9 @@ Phi = [a * sp.cos(th1) + b * sp.cos(th2) - c * sp.cos(th3) - d,
        a * sp.sin(th1) + b * sp.sin(th2) - c * sp.sin(th3)]
 
 model = Model("four_bar", coords=[th1, th2, th3], T=T, V=V, constraints=Phi,
-              description="Four-bar crank-rocker linkage in absolute angles, two loop constraints.")
+              description="Four-bar crank-rocker linkage in absolute angles, two loop constraints.",
+              # C is drawn from both sides (coupler end, rocker end): a drift shows as a gap
+              draw=Drawing(points={"A": (0, 0), "B": (a * sp.cos(th1), a * sp.sin(th1)),
+                                   "C": (a * sp.cos(th1) + b * sp.cos(th2), a * sp.sin(th1) + b * sp.sin(th2)),
+                                   "C_rocker": (d + c * sp.cos(th3), c * sp.sin(th3)), "D": (d, 0)},
+                           segments=[("A", "B"), ("B", "C"), ("C_rocker", "D"), ("D", "A")]))

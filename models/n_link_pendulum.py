@@ -3,7 +3,7 @@ vertical. `n_link_pendulum(n)` builds the model; `lagrange-gen models/n_link_pen
 generates generated/n_link_pendulum_8.py. The file's default `model` has n = 3."""
 import sympy as sp
 
-from lagrange_gen import Model, coordinates, parameters
+from lagrange_gen import Drawing, Model, coordinates, parameters
 
 
 def n_link_pendulum(n=3):
@@ -17,15 +17,18 @@ def n_link_pendulum(n=3):
     # those sums so its Hessian is H directly, with no expansion.
     x = y = vx = vy = 0
     T = V = 0
+    points = {"pivot": (0, 0)}
     for k in range(n):
         x += l * sp.sin(th[k])
         y -= l * sp.cos(th[k])
+        points[f"m{k + 1}"] = (x, y)
         vx += l * sp.cos(th[k]) * th[k].d
         vy += l * sp.sin(th[k]) * th[k].d
         T += m * (vx**2 + vy**2) / 2
         V += m * g * y
     return Model(f"n_link_pendulum_{n}", coords=th, T=T, V=V,
-                 description=f"Planar {n}-link pendulum, equal point masses and rods.")
+                 description=f"Planar {n}-link pendulum, equal point masses and rods.",
+                 draw=Drawing(points, segments=list(zip(points, list(points)[1:]))))
 
 
 build = n_link_pendulum

@@ -7,12 +7,14 @@ exit (``--debug`` shows the traceback).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 
+from .cli_options import BUILD, NUMBER, one_line_warnings, parse_assignments
 from .errors import LagrangeGenError
 
-SUBCOMMANDS = ("simulate", "sweep", "bench", "identify")
+SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate")
 
 _EPILOG = """\
 examples:
@@ -23,10 +25,13 @@ examples:
   lagrange-gen --methods verlet,midpoint models/double_pendulum.py
   lagrange-gen --freeze g=9.81,l=1 models/n_link_pendulum.py --set n=16
   lagrange-gen simulate models/cart_pendulum.py --method midpoint --h 1e-3 --t-end 10
+  lagrange-gen simulate models/n_link_pendulum.py --set n=4 --method rk4 --h 1e-3 --t-end 5
+  lagrange-gen equations models/cart_pendulum.py [--latex]   print H, h, g, Q (Phi, J, gamma)
   lagrange-gen sweep models/cart_pendulum.py --method rk4 --h 1e-3 --t-end 10 \\
       --grid k=1:100:50 --grid m=0.1:1:20 --out sweep.npz --plot sweep.png
   lagrange-gen bench --help
   lagrange-gen identify cycle.csv --kind prandtl --elements 3
+  lagrange-gen animate traj.npz --out traj.gif    the model's draw= along a saved run
 
 A model file builds a lagrange_gen.Model from SymPy expressions and assigns it to `model`
 (see models/cart_pendulum.py). The generated module holds numba kernels (dynamics, energy,
@@ -35,40 +40,25 @@ or use `lagrange-gen simulate`.
 """
 
 
-def _parse_options(pairs):
-    options = {}
-    for pair in pairs or []:
-        if "=" not in pair:
-            raise LagrangeGenError(f"--set {pair}: expected NAME=VALUE")
-        key, value = pair.split("=", 1)
-        for convert in (int, float):
-            try:
-                value = convert(value)
-                break
-            except ValueError:
-                continue
-        options[key.strip()] = value
-    return options
-
-
 def generate_parser():
     p = argparse.ArgumentParser(
         prog="lagrange-gen",
         description="Derive equations of motion from SymPy model files and write numba kernels "
-                    "into generated/. Subcommands: simulate, bench, identify (lagrange-gen SUBCOMMAND --help).",
+                    "into generated/. Subcommands: simulate, sweep, equations, bench, identify "
+                    "(lagrange-gen SUBCOMMAND --help).",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
-    p.add_argument("-o", "--out-dir", default="generated", metavar="DIR",
+    p.add_argument("-o", "--out-dir", "--gen-dir", default="generated", metavar="DIR", dest="out_dir",
                    help="directory for generated modules (default: generated)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 when a generated file is missing or stale")
     p.add_argument("--methods", metavar="M1,M2",
                    help="emit glue only for these steppers (default: all)")
-    p.add_argument("--freeze", metavar="NAME=VALUE,...",
+    p.add_argument("--freeze", action="append", metavar="NAME=VALUE,...",
                    help="fold these parameters into the kernels as constants (e.g. g=9.81,l=1); "
-                        "they leave PARAMS and cannot be passed at run time")
-    p.add_argument("--set", action="append", metavar="NAME=VALUE", dest="options",
-                   help="option passed to the model file's build() (e.g. n=8), repeatable")
+                        "they leave PARAMS and cannot be passed at run time; repeatable")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
+                   help="options passed to the model file's build() (e.g. n=8), repeatable")
     p.add_argument("--force", action="store_true",
                    help="overwrite a generated file even when it was generated from another model "
                         "file with the same model name (or was not written by lagrange-gen)")
@@ -78,15 +68,20 @@ def generate_parser():
 
 def run_generate(args) -> int:
     """Generate (or --check) every model file given: a failing model is one line on stderr and
-    does not stop the others; exit 2 if any failed, 1 if any is missing or stale (--check)."""
-    from .derive.freeze import parse_freeze
+    does not stop the others; with several files, a last line lists the failed ones. Exit 2 if
+    any failed, 1 if any is missing or stale (--check)."""
+    from .errors import GenerationError
     methods = args.methods.split(",") if args.methods else None
-    options = _parse_options(args.options)
-    freeze = parse_freeze(args.freeze)
+    options = parse_assignments(args.options, "--set", BUILD)
+    freeze = parse_assignments(args.freeze, "--freeze", NUMBER, GenerationError)
     action = _check_one if args.check else _generate_one
     outcomes = [for_each_model(path, args.debug, action, path, args, methods, options, freeze)
                 for path in args.models]
-    return 2 if None in outcomes else 1 if False in outcomes else 0
+    failed = [str(path) for path, ok in zip(args.models, outcomes) if ok is None]
+    if failed and len(args.models) > 1:
+        print(f"lagrange-gen: {len(failed)} of {len(args.models)} model files failed: "
+              f"{', '.join(failed)}", file=sys.stderr)
+    return 2 if failed else 1 if False in outcomes else 0
 
 
 def _generate_one(path, args, methods, options, freeze):
@@ -142,6 +137,10 @@ def _subcommand_parser(name):
         from .cli_sweep import add_parser
     elif name == "identify":
         from .identify.cli import add_parser
+    elif name == "equations":
+        from .cli_equations import add_parser
+    elif name == "animate":
+        from .cli_animate import add_parser
     else:
         from .bench.cli import add_parser
     add_parser(sub)
@@ -155,6 +154,10 @@ def _run_subcommand(args) -> int:
         from .cli_sweep import run
     elif args.command == "identify":
         from .identify.cli import run
+    elif args.command == "equations":
+        from .cli_equations import run
+    elif args.command == "animate":
+        from .cli_animate import run
     else:
         from .bench.cli import run
     return run(args)
@@ -164,12 +167,8 @@ def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
     try:
-        if argv and argv[0] in SUBCOMMANDS:
-            argv = [a for a in argv if a != "--debug"]
-            args = _subcommand_parser(argv[0]).parse_args(argv)
-            return _run_subcommand(args)
-        args = generate_parser().parse_args(argv)
-        return run_generate(args)
+        with one_line_warnings():
+            return _dispatch(argv)
     except LagrangeGenError as exc:
         if debug:
             raise
@@ -178,6 +177,18 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("lagrange-gen: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:         # `lagrange-gen equations ... | head`: the reader left
+        sys.stdout = open(os.devnull, "w")
+        return 0
+
+
+def _dispatch(argv):
+    if argv and argv[0] in SUBCOMMANDS:
+        argv = [a for a in argv if a != "--debug"]
+        args = _subcommand_parser(argv[0]).parse_args(argv)
+        return _run_subcommand(args)
+    args = generate_parser().parse_args(argv)
+    return run_generate(args)
 
 
 if __name__ == "__main__":

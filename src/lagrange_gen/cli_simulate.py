@@ -14,11 +14,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
-import warnings
 from pathlib import Path
 
+from .cli_options import BUILD, NUMBER, one_line_warnings, parse_assignments, velocity_names
 from .errors import SimulationError
 from .steppers.registry import INFO, METHODS
 from .steppers.spec import SETTING_HELP
@@ -48,8 +47,14 @@ def add_parser(subparsers):
                    help="initial coordinates (default 0)")
     p.add_argument("--v0", type=float, nargs="+", metavar="V",
                    help="initial velocities (default 0)")
-    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="parameter value, repeatable (default: the model's defaults)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE,...",
+                   help="parameter values, e.g. k=20,m=0.5; repeatable (default: the model's "
+                        "defaults)")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
+                   help="options passed to the model file's build() (e.g. n=8), repeatable")
+    p.add_argument("--keep", action="append", metavar="NAME,...",
+                   help="constrained models: velocities (e.g. theta_dot) whose v0 is kept when "
+                        "v0 is projected onto J v = 0; the others are solved for")
     p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
     p.add_argument("--t-eval", type=float, nargs="+", metavar="T",
                    help="adaptive methods: save the states at these times (default: every step)")
@@ -101,16 +106,8 @@ def _given_settings(args):
 
 
 def _parse_params(pairs):
-    params = {}
-    for pair in pairs:
-        name, sep, value = pair.partition("=")
-        if not sep or not name.strip():
-            raise SimulationError(f"--param {pair}: expected NAME=VALUE")
-        try:
-            params[name.strip()] = float(value)
-        except ValueError:
-            raise SimulationError(f"--param {pair}: {value!r} is not a number") from None
-    return params
+    """--param values (a list of 'a=1,b=2') -> {name: float}; SimulationError when malformed."""
+    return parse_assignments(pairs, "--param", NUMBER, SimulationError)
 
 
 def _vector(values):
@@ -142,22 +139,23 @@ def check_output_path(option, path, suffixes):
 
 def run(args) -> int:
     """Run the subcommand; returns the exit status."""
-    from .simulation import simulate
+    from .simulation import load_module, simulate
     if args.out:
         check_output_path("--out", args.out, OUT_SUFFIXES)
     if args.plot:
         check_output_path("--plot", args.plot, PLOT_SUFFIXES)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            traj = simulate(args.model, args.method, args.q0, args.v0, t_end=args.t_end,
-                            h=args.h, params=_parse_params(args.param),
-                            save_every=args.save_every, t_eval=args.t_eval, t0=args.t0,
-                            progress=args.progress, out_dir=args.gen_dir, force=args.force,
-                            **_given_settings(args))
-        finally:
-            for warning in caught:      # one line each, also when the run then failed
-                print(f"lagrange-gen: warning: {warning.message}", file=sys.stderr)
+    params = _parse_params(args.param)
+    options = parse_assignments(args.options, "--set", BUILD, SimulationError)
+    keep = velocity_names(args.keep)
+    with one_line_warnings():       # one line each, also when the run then fails
+        model = args.model
+        if options:
+            model = load_module(model, args.gen_dir, args.method, args.force, options=options)
+        traj = simulate(model, args.method, args.q0, args.v0, t_end=args.t_end,
+                        h=args.h, params=params, save_every=args.save_every,
+                        t_eval=args.t_eval, t0=args.t0, progress=args.progress,
+                        out_dir=args.gen_dir, force=args.force, keep=keep,
+                        **_given_settings(args))
     _summary(traj)
     _write_outputs(traj, args.out, args.plot)
     return 0
@@ -175,7 +173,11 @@ def _summary(traj):
     print(f"wall time {traj.wall_time:.3f} s ({per_step * 1e9:.0f} ns/step), "
           f"compile/load {traj.compile_time:.2f} s")
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")
-    print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
+    if traj.work is None:
+        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
+    else:       # forced, damped or rheonomic: E changes by the work W done on the system
+        print(f"max |E - E0 - W| = {traj.max_energy_balance_error:.3e} (E0 = {traj.energy[0]:.9g}, "
+              f"final W = {traj.work[-1]:.6g})")
     if traj.constraint_names:
         print(f"max |Phi| = {traj.constraint_error.max():.3e}, "
               f"max |J v| = {traj.velocity_constraint_error.max():.3e}")

@@ -15,10 +15,10 @@ mean the same; cli.py wires ``add_parser`` and ``run`` in.
 from __future__ import annotations
 
 import sys
-import warnings
 
 import numpy as np
 
+from .cli_options import BUILD, one_line_warnings, parse_assignments
 from .cli_simulate import (_add_setting_options, _given_settings, _parse_params,
                            check_output_path)
 from .errors import SimulationError
@@ -49,8 +49,10 @@ def add_parser(subparsers):
     p.add_argument("--t-end", type=float, required=True, help="final time")
     p.add_argument("--q0", type=float, nargs="+", metavar="Q", help="initial coordinates")
     p.add_argument("--v0", type=float, nargs="+", metavar="V", help="initial velocities")
-    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="a parameter shared by every member")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE,...",
+                   help="parameters shared by every member, e.g. k=20,m=0.5; repeatable")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
+                   help="options passed to the model file's build() (e.g. n=8), repeatable")
     p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
     p.add_argument("--scalar", default="final_energy", choices=sorted(SCALARS),
                    help="; ".join(f"{k}: {text}" for k, (text, _) in SCALARS.items()))
@@ -101,16 +103,16 @@ def run(args) -> int:
     both = sorted(set(shared) & set(axes))
     if both:
         raise SimulationError(f"parameter {both[0]!r} is given both by --grid and --param")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        try:
-            result = ensemble(args.model, args.method, q0=args.q0, v0=args.v0,
-                              params={**shared, **grid(**axes)}, t_end=args.t_end, h=args.h,
-                              save_every=args.save_every, progress=args.progress,
-                              out_dir=args.gen_dir, **_given_settings(args))
-        finally:
-            for warning in caught:
-                print(f"lagrange-gen: warning: {warning.message}", file=sys.stderr)
+    options = parse_assignments(args.options, "--set", BUILD, SimulationError)
+    with one_line_warnings():
+        model = args.model
+        if options:
+            from .simulation import load_module
+            model = load_module(model, args.gen_dir, args.method, options=options)
+        result = ensemble(model, args.method, q0=args.q0, v0=args.v0,
+                          params={**shared, **grid(**axes)}, t_end=args.t_end, h=args.h,
+                          save_every=args.save_every, progress=args.progress,
+                          out_dir=args.gen_dir, **_given_settings(args))
     coord = _coord_index(result, args.coord)
     scalar = SCALARS[args.scalar][1](result, coord)
     scalar = np.where(result.ok, scalar, np.nan)

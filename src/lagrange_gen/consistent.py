@@ -1,6 +1,9 @@
-"""Consistent initial conditions for models with holonomic constraints Phi(q) = 0.
+"""Consistent initial conditions for models with holonomic constraints Phi(q, t) = 0.
 
-A constrained method needs q0 on the manifold Phi(q0) = 0 and v0 tangent to it, J(q0) v0 = 0.
+A constrained method needs q0 on the manifold Phi(q0, t0) = 0 and v0 satisfying the velocity
+constraint J(q0) v0 + dPhi/dt = 0 (tangent to the manifold when the constraints are
+scleronomic; dPhi/dt from the generated ``constraint_rate``). Every function takes the time t
+(default 0) at which the constraints are evaluated.
 ``consistent_initial_state`` projects a user's (q0, v0) there and warns by how much it moved them:
 
 * positions: Gauss-Newton with the minimum-norm step in the metric of H(q) (the kinetic-energy
@@ -10,7 +13,11 @@ A constrained method needs q0 on the manifold Phi(q0) = 0 and v0 tangent to it, 
   the constraints still violated when Phi cannot be brought to zero from q0 (no real solution
   nearby, or the iteration reaches a point where J loses rank);
 * velocities: the closest tangent velocity in the same metric (least squares),
-      v = v0 - H^-1 J^T (J H^-1 J^T)^-1 J v0;
+      v = v0 - H^-1 J^T (J H^-1 J^T)^-1 (J v0 + dPhi/dt);
+  with ``keep`` (velocity names), the kept velocities stay and only the others (F) change, by
+  the same formula on the free block: dv_F = -H_FF^-1 J_F^T (J_F H_FF^-1 J_F^T)^+ (J v0 +
+  dPhi/dt); a ConstraintError when J v + dPhi/dt = 0 cannot be met that way (J_F lacks rank
+  for the kept values);
 * multipliers lam0 from the acceleration-level KKT system at (q, v), the constraint forces of
   the initial state (row 0 of Trajectory.multipliers).
 
@@ -52,19 +59,27 @@ class ConsistentState:
     dv: float
 
 
-def evaluate(module, q, v, p):
-    """Phi (m,), J (m, n), gamma (m,) at (q, v) from the generated ``constraints`` kernel."""
+def evaluate(module, q, v, p, t=0.0):
+    """Phi (m,), J (m, n), gamma (m,) at (q, v, t) from the generated ``constraints`` kernel."""
     n, m = module.N_COORDS, module.N_CONSTRAINTS
     phi, J, gamma = np.empty(m), np.empty((m, n)), np.empty(m)
     module.constraints(np.ascontiguousarray(q, dtype=float), np.ascontiguousarray(v, dtype=float),
-                       p, phi, J, gamma)
+                       float(t), p, phi, J, gamma)
     return phi, J, gamma
 
 
-def mass(module, q, p):
+def rate(module, q, p, t=0.0):
+    """dPhi/dt (m,) at (q, t) (zeros for scleronomic constraints)."""
+    out = np.zeros(module.N_CONSTRAINTS)
+    if getattr(module, "CONSTRAINTS_RHEONOMIC", False):
+        module.constraint_rate(np.ascontiguousarray(q, dtype=float), float(t), p, out)
+    return out
+
+
+def mass(module, q, p, t=0.0):
     n = module.N_COORDS
     H = np.empty((n, n))
-    module.mass_matrix(np.ascontiguousarray(q, dtype=float), p, H)
+    module.mass_matrix(np.ascontiguousarray(q, dtype=float), float(t), p, H)
     return H
 
 
@@ -86,9 +101,9 @@ def dependent_constraints(J):
     return tuple(int(i) for i in np.flatnonzero(np.abs(null) > 1e-6 * np.abs(null).max()))
 
 
-def check_rank(module, q, p, where="at q0"):
+def check_rank(module, q, p, where="at q0", t=0.0):
     """Raise ConstraintError naming the dependent constraints when J(q) is rank-deficient."""
-    _, J, _ = evaluate(module, q, np.zeros_like(q), p)
+    _, J, _ = evaluate(module, q, np.zeros_like(q), p, t)
     bad = dependent_constraints(J)
     if bad:
         names = "; ".join(constraint_label(module, i) for i in bad)
@@ -116,10 +131,10 @@ def _min_norm_step(H, J, r):
     return Y @ np.linalg.solve(J @ Y, r)
 
 
-def project_positions(module, q0, p, tol=1e-12, max_iter=50):
-    """q on Phi(q) = 0 near q0 (see the module docstring). Raises ConstraintError."""
+def project_positions(module, q0, p, tol=1e-12, max_iter=50, t=0.0):
+    """q on Phi(q, t) = 0 near q0 (see the module docstring). Raises ConstraintError."""
     q = np.array(q0, dtype=float)
-    phi, J, _ = evaluate(module, q, np.zeros_like(q), p)
+    phi, J, _ = evaluate(module, q, np.zeros_like(q), p, t)
     norm = np.abs(phi).max(initial=0.0)
     for _ in range(max_iter):
         if scaled_violation(phi, J, q) <= 1e-3 * tol:
@@ -127,13 +142,13 @@ def project_positions(module, q0, p, tol=1e-12, max_iter=50):
         if dependent_constraints(J):
             break
         try:
-            dq = -_min_norm_step(mass(module, q, p), J, phi)
+            dq = -_min_norm_step(mass(module, q, p, t), J, phi)
         except np.linalg.LinAlgError:
             break
         step = 1.0
         while step > 1e-8:
             trial = q + step * dq
-            phi_t, J_t, _ = evaluate(module, trial, np.zeros_like(q), p)
+            phi_t, J_t, _ = evaluate(module, trial, np.zeros_like(q), p, t)
             if np.abs(phi_t).max() < norm or scaled_violation(phi_t, J_t, trial) <= tol:
                 break
             step *= 0.5
@@ -150,11 +165,42 @@ def project_positions(module, q0, p, tol=1e-12, max_iter=50):
         f"equations and parameters, or give a q0 closer to Phi(q) = 0")
 
 
-def project_velocities(module, q, v0, p):
-    """The tangent velocity closest to v0 in the metric of H(q): J(q) v = 0."""
-    _, J, _ = evaluate(module, q, v0, p)
+def project_velocities(module, q, v0, p, keep=(), t=0.0):
+    """The velocity closest to v0 in the metric of H(q) with J(q) v + dPhi/dt = 0, changing only
+    the velocities not named in ``keep`` (see the module docstring)."""
+    _, J, _ = evaluate(module, q, v0, p, t)
     v = np.array(v0, dtype=float)
-    return v - _min_norm_step(mass(module, q, p), J, J @ v)
+    H, phi_t = mass(module, q, p, t), rate(module, q, p, t)
+    if not keep:
+        return v - _min_norm_step(H, J, J @ v + phi_t)
+    kept = kept_indices(module, keep)
+    free = np.array([i for i in range(len(v)) if i not in kept], dtype=int)
+    r = J @ v + phi_t
+    if free.size:
+        Y = np.linalg.solve(H[np.ix_(free, free)], J[:, free].T)
+        v[free] -= Y @ np.linalg.lstsq(J[:, free] @ Y, r, rcond=None)[0]
+    residual = np.abs(J @ v + phi_t).max(initial=0.0)
+    if residual > 1e-9 * max(1.0, float(np.abs(v0).max(initial=0.0))) * max(1.0, float(np.abs(J).max())):
+        names = [f"{module.COORDS[i]}_dot" for i in sorted(kept)]
+        raise ConstraintError(
+            f"{module.NAME}: keeping {', '.join(names)} at v0 leaves J v = 0 unsolvable (max|J v| "
+            f"= {residual:.3g} at best with the other velocities free): keep fewer velocities, or "
+            f"give kept values that satisfy the constraints")
+    return v
+
+
+def kept_indices(module, keep):
+    """Indices of the velocities named in ``keep`` (theta_dot, or the coordinate theta);
+    SimulationError naming an unknown one."""
+    names = [f"{c}_dot" for c in module.COORDS]
+    out = set()
+    for name in keep:
+        key = name if name in names else f"{name}_dot"
+        if key not in names:
+            raise SimulationError(f"{module.NAME}: keep {name!r} is not a velocity (velocities: "
+                                  f"{', '.join(names)})")
+        out.add(names.index(key))
+    return out
 
 
 def initial_multipliers(module, q, v, t, p):
@@ -162,26 +208,28 @@ def initial_multipliers(module, q, v, t, p):
     n, m = module.N_COORDS, module.N_CONSTRAINTS
     H, rhs = np.empty((n, n)), np.empty(n)
     module.dynamics(q, v, float(t), p, H, rhs)
-    _, J, gamma = evaluate(module, q, v, p)
+    _, J, gamma = evaluate(module, q, v, p, t)
     K = np.block([[H, -J.T], [J, np.zeros((m, m))]])
     return np.linalg.solve(K, np.concatenate((rhs, gamma)))[n:]
 
 
-def consistent_initial_state(module, q0, v0, p, t0=0.0, tol=1e-12, warn=True, stacklevel=2):
+def consistent_initial_state(module, q0, v0, p, t0=0.0, tol=1e-12, warn=True, stacklevel=2,
+                             keep=None):
     """Project (q0, v0) onto the constraint manifold and its tangent space; ConsistentState.
 
     Warns (UserWarning) with the size of the violation and of the correction when q0 or v0 was
     off by more than the tolerance (in the scaled measure of ``scaled_violation``). Raises
     ConstraintError for redundant constraints or constraints that cannot be satisfied.
-    stacklevel: of the warnings, as for warnings.warn (2: the caller of this function)."""
+    stacklevel: of the warnings, as for warnings.warn (2: the caller of this function).
+    keep: velocity names whose v0 the velocity projection keeps (project_velocities)."""
     q0, v0 = np.asarray(q0, dtype=float), np.asarray(v0, dtype=float)
-    check_rank(module, q0, p)
-    phi0, J0, _ = evaluate(module, q0, v0, p)
-    q = project_positions(module, q0, p, tol) if scaled_violation(phi0, J0, q0) > 1e-3 * tol else q0
-    check_rank(module, q, p, where=f"at the projected q0 = {q.tolist()}")
-    _, J, _ = evaluate(module, q, v0, p)
-    jv0 = J @ v0
-    v = project_velocities(module, q, v0, p)
+    check_rank(module, q0, p, t=t0)
+    phi0, J0, _ = evaluate(module, q0, v0, p, t0)
+    q = project_positions(module, q0, p, tol, t=t0) if scaled_violation(phi0, J0, q0) > 1e-3 * tol else q0
+    check_rank(module, q, p, where=f"at the projected q0 = {q.tolist()}", t=t0)
+    _, J, _ = evaluate(module, q, v0, p, t0)
+    jv0 = J @ v0 + rate(module, q, p, t0)
+    v = project_velocities(module, q, v0, p, tuple(keep or ()), t0)
     dq, dv = float(np.abs(q - q0).max()), float(np.abs(v - v0).max())
     if warn and scaled_violation(phi0, J0, q0) > tol:
         worst = int(np.argmax(np.abs(phi0)))
@@ -193,12 +241,20 @@ def consistent_initial_state(module, q0, v0, p, t0=0.0, tol=1e-12, warn=True, st
     if warn and float((np.abs(jv0) / gscale).max()) > tol * vscale:
         warnings.warn(f"{module.NAME}: v0 is not tangent to the constraints (max|J v0| = "
                       f"{np.abs(jv0).max():.3g}); replaced by the closest tangent velocity in the "
-                      f"kinetic-energy metric, changing v0 by max|dv| = {dv:.3g}",
+                      f"kinetic-energy metric{_kept_phrase(module, keep)}, changing v0 by "
+                      f"max|dv| = {dv:.3g}",
                       stacklevel=stacklevel)
-    phi, J, _ = evaluate(module, q, v, p)
+    phi, J, _ = evaluate(module, q, v, p, t0)
     lam = initial_multipliers(module, q, v, t0, p)
     return ConsistentState(q=q, v=v, lam=lam, phi_norm=float(np.abs(phi).max()),
-                           jv_norm=float(np.abs(J @ v).max()), dq=dq, dv=dv)
+                           jv_norm=float(np.abs(J @ v + rate(module, q, p, t0)).max()), dq=dq, dv=dv)
+
+
+def _kept_phrase(module, keep):
+    if not keep:
+        return " (keep= / --keep names velocities to leave unchanged)"
+    names = [f"{module.COORDS[i]}_dot" for i in sorted(kept_indices(module, keep))]
+    return f" keeping {', '.join(names)}"
 
 
 def check_method(module, method):

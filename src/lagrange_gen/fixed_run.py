@@ -55,7 +55,7 @@ def integrate_fixed(task, q, v, out, progress):
     out["n_events"]. Returns (compile seconds, integration seconds). Raises the exception of a
     failure status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
-    last = np.empty(2 * n + 3 + out["extra"].shape[1])
+    last = np.zeros(2 * n + 4 + out["extra"].shape[1])     # the last entry: W (base.run_loop)
     compile_time = warm_up(task.run, q, v, t0, h, task.p, task.settings,
                            out["extra"][:1].copy(), last.copy(), out["events"][:0],
                            label=f"run_{task.method} for {m.NAME}")

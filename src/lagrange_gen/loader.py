@@ -202,12 +202,14 @@ def _kernel_args(module):
     p = np.ones(module.N_PARAMS)
     A, B, v = np.empty((n, n)), np.empty((n, n)), np.empty(n)
     return {
-        "mass_matrix": (q, p, A), "dynamics": (q, q, 0.0, p, A, v), "rhs": (q, q, 0.0, p, v),
+        "mass_matrix": (q, 0.0, p, A), "dynamics": (q, q, 0.0, p, A, v), "rhs": (q, q, 0.0, p, v),
         "energy": (q, q, 0.0, p), "momentum_rate": (q, q, 0.0, p, v),
         "rhs_jacobian": (q, q, 0.0, p, A, B), "momentum_rate_jacobian": (q, q, 0.0, p, A, B),
-        "mass_matvec_dq": (q, w, p, A),
-        "constraints": (q, q, p, np.empty(m), np.empty((m, n)), np.empty(m)),
-        "constraint_dq": (q, w, lam, p, np.empty((m, n)), A),
+        "mass_matvec_dq": (q, w, 0.0, p, A),
+        "constraints": (q, q, 0.0, p, np.empty(m), np.empty((m, n)), np.empty(m)),
+        "constraint_rate": (q, 0.0, p, np.empty(m)),
+        "transport": (q, 0.0, p, v), "power": (q, q, 0.0, p, np.empty(2 * n + 2)), "transport_dq": (q, 0.0, p, A),
+        "constraint_dq": (q, w, lam, 0.0, p, np.empty((m, n)), A),
         "elements": (q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))),
         "elements_hessian": (q, we, p, A),
         "forward_dynamics": (q, q, 0.0, p, A, v),

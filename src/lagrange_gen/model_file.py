@@ -18,7 +18,8 @@ def load_model(path, **options) -> Model:
     """Execute a model file and return its validated Model.
 
     With ``options`` the file must define ``build(**options)`` (e.g. ``n=8`` for the n-link
-    pendulum); otherwise it must assign a Model to ``model``. Every failure is a ModelError whose
+    pendulum); otherwise it assigns a Model to ``model`` or, failing that, defines a ``build()``
+    whose defaults give the model. Every failure is a ModelError whose
     message names the file.
     """
     path = Path(path)
@@ -84,9 +85,26 @@ def _pick_model(path, namespace, options):
                                  "`model`: assign the one to generate to `model`")
             if found:
                 model = next(iter(found.values()))[1]
+            elif callable(namespace.get("build")):
+                model = _build_with_defaults(path, namespace["build"])
     if not isinstance(model, Model):
         raise ModelError(f"{path}: defines no Model (assign one to a variable named `model`)")
     return model
+
+
+def _build_with_defaults(path, build):
+    """build() of a file that defines no Model: its defaults must give one."""
+    import inspect
+    try:
+        required = [name for name, par in inspect.signature(build).parameters.items()
+                    if par.default is par.empty and par.kind in (par.POSITIONAL_OR_KEYWORD,
+                                                                  par.KEYWORD_ONLY)]
+    except (TypeError, ValueError):
+        required = []
+    if required:
+        raise ModelError(f"{path}: defines no `model`, and build() needs {', '.join(required)}: "
+                         f"give them, e.g. --set {required[0]}=...")
+    return build()
 
 
 def _user_line(exc, resolved):

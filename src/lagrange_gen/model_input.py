@@ -7,7 +7,46 @@ from __future__ import annotations
 import sympy as sp
 
 from .errors import ModelError
-from .symbols import Coordinate, _check_name, t
+from .symbols import Coordinate, Parameter, Velocity, _check_name, t
+
+
+def _is_dynamicsymbol(c):
+    return (isinstance(c, sp.core.function.AppliedUndef) and len(c.args) == 1
+            and isinstance(c.args[0], sp.Symbol))
+
+
+def _mechanics_speeds(coords):
+    """[q(t)' for q(t) in coords] when every coordinate is a dynamicsymbol (the speeds that
+    sympy.physics.mechanics loads are converted with), else []."""
+    if not all(_is_dynamicsymbol(c) for c in coords):
+        return []
+    return [sp.Derivative(c, c.args[0]) for c in coords]
+
+
+def is_mechanics_load(item):
+    """A sympy.physics.mechanics load (lagrange_gen.mechanics.is_mechanics_load), cheaply False
+    for anything that cannot be one (no mechanics import)."""
+    from .loads import PointForce
+    if not (isinstance(item, tuple) or isinstance(item, PointForce)):
+        return False
+    from .mechanics import is_mechanics_load as check
+    return check(item)
+
+
+def _equation_as_expr(c):
+    """An sp.Eq(lhs, rhs) constraint as lhs - rhs (Phi = 0 means lhs = rhs); others unchanged."""
+    return c.lhs - c.rhs if isinstance(c, sp.Equality) else c
+
+
+def unknown_symbols_hint(unknown):
+    """A hint for symbols that are not part of the model: plain sp.Symbols are not parameters
+    (their defaults and order come from lagrange_gen.parameters); '' when none is plain."""
+    plain = sorted(str(s) for s in unknown if type(s) is sp.Symbol)
+    if not plain:
+        return ""
+    names = " ".join(plain)
+    return (f"; plain sp.symbols are not parameters: declare them with "
+            f"lagrange_gen.parameters({names!r}, defaults=...) (or coordinates() if they move)")
 
 
 def _convert_dynamicsymbols(coords):
@@ -22,7 +61,7 @@ def _convert_dynamicsymbols(coords):
         if isinstance(c, Coordinate):
             out.append(c)
             continue
-        if isinstance(c, sp.core.function.AppliedUndef) and len(c.args) == 1 and isinstance(c.args[0], sp.Symbol):
+        if _is_dynamicsymbol(c):
             time_sym = c.args[0]
             coord = Coordinate(str(c.func))
             replace[sp.Derivative(c, time_sym)] = coord.d
@@ -30,7 +69,9 @@ def _convert_dynamicsymbols(coords):
             replace[time_sym] = t
             out.append(coord)
             continue
-        raise ModelError(f"coordinate {c!r} is neither a Coordinate nor a dynamicsymbol q(t)")
+        hint = (f" (declare it with lagrange_gen.coordinates({str(c)!r}), or as a "
+                "sympy.physics.mechanics dynamicsymbol)" if isinstance(c, sp.Symbol) else "")
+        raise ModelError(f"coordinate {c!r} is neither a Coordinate nor a dynamicsymbol q(t){hint}")
     if replace:
         # Derivatives must be replaced before the functions they contain.
         derivs = {k: v for k, v in replace.items() if isinstance(k, sp.Derivative)}
@@ -157,4 +198,44 @@ def _events(model_name, events, replace):
         named = Event(expr, bool(terminal), int(direction))
         named.name = name
         out.append(named)
+    return out
+
+
+def _prescriptions(model_name, prescribed, coords, replace):
+    """``prescribed`` {Coordinate: expression of t and parameters} checked: {Coordinate: sympy
+    expression}. ModelError (one line naming the symbol) for a key that is not a Coordinate or
+    is also in coords, and for an expression using a coordinate, a velocity or another symbol."""
+    if prescribed is None:
+        return {}
+    if not isinstance(prescribed, dict):
+        raise ModelError(f"model {model_name}: prescribed must be a dict {{coordinate: expression of t}}, "
+                         f"got {prescribed!r}")
+    out = {}
+    for c, given in prescribed.items():
+        c = replace.get(c, c) if replace else c
+        if not isinstance(c, Coordinate):
+            raise ModelError(f"model {model_name}: prescribed key {c!r} is not a Coordinate "
+                             "(declare it with coordinates() and leave it out of coords)")
+        if c in coords:
+            raise ModelError(f"model {model_name}: prescribed coordinate {c} is also in coords; "
+                             "a coordinate is either free (coords) or prescribed, not both")
+        try:
+            expr = _sympify(given, f"prescription of {c}", replace)
+        except ModelError as exc:
+            raise ModelError(f"model {model_name}: {exc}") from None
+        for s in sorted(expr.free_symbols, key=str):
+            if isinstance(s, Velocity):
+                raise ModelError(f"model {model_name}: prescription of {c} uses the velocity {s}; "
+                                 "a prescribed coordinate is a function of t and parameters only")
+            if isinstance(s, Coordinate):
+                raise ModelError(f"model {model_name}: prescription of {c} uses the coordinate {s}; "
+                                 "a prescribed coordinate is a function of t and parameters only "
+                                 "(a relation between coordinates is a constraint)")
+            if not (isinstance(s, Parameter) or s == t):
+                raise ModelError(f"model {model_name}: prescription of {c} uses the symbol {s}, which "
+                                 "is neither a parameter nor t")
+        if expr.has(sp.Derivative) or expr.atoms(sp.core.function.AppliedUndef):
+            raise ModelError(f"model {model_name}: prescription of {c} contains an undefined function "
+                             f"or derivative: {expr}")
+        out[c] = expr
     return out

@@ -31,31 +31,36 @@ from .errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
 from .fixed_run import allocate, integrate_fixed, n_steps_to
 from .keys import regeneration_command_for
-from .params import resolve_params
+from .control import attach_inputs_outputs, controlled_run, resolve_inputs
 from .steppers import registry
-from .steppers.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
+from .steppers.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK
 from .steppers.spec import make_settings
 from .trajectory import Trajectory
 
 __all__ = ["simulate", "Trajectory", "load_module"]
 
 
-def load_module(module_or_path, out_dir="generated", method=None, force=False):
+def load_module(module_or_path, out_dir="generated", method=None, force=False, options=None):
     """A generated module from: the module itself, a generated .py, or a model file (generated
     into ``out_dir`` first when missing or stale, keeping the freeze, build options and methods
     of the module on disk, see loader.load). When the module lacks the glue of the method that
     runs ``method`` on it (e.g. nonsmooth_euler for implicit_euler on a model with elements), it
     is regenerated with that method added. ``force`` overwrites a module generated from another
-    model file or with another freeze."""
+    model file or with another freeze. ``options``: build() options of a model file (None: those
+    of the module on disk)."""
     if isinstance(module_or_path, types.ModuleType):
         return module_or_path
-    from .loader import load
-    module = load(Path(module_or_path), out_dir=out_dir, force=force)
+    from .loader import load, read_key
+    if options and read_key(Path(module_or_path)) is not None:
+        raise SimulationError(f"{module_or_path} is a generated module: build options "
+                              f"({', '.join(options)}) apply to model files; pass the model file")
+    module = load(Path(module_or_path), out_dir=out_dir, options=options, force=force)
     if method is None or getattr(module, "KEY", None) is None:
         return module
     runs = _element_method(module, method)
     if runs in registry.METHODS and not hasattr(module, f"run_{runs}"):
-        module = load(Path(module_or_path), out_dir=out_dir, methods=[runs], force=force)
+        module = load(Path(module_or_path), out_dir=out_dir, methods=[runs], options=options,
+                      force=force)
     return module
 
 
@@ -93,7 +98,7 @@ def _element_energy(module, p, state):
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
              save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
-             element_state0=None, force=False, **settings) -> Trajectory:
+             element_state0=None, force=False, keep=None, control=None, **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -117,10 +122,15 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         max_iter for the implicit ones; newton_always (the Newton path of the partitioned
         methods even when the model allows the explicit one); spook's compliance (epsilon >= 0)
         and relaxation (d > 0); index1's baumgarte = (alpha, beta); dop853's rtol, atol, h_max.
+    control: the model's inputs (Model inputs=) inside the loop: a numba-jitted controller
+        u = f(t, q, qd, p) or a lagrange_gen.control.Signal (see lagrange_gen.control); constant
+        inputs are given in params. The Trajectory then saves "input_<name>" and, for a model
+        with outputs, "output_<name>" (Trajectory.saved).
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.consistent), and the Trajectory carries the multipliers and
-    max|Phi|, max|J v| per saved state.
+    max|Phi|, max|J v| per saved state. ``keep``: names of velocities (``theta_dot``, or the
+    coordinate ``theta``) whose v0 the projection keeps; the others are solved from J v = 0.
     A fixed-step run ends at t0 + n_steps h with n_steps = (t_end - t0) / h rounded up.
     Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
     SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
@@ -141,15 +151,19 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     config = make_settings(spec, settings)
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
-    p = resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME,
-                       frozen=getattr(module, "FROZEN", None))
+    p, hook, data = resolve_inputs(module, params, control, h, t0, q, v)     # inputs: control.py
+    if hook is not None:
+        run = _with_data(controlled_run(module, method, hook), data)
     run_checks.check_element_coefficients(module, p)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS)
     initial = np.zeros(0)
+    if keep and not spec.constraints:
+        raise SimulationError(f"{module.NAME}: keep= ({', '.join(keep)}) chooses the velocities "
+                              "kept when v0 is projected onto J v = 0; this model has no constraints")
     if spec.constraints:
         q, v, initial = _constrained_start(module, q, v, p, t0,
-                                           getattr(config, "newton_tol", 1e-12))
+                                           getattr(config, "newton_tol", 1e-12), keep)
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
     if spec.adaptive:
@@ -157,15 +171,21 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
         out, compile_time, wall = integrate_adaptive(
             task, q, v, initial, t_end, None if wanted is None else wanted[wanted > t0], progress)
-        return _adaptive_trajectory(task, out, wanted, wall, compile_time)
+        return attach_inputs_outputs(_adaptive_trajectory(task, out, wanted, wall, compile_time),
+                                     module, p, hook, data)
     n_steps = n_steps_to(t0, t_end, h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
-    task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every)
+    task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     compile_time, wall = integrate_fixed(task, q, v, out, progress)
-    return _trajectory(task, out, wall, compile_time)
+    return attach_inputs_outputs(_trajectory(task, out, wall, compile_time), module, p, hook, data)
+
+
+def _with_data(run, data):
+    """The glue signature of a run with an input hook (control.controlled_run): data bound."""
+    return lambda *args: run(*args, data)
 
 
 def _check_times(spec, h, t0, t_end, save_every, t_eval):
@@ -203,6 +223,7 @@ class _Task:
     t0: float
     n_steps: int        # fixed-step methods
     save_every: int
+    controlled: bool = False    # inputs written by a controller or a signal (control.py)
 
     @property
     def method(self):
@@ -229,8 +250,8 @@ def _trajectory(task, out, wall, compile_time):
             raise_for_status(st.NON_FINITE, m, task.method, steps, task.n_steps, last,
                              task.max_iter, h, p)
         out["t"][row], out["q"][row], out["v"][row] = last[0], q, v
-        out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n])
-        out["extra"][row] = last[3 + 2 * n:]
+        out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n], last[-1])
+        out["extra"][row] = last[3 + 2 * n:-1]
     rows = slice(0, row + 1)
     traj = _build(task, {k: out[k][rows] for k in ("t", "q", "v", "stats", "extra")},
                   out, steps, h, wall, compile_time)
@@ -256,6 +277,12 @@ def _adaptive_trajectory(task, out, t_eval, wall, compile_time):
     return _warn_energy(task, traj, h, "tighten rtol and atol")
 
 
+def _has_work(module, spec):
+    """Whether the run integrated W (steppers/work.py): fixed-step methods on a model whose
+    energy E = T2 - T0 + V is not conserved (WORK; modules generated before it have none)."""
+    return bool(getattr(module, "WORK", False)) and not spec.adaptive
+
+
 def _build(task, rows, out, steps, h, wall, compile_time):
     """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
     m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
@@ -270,9 +297,20 @@ def _build(task, rows, out, steps, h, wall, compile_time):
                       h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
                       coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
                       compile_time=compile_time, saved=saved,
+                      work=rows["stats"][:, STAT_WORK].copy() if _has_work(m, spec) else None,
                       element_names=tuple(m.ELEMENTS) if spec.elements else (),
                       constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
-                      events=_events(m, out))
+                      events=_events(m, out), source=_source(m))
+
+
+def _source(module):
+    """{model_file (absolute), build options, frozen parameters} of a generated module; {} for a
+    module without MODEL_PATH (hand-made modules in tests)."""
+    if getattr(module, "MODEL_PATH", None) is None:
+        return {}
+    model_file = (Path(module.__file__).parent / module.MODEL_PATH).resolve()
+    return dict(model_file=str(model_file), build=dict(module.OPTIONS.get("build", {})),
+                frozen=dict(getattr(module, "FROZEN", {})))
 
 
 def _events(module, out):
@@ -284,6 +322,8 @@ def _events(module, out):
 
 
 def _warn_energy(task, traj, h, advice):
+    if task.controlled:         # driven by its inputs: the premise of a conservative model fails
+        return traj
     message = energy_warning(task.module, task.method, traj.q, traj.v, traj.t, traj.energy,
                              task.p, h, advice)
     if message:
@@ -293,11 +333,11 @@ def _warn_energy(task, traj, h, advice):
     return traj
 
 
-def _constrained_start(module, q, v, p, t0, tol):
+def _constrained_start(module, q, v, p, t0, tol, keep=None):
     """The consistent initial state and row 0 of the saved fields of a constrained method:
     (q, v, [lam0, max|Phi|, max|J v|])."""
     from .consistent import consistent_initial_state
     # stacklevel 4: the warning points at the user's call of simulate().
-    state = consistent_initial_state(module, q, v, p, t0, tol, stacklevel=4)
+    state = consistent_initial_state(module, q, v, p, t0, tol, stacklevel=4, keep=keep)
     initial = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
     return np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial

@@ -1,21 +1,26 @@
 """The result of lagrange_gen.simulate: saved states, energies, Newton statistics, writers.
 
     traj = simulate(...); traj.to_npz("traj.npz"); traj.to_csv("traj.csv"); traj.plot("traj.png")
+    traj.to_dataframe(); Trajectory.load("traj.npz"); traj.animate("traj.gif")
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
+
+from .trajectory_io import dataframe, read_npz, write_csv, write_npz
 
 
 @dataclass
 class Trajectory:
     """Saved states of one simulation.
 
-    t (S,), q (S, n), v (S, n), energy (S,) E = T + V, newton_iters (S,) Newton iterations summed
+    t (S,), q (S, n), v (S, n), energy (S,) the energy function E = T2 - T0 + V (T + V for a
+    scleronomic T), work (S,) or None: W, the work of the non-conservative forces, dissipation
+    and explicit time since t0 (steppers/work.py: fixed-step runs on models whose E is not
+    conserved), newton_iters (S,) Newton iterations summed
     over the steps since the previous saved row, newton_residual (S,) the largest final Newton
     residual over those steps. S = n_steps // save_every + 1 (+1 when the final state does not
     fall on a save).
@@ -41,6 +46,10 @@ class Trajectory:
     warnings: list = field(default_factory=list)   # one line each (also issued as Python warnings)
     events: tuple = ()          # located events (steppers/events.py events_table), in time order
     step_counts: dict = field(default_factory=dict)  # adaptive runs: accepted, rejected, evaluations
+    # where the module came from: {"model_file": absolute path, "build": {...}, "frozen": {...}}
+    # (what animate needs to rebuild the model's Drawing)
+    source: dict = field(default_factory=dict)
+    work: np.ndarray | None = None   # W (S,), see above; None when E is conserved or not tracked
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -78,61 +87,56 @@ class Trajectory:
     def max_energy_error(self) -> float:
         return float(np.max(np.abs(self.energy_error)))
 
+    @property
+    def energy_balance(self) -> np.ndarray:
+        """E - E0 - W (S,): zero up to the method's error when the work is tracked (``work``),
+        else E - E0."""
+        return self.energy_error if self.work is None else self.energy_error - self.work
+
+    @property
+    def max_energy_balance_error(self) -> float:
+        return float(np.max(np.abs(self.energy_balance)))
+
     def to_npz(self, path):
-        """Write every array and the metadata to a .npz file."""
-        _parent(path)
-        saved = {name: (a[:, 0] if a.shape[1] == 1 else a) for name, a in self.saved.items()}
-        saved.setdefault("element_state", self.element_state)
-        saved.setdefault("multipliers", self.multipliers)
-        np.savez(path, t=self.t, q=self.q, v=self.v, energy=self.energy,
-                 newton_iters=self.newton_iters, newton_residual=self.newton_residual,
-                 method=self.method, h=self.h, model=self.model, coords=np.array(self.coords),
-                 param_names=np.array(list(self.params)),
-                 param_values=np.array(list(self.params.values()), dtype=float),
-                 n_steps=self.n_steps, element_names=np.array(self.element_names, dtype=str),
-                 constraint_names=np.array(self.constraint_names, dtype=str), **saved)
+        """Write every field to a .npz file (trajectory_io.py); Trajectory.load reads it back."""
+        write_npz(self, path)
+
+    save = to_npz
+
+    @classmethod
+    def load(cls, path) -> "Trajectory":
+        """The Trajectory saved by to_npz/save (also a .npz of an older writer, without events,
+        warnings and source)."""
+        return read_npz(cls, path)
 
     def to_csv(self, path):
         """Write one row per saved state: t, coordinates, velocities, energy, newton_iters and
         the method's saved fields (a field of width w > 1 as name_0..name_w-1; for a constrained
         method lam_0..lam_m-1, constraint_error, velocity_constraint_error)."""
-        header = ["t", *self.coords, *(f"{c}_dot" for c in self.coords), "energy", "newton_iters"]
-        data = np.column_stack([self.t, self.q, self.v, self.energy, self.newton_iters])
-        short = {"multipliers": "lam"}
-        for name, values in self.saved.items():
-            stem = short.get(name, name)
-            header += [stem] if values.shape[1] == 1 and name not in short else [
-                f"{stem}_{i}" for i in range(values.shape[1])]
-            data = np.column_stack([data, values])
-        _parent(path)
-        np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+        write_csv(self, path)
 
-    def plot(self, path):
-        """Figure (matplotlib Agg; format from the suffix, e.g. .png): coordinates vs t, and the
-        energy error E - E0 vs t."""
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, (ax_q, ax_e) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-        for i, name in enumerate(self.coords):
-            ax_q.plot(self.t, self.q[:, i], label=name)
-        ax_q.set_ylabel("q")
-        ax_q.legend(loc="upper right")
-        ax_q.set_title(f"{self.model}: {self.method}, h = {self.h:g}")
-        ax_e.plot(self.t, self.energy_error)
-        ax_e.set_ylabel("E - E0")
-        ax_e.set_xlabel("t")
-        fig.tight_layout()
-        try:
-            _parent(path)
-            fig.savefig(path, dpi=110)
-        finally:
-            plt.close(fig)
+    def to_dataframe(self):
+        """pandas.DataFrame indexed by t with the columns of to_csv (pandas is the optional extra
+        ``lagrange-gen[dataframe]``)."""
+        return dataframe(self)
+
+    def plot(self, path=None):
+        """Coordinates and velocities (one axis each), energy (balance), and the constraint
+        errors and multipliers or element states when the run has them (plot.py). Writes
+        ``path`` (format from the suffix: .png, .pdf, .svg) or returns the Figure."""
+        from .plot import plot_trajectory
+        return plot_trajectory(self, path)
+
+    def animate(self, path, model=None, frames=None, fps=25, dpi=80):
+        """Write an animation of the model's Drawing (Model(draw=...)) along this trajectory:
+        .gif (Pillow) or .mp4 (ffmpeg). ``model``: a Model or model file; default the model file
+        the run came from (self.source). ``frames`` evenly spaced in time (default: real time at
+        ``fps``, at most 300). See animate.py."""
+        from .animate import animate
+        return animate(self, path, model=model, frames=frames, fps=fps, dpi=dpi)
 
     def __repr__(self):
         return (f"Trajectory({self.model}, {self.method}, h={self.h:g}, steps={self.n_steps}, "
                 f"saved={len(self.t)}, t=[{self.t[0]:g}, {self.t[-1]:g}])")
 
 
-def _parent(path):
-    Path(path).parent.mkdir(parents=True, exist_ok=True)

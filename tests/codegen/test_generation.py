@@ -64,7 +64,7 @@ def test_constraint_kernel_of_cartesian_pendulum(generated):
     mod = generated("cartesian_pendulum")
     q, qd = np.array([0.6, -0.8]), np.array([0.8, 0.6])
     phi, J, gamma = np.empty(1), np.empty((1, 2)), np.empty(1)
-    mod.constraints(q, qd, mod.DEFAULT_PARAMS, phi, J, gamma)
+    mod.constraints(q, qd, 0.0, mod.DEFAULT_PARAMS, phi, J, gamma)
     # Phi = (x^2 + y^2 - l^2)/2, J = (x, y), gamma = -(xd^2 + yd^2)
     np.testing.assert_allclose(phi, [0.0], atol=1e-15)
     np.testing.assert_allclose(J, [[0.6, -0.8]], rtol=1e-15)

@@ -106,7 +106,7 @@ def test_constant_mass_matrix_is_factored_at_import(generated, stem):
     n = mod.N_COORDS
     assert mod.MASS_IS_CONSTANT and "factored once at import" in mod.__doc__
     H, rhs = np.empty((n, n)), np.empty(n)
-    mod.mass_matrix(np.zeros(n), mod.DEFAULT_PARAMS, H)
+    mod.mass_matrix(np.zeros(n), 0.0, mod.DEFAULT_PARAMS, H)
     L = mod.MASS_FACTOR
     np.testing.assert_array_equal(L, np.tril(L))
     np.testing.assert_allclose(L @ L.T, H, rtol=1e-14, atol=1e-14)
@@ -130,7 +130,7 @@ def test_structural_zeros_are_written_not_computed(generated, derived):
     assert zero and all(source.count(f"H[{k // n}, {k % n}]") == 1 and
                         f"H[{k // n}, {k % n}] = 0.0" in source for k in zero)
     H = np.full((n, n), np.nan)                        # whatever the caller's array held
-    mod.mass_matrix(np.zeros(n), mod.DEFAULT_PARAMS, H)
+    mod.mass_matrix(np.zeros(n), 0.0, mod.DEFAULT_PARAMS, H)
     assert np.all(H.ravel()[zero] == 0.0) and np.all(np.isfinite(H))
     assert dyn.jac["dHw_dq"] == sp.zeros(n, n)
     assert "mass_matvec_dq 16/16" in mod.__doc__
@@ -192,5 +192,5 @@ def test_large_outputs_go_through_the_flat_view_with_a_zero_loop(tmp_path):
     assert list(mod._ZEROS_MASS_MATRIX_H) == zero
     assert "H_f = H.reshape(25)" in inspect.getsource(mod.mass_matrix.py_func)
     H = np.full((5, 5), np.nan)
-    mod.mass_matrix(np.zeros(5), mod.DEFAULT_PARAMS, H)
+    mod.mass_matrix(np.zeros(5), 0.0, mod.DEFAULT_PARAMS, H)
     np.testing.assert_array_equal(H, np.diag([1.0, 2.0, 3.0, 4.0, 5.0]))

@@ -54,9 +54,9 @@ def test_jacobian_kernels_equal_direct_differentiation(tmp_path, stem):
         check("drhs_dq", A), check("drhs_dqd", B)
         mod.momentum_rate_jacobian.py_func(q, qd, t, p, A, B)
         check("dmom_dq", A), check("dmom_dqd", B)
-        mod.mass_matvec_dq.py_func(q, w, p, A)
+        mod.mass_matvec_dq.py_func(q, w, t, p, A)
         check("dHw_dq", A)
         if m:
             dJw = np.empty((m, n))
-            mod.constraint_dq.py_func(q, w, lam, p, dJw, A)
+            mod.constraint_dq.py_func(q, w, lam, t, p, dJw, A)
             check("dJw_dq", dJw), check("dJTlam_dq", A)

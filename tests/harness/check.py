@@ -33,16 +33,20 @@ _QQTP = ("q", "qd", "t", "p")
 #: kernel -> (inputs, outputs as (argument, shape), reference quantities), as documented in
 #: README / codegen.spec; shapes: n coordinates, m constraints, e elements.
 CONTRACT = {
-    "mass_matrix": (("q", "p"), (("H", "nn"),), ("H",)),
+    "mass_matrix": (("q", "t", "p"), (("H", "nn"),), ("H",)),
     "dynamics": (_QQTP, (("H", "nn"), ("rhs", "n")), ("H", "rhs")),
     "rhs": (_QQTP, (("out", "n"),), ("rhs",)),
     "energy": (_QQTP, (), ("E",)),
     "momentum_rate": (_QQTP, (("out", "n"),), ("momentum_rate",)),
     "rhs_jacobian": (_QQTP, (("Jq", "nn"), ("Jqd", "nn")), ("drhs_dq", "drhs_dqd")),
     "momentum_rate_jacobian": (_QQTP, (("Jq", "nn"), ("Jqd", "nn")), ("dmom_dq", "dmom_dqd")),
-    "mass_matvec_dq": (("q", "w", "p"), (("out_mat", "nn"),), ("dHw_dq",)),
-    "constraints": (("q", "qd", "p"), (("phi", "m"), ("J", "mn"), ("gamma", "m")), ("Phi", "J", "gamma")),
-    "constraint_dq": (("q", "w", "lam", "p"), (("dJw", "mn"), ("dJTlam", "nn")), ("dJw_dq", "dJTlam_dq")),
+    "mass_matvec_dq": (("q", "w", "t", "p"), (("out_mat", "nn"),), ("dHw_dq",)),
+    "constraints": (("q", "qd", "t", "p"), (("phi", "m"), ("J", "mn"), ("gamma", "m")), ("Phi", "J", "gamma")),
+    "constraint_rate": (("q", "t", "p"), (("out", "m"),), ("Phi_t",)),
+    "power": (_QQTP, (("out", "P"),), ("power",)),
+    "transport": (("q", "t", "p"), (("out", "n"),), ("b",)),
+    "transport_dq": (("q", "t", "p"), (("out_mat", "nn"),), ("db",)),
+    "constraint_dq": (("q", "w", "lam", "t", "p"), (("dJw", "mn"), ("dJTlam", "nn")), ("dJw_dq", "dJTlam_dq")),
     "elements": (("q", "p"), (("s", "e"), ("G", "en"), ("coef", "e3")), ("s", "G", "coef")),
     "elements_hessian": (("q", "we", "p"), (("out_mat", "nn"),), ("hess_w",)),
     "events": (_QQTP, (("out", "g"),), ("events",)),
@@ -116,15 +120,21 @@ def compare(label, got, expected, rtol=RTOL, floor=FLOOR):
     return f"{label}{[int(i) for i in worst]}: got {float(got[worst])!r}, expected {float(expected[worst])!r}"
 
 
+ACCUMULATING = {"transport", "transport_dq"}
+
+
 def _shape(key, n, m, ne, ng=0):
     return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n),
-            "e3": (ne, 3), "g": (ng,)}[key]
+            "e3": (ne, 3), "g": (ng,), "P": (2 * n + 2,)}[key]
 
 
 def call_kernel(kern, name, state, sizes):
     """Run kernel ``name`` of ``kern`` at a state on NaN-filled outputs: {reference name: value}."""
     inputs, outputs, quantities = CONTRACT[name]
-    arrays = [np.full(_shape(key, *sizes), np.nan) for _, key in outputs]
+    # The accumulating kernels (out += ...) start from zeros, the others from NaN (unwritten
+    # entries show).
+    fill = 0.0 if name in ACCUMULATING else np.nan
+    arrays = [np.full(_shape(key, *sizes), fill) for _, key in outputs]
     result = getattr(kern, name)(*[getattr(state, a) for a in inputs], *arrays)
     return dict(zip(quantities, arrays if outputs else [result]))
 

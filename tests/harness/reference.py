@@ -23,7 +23,8 @@ from lagrange_gen import t
 _MODULES = [{"DiracDelta": lambda *args: 0.0}, "numpy"]
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
-VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "gamma", "s", "events"}
+VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
+           "power", "b"}
 
 
 def _vector(exprs):
@@ -105,6 +106,23 @@ class Reference:
 
     def _Phi(self):
         return _vector(self.drawn.constraints)
+
+    def _power(self):
+        """(P, dP/dq, dP/dqd, dP/dt) with P = qd . (Q - dD/dqd) - d(T - V)/dt = dE/dt."""
+        d = self.drawn
+        Q = self._generalized_forces() - sp.Matrix([d.dissipation]).jacobian(self.qd).T
+        P = (self.qd.T * Q)[0, 0] - sp.diff(d.T - d.V, t)
+        return sp.Matrix([P, *(sp.diff(P, x) for x in [*self.q, *self.qd, t])])
+
+    def _b(self):
+        """dT/dqd at qd = 0 (the T1 = b . qd part of T)."""
+        return self.expr("dT_dqd").subs({v: 0 for v in self.qd})
+
+    def _db(self):
+        return self.expr("b").jacobian(self.q)
+
+    def _Phi_t(self):
+        return self.expr("Phi").diff(t)
 
     def _J(self):
         return self.expr("Phi").jacobian(self.q)

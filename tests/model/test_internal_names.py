@@ -73,9 +73,9 @@ def _kernel_calls(n, m, ne, rng):
     return {
         "dynamics": lambda k: run(k.dynamics, q, v, 0.3, k.DEFAULT_PARAMS, shapes=[(n, n), n]),
         "rhs_jacobian": lambda k: run(k.rhs_jacobian, q, v, 0.3, k.DEFAULT_PARAMS, shapes=[(n, n)] * 2),
-        "mass_matvec_dq": lambda k: run(k.mass_matvec_dq, q, w, k.DEFAULT_PARAMS, shapes=[(n, n)]),
-        "constraints": lambda k: run(k.constraints, q, v, k.DEFAULT_PARAMS, shapes=[m, (m, n), m]),
-        "constraint_dq": lambda k: run(k.constraint_dq, q, w, lam, k.DEFAULT_PARAMS, shapes=[(m, n), (n, n)]),
+        "mass_matvec_dq": lambda k: run(k.mass_matvec_dq, q, w, 0.3, k.DEFAULT_PARAMS, shapes=[(n, n)]),
+        "constraints": lambda k: run(k.constraints, q, v, 0.3, k.DEFAULT_PARAMS, shapes=[m, (m, n), m]),
+        "constraint_dq": lambda k: run(k.constraint_dq, q, w, lam, 0.3, k.DEFAULT_PARAMS, shapes=[(m, n), (n, n)]),
         "elements": lambda k: run(k.elements, q, k.DEFAULT_PARAMS, shapes=[ne, (ne, n), (ne, 3)]),
         "elements_hessian": lambda k: run(k.elements_hessian, q, we, k.DEFAULT_PARAMS, shapes=[(n, n)]),
     }, (q, w, lam, we)

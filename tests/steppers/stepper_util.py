@@ -85,7 +85,7 @@ def one_step(mod, method, q, v, h, p, t0=0.0, settings=None):
 
 def mass_matrix(mod, q, p):
     H = np.empty((mod.N_COORDS, mod.N_COORDS))
-    mod.mass_matrix(np.asarray(q, dtype=np.float64), p, H)
+    mod.mass_matrix(np.asarray(q, dtype=np.float64), 0.0, p, H)
     return H
 
 

@@ -57,7 +57,7 @@ def ode_jacobian(mod, p):
         Hm = H.copy()
         qdd_ = np.linalg.solve(Hm, qdd)
         mod.rhs_jacobian(q, v, t, p, Jq, Jv)
-        mod.mass_matvec_dq(q, qdd_, p, dHw)
+        mod.mass_matvec_dq(q, qdd_, t, p, dHw)
         out = np.zeros((2 * n, 2 * n))
         out[:n, n:] = np.eye(n)
         out[n:, :n] = np.linalg.solve(Hm, Jq - dHw)
@@ -76,7 +76,7 @@ def kkt_rhs(mod, p):
     def f(t, y):
         q, v = y[:n], y[n:]
         mod.dynamics(q, v, t, p, H, rhs)
-        mod.constraints(q, v, p, phi, J, gamma)
+        mod.constraints(q, v, t, p, phi, J, gamma)
         K = np.block([[H, -J.T], [J, np.zeros((m, m))]])
         sol = np.linalg.solve(K, np.concatenate((rhs, gamma)))
         return np.concatenate((v, sol[:n]))
@@ -91,7 +91,7 @@ def constraint_residuals(mod, p, q, v=None):
     out_phi, out_jv = np.zeros(len(q)), np.zeros(len(q))
     for i, qi in enumerate(q):
         vi = np.zeros(n) if v is None else np.ascontiguousarray(v[i])
-        mod.constraints(np.ascontiguousarray(qi), vi, p, phi, J, gamma)
+        mod.constraints(np.ascontiguousarray(qi), vi, 0.0, p, phi, J, gamma)   # scleronomic models
         if m:
             out_phi[i] = np.max(np.abs(phi))
             out_jv[i] = np.max(np.abs(J @ vi))

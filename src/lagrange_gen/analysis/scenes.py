@@ -86,7 +86,7 @@ def four_bar_start(mod, p, th1=math.pi / 2):
     phi, J, gamma = np.empty(m), np.empty((m, n)), np.empty(m)
 
     def residual(x):
-        mod.constraints(np.array([th1, *x]), np.zeros(n), p, phi, J, gamma)
+        mod.constraints(np.array([th1, *x]), np.zeros(n), 0.0, p, phi, J, gamma)
         return phi.copy()
     x, _, ier, msg = fsolve(residual, [0.3, 1.5], full_output=True, xtol=1e-14)
     if ier != 1:

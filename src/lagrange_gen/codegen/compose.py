@@ -24,10 +24,13 @@ from .spec import KernelSpec, Output
 def compositions(dyn, selected, needs) -> dict:
     """{kernel: reason} of the selected kernels to compose; needs {method: kern names}."""
     out = {}
+    if dyn.has_transport:       # momentum_rate (canonical, with b) is not dT/dq - g + Q there
+        return out
     if "mass_matvec_dq" in selected and "momentum_rate_jacobian" in selected:
         out["momentum_rate_jacobian"] = "d/dqd part = mass_matvec_dq(q, qd)^T + dQ/dqd"
     callers = [names for names in needs.values() if "dynamics" in names]
-    if (not dyn.mass_is_constant and {"mass_matvec_dq", "momentum_rate"} <= set(selected)
+    # (not for H(q, t): rhs also holds -dH/dt qd, which the composition would miss)
+    if (not dyn.mass_is_constant and not dyn.mass_depends_on_t and {"mass_matvec_dq", "momentum_rate"} <= set(selected)
             and callers and all("momentum_rate" in names for names in callers)):
         out["dynamics"] = "mass_matrix, momentum_rate - mass_matvec_dq(q, qd) qd"
     return out
@@ -40,7 +43,7 @@ def composed_spec(name, dyn) -> KernelSpec:
             "momentum_rate_jacobian", ["q", "qd", "t", "p"],
             [Output("Jq", dyn.jac.native("dmom_dq")), Output("Jqd", dyn.jac.native("dQ_dqd"), accumulate=True)],
             doc="d(dp/dt)/dq and d(dp/dt)/dqd (n, n); the latter composed as D(qd)^T + dQ/dqd",
-            prologue=["mass_matvec_dq(q, qd, p, Jqd)      # D(qd) = d(H qd)/dq",
+            prologue=["mass_matvec_dq(q, qd, t, p, Jqd)      # D(qd) = d(H qd)/dq",
                       f"for j in range({n}):",
                       f"    for l in range(j + 1, {n}):",
                       "        Jqd[j, l], Jqd[l, j] = Jqd[l, j], Jqd[j, l]"])
@@ -49,12 +52,12 @@ def composed_spec(name, dyn) -> KernelSpec:
             "dynamics", ["q", "qd", "t", "p"], [], out_args=["H", "rhs"],
             doc="H(q) (n, n) and rhs = Q - h - g (n,), so that H qddot = rhs; composed as "
                 "rhs = dp/dt - D(qd) qd",
-            prologue=["mass_matvec_dq(q, qd, p, H)        # H holds D(qd) until mass_matrix below",
+            prologue=["mass_matvec_dq(q, qd, t, p, H)        # H holds D(qd) until mass_matrix below",
                       "momentum_rate(q, qd, t, p, rhs)",
                       f"for j in range({n}):",
                       "    s = 0.0",
                       f"    for l in range({n}):",
                       "        s += H[j, l] * qd[l]",
                       "    rhs[j] -= s",
-                      "mass_matrix(q, p, H)"])
+                      "mass_matrix(q, t, p, H)"])
     raise KeyError(f"no composed form of kernel {name!r}")

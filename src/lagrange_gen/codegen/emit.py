@@ -86,10 +86,18 @@ def _flat(entry):
     return [i * cols + j] + ([j * cols + i] if out.symmetric and i != j else [])
 
 
+def local_name(out_name, i, j=None):
+    """The local variable a ``local`` output's entry is assigned to: H_0_1, rhs_1."""
+    return f"{out_name}_{i}" if j is None else f"{out_name}_{i}_{j}"
+
+
 def _targets(entry):
     """Store targets of an entry: rhs[3] for a vector, H[1, 2] for a small matrix, H_f[7]
-    (flat view) for a large one; two for an off-diagonal symmetric entry."""
+    (flat view) for a large one; two for an off-diagonal symmetric entry; one local variable
+    for a ``local`` output."""
     out = entry.out
+    if out.local:
+        return [local_name(out.name, entry.i, None if out.is_vector else entry.j)]
     if out.is_vector or _through_view(out):
         return [f"{_flat_name(out)}[{k}]" for k in _flat(entry)]
     cols = out.matrix.shape[1]
@@ -100,6 +108,9 @@ def _zero_lines(spec, zeros):
     """Statements and module constants that write the structural zeros of each output."""
     lines, constants = [], []
     for out in spec.outputs:
+        if out.local:
+            lines += [f"    {_targets(e)[0]} = 0.0" for e in zeros if e.out is out]
+            continue
         index = sorted(k for e in zeros if e.out is out for k in _flat(e))
         if not index:
             continue
@@ -151,12 +162,13 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
         used |= {s.name for s in expr.free_symbols}
     zero_lines, constants = _zero_lines(spec, zeros)
     views = [f"    {o.name}_f = {o.name}.reshape({o.matrix.shape[0] * o.matrix.shape[1]})"
-             for o in spec.outputs if _through_view(o)]
+             for o in spec.outputs if _through_view(o) and not o.local]
     args = ", ".join(spec.signature)
     lines = ['@njit(cache=True, _nrt=False, error_model="numpy")', f"def {spec.name}({args}):",
              f'    """{_doc(spec, zeros, entries)}"""']
     lines += [f"    {line}" for line in spec.prologue]
     lines += _load_lines(used, inputs.loads(spec.args)) + body + views + stores + zero_lines
+    lines += [f"    {line}" for line in spec.epilogue]
     if spec.result is not None:
         lines.append(f"    return {result}")
     elif len(lines) == 3:

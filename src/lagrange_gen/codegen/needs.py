@@ -164,8 +164,14 @@ def select_kernels(dyn, methods) -> dict:
         why.setdefault("rhs", []).append("constant H: forward dynamics with the factor from import")
     if dyn.m:
         why.setdefault("constraints", []).append("constrained model (consistent initial conditions)")
+        why.setdefault("constraint_rate", []).append("constrained model (consistent initial velocities)")
     if dyn.n_elements:
         why.setdefault("elements", []).append("model with nonsmooth elements (element energy)")
+    if {"input_jacobian", "outputs"} & set(table):   # inputs or outputs: control.py, linearize
+        for name in ("input_jacobian", "outputs", "output_jacobian", "rhs_jacobian",
+                     "mass_matvec_dq") + (("constraint_dq",) if dyn.m else ()):
+            if name in table:
+                why.setdefault(name, []).append("model inputs/outputs (saved outputs, linearize)")
     for method, names in methods_needs(methods).items():
         for name in names:
             if name.isupper() or name in MODULE_FUNCTIONS:

@@ -7,7 +7,7 @@ import sympy as sp
 from ..derive.elements import KIND_CODES
 from ..keys import KEY_PREFIX, TEXT_SHA_PREFIX, key_of_text, text_hash
 from .forward import factor_at_import, forward_source
-from .spec import default_kernels, event_functions
+from .spec import default_kernels, event_functions, live_inputs
 
 
 def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
@@ -34,7 +34,7 @@ def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
                   f"{', terminal' if e.terminal else ''})"
                   for i, (e, g) in enumerate(zip(m.events, event_functions(dyn)))]
     lines += _specialization(dyn, methods, why or {}, texts)
-    lines.append("Equations of motion: H(q) qddot + h(q, qd) + g(q) = Q(q, qd, t) + J(q)^T lam, Phi(q) = 0.")
+    lines.append("Equations of motion: H(q, t) qddot + h(q, qd, t) + g(q, t) = Q(q, qd, t) + J(q, t)^T lam, Phi(q, t) = 0.")
     return "\n".join(lines)
 
 
@@ -72,7 +72,7 @@ _IMPORTS = [
     "from lagrange_gen.keys import check_current",
     "from lagrange_gen.loader import njit, register_module  # numba.njit; a bad cache entry is a miss",
     "from lagrange_gen.errors import SingularMass",
-    "from lagrange_gen.linalg import cholesky_inplace, cholesky_solve_inplace",
+    "from lagrange_gen.linalg import SINGULAR_RTOL, cholesky_inplace, cholesky_solve_inplace",
     "from lagrange_gen.params import resolve_params",
     "from lagrange_gen.status import OK, SINGULAR_MASS",
 ]
@@ -107,8 +107,15 @@ def _model_constants(dyn, methods, texts):
         f"EVENT_TERMINAL = np.array({[e.terminal for e in events]!r}, dtype=np.bool_)",
         f"EVENT_DIRECTION = np.array({[e.direction for e in events]!r}, dtype=np.int64)"
         "  # +1 rising, -1 falling, 0 both",
+        f"INPUTS = {tuple(u.name for u in live_inputs(dyn))!r}  # the last N_INPUTS entries of PARAMS",
+        f"N_INPUTS = {len(live_inputs(dyn))}",
+        f"OUTPUTS = {tuple(dyn.model.outputs)!r}",
+        f"N_OUTPUTS = {len(dyn.model.outputs)}",
         f"MASS_IS_CONSTANT = {dyn.mass_is_constant}",
         f"FORCES_VELOCITY_FREE = {dyn.forces_velocity_free}",
+        f"CONSTRAINTS_RHEONOMIC = {dyn.constraints_rheonomic}  # Phi(q, t): J qd = -dPhi/dt",
+        f"WORK = {dyn.has_work}  # E not conserved: the run loop integrates W = int P dt",
+        f"TRANSPORT = {dyn.has_transport}  # T1 = b(q, t) . qd: momentum p = H qd + b",
         f"METHODS = {tuple(methods)!r}",
         f"KERNELS = {tuple(k.name for k in texts)!r}",
     ]

@@ -16,13 +16,16 @@ class Output:
     name: argument name; matrix: sympy Matrix whose shape is the array's shape (a column vector
     becomes a 1-D array); symmetric: only the upper triangle is computed, then mirrored;
     accumulate: the kernel's prologue already filled the array and the nonzero entries are added
-    to it (``+=``; zero entries are left alone).
+    to it (``+=``; zero entries are left alone); local: no array, each entry is assigned to a
+    local variable (``H_0_1``, ``rhs_1``; symmetric: upper triangle only) that the kernel's
+    epilogue reads (codegen.forward's unrolled solve).
     """
 
     name: str
     matrix: sp.Matrix
     symmetric: bool = False
     accumulate: bool = False
+    local: bool = False
 
     @property
     def is_vector(self):
@@ -33,7 +36,7 @@ class Output:
         return (self.matrix.shape[0],) if self.is_vector else tuple(self.matrix.shape)
 
 
-_ALWAYS_2D = {"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef"}
+_ALWAYS_2D = {"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef", "Ju", "Cq", "Cqd", "Du"}
 
 
 @dataclass
@@ -43,7 +46,7 @@ class KernelSpec:
     args: input argument names in order (q, qd, t, p, w, lam); doc: one line for the docstring.
     out_args: output argument names when they are not exactly the symbolic outputs' names (a
     composed kernel, see codegen.compose); prologue: statements run first (calls of other kernels,
-    numeric loops).
+    numeric loops); epilogue: statements run last (they may ``return``).
     """
 
     name: str
@@ -53,6 +56,7 @@ class KernelSpec:
     doc: str = ""
     out_args: list | None = None
     prologue: list = field(default_factory=list)
+    epilogue: list = field(default_factory=list)
 
     @property
     def signature(self):
@@ -69,30 +73,44 @@ def kernel_table(dyn) -> dict:
     section 5. Specs are built on demand: a Jacobian is only derived when its kernel is emitted."""
     nat, jac = dyn.native, dyn.jac.native
     table = {
-        "mass_matrix": lambda: KernelSpec("mass_matrix", ["q", "p"], [Output("H", nat["H"], symmetric=True)],
-                                          doc="H(q) (n, n), the generalized inertia"),
+        "mass_matrix": lambda: KernelSpec("mass_matrix", ["q", "t", "p"], [Output("H", nat["H"], symmetric=True)],
+                                          doc="H(q, t) (n, n), the generalized inertia"),
         "dynamics": lambda: KernelSpec(
             "dynamics", ["q", "qd", "t", "p"], [Output("H", nat["H"], symmetric=True), Output("rhs", nat["rhs"])],
             doc="H(q) (n, n) and rhs = Q - h - g (n,), so that H qddot = rhs"),
         "rhs": lambda: KernelSpec("rhs", ["q", "qd", "t", "p"], [Output("out", nat["rhs"])],
                                   doc="rhs = Q - h - g (n,) alone (for a constant, pre-factored H)"),
-        "energy": lambda: KernelSpec("energy", ["q", "qd", "t", "p"], result=nat["E"], doc="E = T + V (scalar)"),
+        "energy": lambda: KernelSpec("energy", ["q", "qd", "t", "p"], result=nat["E"],
+                                     doc="E = T2 - T0 + V (scalar; T + V when T is scleronomic)"),
         "momentum_rate": lambda: KernelSpec("momentum_rate", ["q", "qd", "t", "p"], [Output("out", nat["momentum_rate"])],
-                                            doc="dp/dt = dT/dq - dV/dq + Q (n,) for p = H(q) qd"),
+                                            doc="dp/dt = dL/dq + Q_nc (n,) for the canonical momentum p = H qd + b"),
+        "power": lambda: KernelSpec(
+            "power", ["q", "qd", "t", "p"], [Output("out", nat["power"])],
+            doc="(P, dP/dq, dP/dqd, dP/dt) (2n + 2,) with P = qd . Q_nc - dL/dt = dE/dt, the "
+                "power whose integral W closes E - E0 - W = 0"),
+        "transport": lambda: KernelSpec(
+            "transport", ["q", "t", "p"], [Output("out", nat["b"], accumulate=True)],
+            doc="out += b(q, t) (n,), the T1 = b . qd part of T: p = H qd + b (nothing when T1 = 0)"),
+        "transport_dq": lambda: KernelSpec(
+            "transport_dq", ["q", "t", "p"], [Output("out_mat", nat["db"], accumulate=True)],
+            doc="out_mat += db/dq (n, n) (nothing when T1 = 0)"),
         "rhs_jacobian": lambda: KernelSpec(
             "rhs_jacobian", ["q", "qd", "t", "p"], [Output("Jq", jac("drhs_dq")), Output("Jqd", jac("drhs_dqd"))],
             doc="d rhs/dq and d rhs/dqd (n, n)"),
         "momentum_rate_jacobian": lambda: KernelSpec(
             "momentum_rate_jacobian", ["q", "qd", "t", "p"], [Output("Jq", jac("dmom_dq")), Output("Jqd", jac("dmom_dqd"))],
             doc="d(dp/dt)/dq and d(dp/dt)/dqd (n, n)"),
-        "mass_matvec_dq": lambda: KernelSpec("mass_matvec_dq", ["q", "w", "p"], [Output("out_mat", jac("dHw_dq"))],
+        "mass_matvec_dq": lambda: KernelSpec("mass_matvec_dq", ["q", "w", "t", "p"], [Output("out_mat", jac("dHw_dq"))],
                                              doc="d(H(q) w)/dq (n, n) for a vector w (n,)"),
         "constraints": lambda: KernelSpec(
-            "constraints", ["q", "qd", "p"],
+            "constraints", ["q", "qd", "t", "p"],
             [Output("phi", nat["Phi"]), Output("J", nat["J"]), Output("gamma", nat["gamma"])],
-            doc="Phi(q) (m,), J = dPhi/dq (m, n), gamma = -(dJ/dt) qd (m,)"),
+            doc="Phi(q, t) (m,), J = dPhi/dq (m, n), gamma (m,) with J qdd = gamma along a motion"),
+        "constraint_rate": lambda: KernelSpec(
+            "constraint_rate", ["q", "t", "p"], [Output("out", nat["Phi_t"])],
+            doc="dPhi/dt (m,): the velocity constraint is J qd + dPhi/dt = 0 (zero when scleronomic)"),
         "constraint_dq": lambda: KernelSpec(
-            "constraint_dq", ["q", "w", "lam", "p"],
+            "constraint_dq", ["q", "w", "lam", "t", "p"],
             [Output("dJw", jac("dJw_dq")), Output("dJTlam", jac("dJTlam_dq"), symmetric=True)],
             doc="d(J w)/dq (m, n) and d(J^T lam)/dq (n, n)"),
         "elements": lambda: KernelSpec(
@@ -108,7 +126,46 @@ def kernel_table(dyn) -> dict:
             doc="event functions g (n_events,) in EVENT_NAMES order, whose zero crossings "
                 "steppers/events.py locates"),
     }
+    table.update(io_kernels(dyn))
     return table
+
+
+def io_kernels(dyn) -> dict:
+    """The kernels of a model with inputs (d rhs/du, for lagrange_gen.linearize) or outputs
+    (their values and Jacobians); {} for a model without either."""
+    model, o, table = dyn.model, dyn.ops, {}
+    inputs = live_inputs(dyn)
+    if inputs:
+        u = o.symbols(inputs)
+        table["input_jacobian"] = lambda: KernelSpec(
+            "input_jacobian", ["q", "qd", "t", "p"], [Output("Ju", o.jacobian(list(dyn.native["rhs"]), u))],
+            doc="d rhs/du (n, n_inputs), u the INPUTS (the trailing entries of p)")
+    if model.outputs:
+        y = [o.native(e) for e in output_functions(dyn)]
+        table["outputs"] = lambda: KernelSpec(
+            "outputs", ["q", "qd", "t", "p"], [Output("out", o.column(y))],
+            doc="outputs y (n_outputs,) in OUTPUTS order")
+        table["output_jacobian"] = lambda: KernelSpec(
+            "output_jacobian", ["q", "qd", "t", "p"],
+            [Output("Cq", o.jacobian(y, dyn.jac._q)), Output("Cqd", o.jacobian(y, dyn.jac._qd)),
+             Output("Du", o.jacobian(y, o.symbols(inputs)) if inputs else o.zeros(len(y), 0))],
+            doc="dy/dq, dy/dqd (n_outputs, n) and dy/du (n_outputs, n_inputs)")
+    return table
+
+
+def live_inputs(dyn) -> list:
+    """The model's inputs that are still parameters (a frozen input is a constant)."""
+    return [u for u in dyn.model.inputs if u.name not in dyn.frozen]
+
+
+def output_functions(dyn) -> list:
+    """The model's outputs y(q, qd, t) (sympy) in OUTPUTS order, frozen parameters substituted."""
+    out = []
+    for expr in dyn.model.outputs.values():
+        frozen = {s: sp.Float(dyn.frozen[s.name]) for s in expr.free_symbols
+                  if isinstance(s, Parameter) and s.name in dyn.frozen}
+        out.append(expr.xreplace(frozen) if frozen else expr)
+    return out
 
 
 def _column(exprs):

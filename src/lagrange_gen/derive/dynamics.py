@@ -13,7 +13,7 @@ from .jacobians import Jacobians
 from .lagrangian import derive_lagrangian
 
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
-FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma",
+FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
           "elem_s", "elem_grad", "elem_coef", "elem_hess_w")
 
 
@@ -21,11 +21,13 @@ class Dynamics:
     """Everything the generator prints.
 
     Shapes (n coordinates, m constraints): H (n, n); h, g, Q, rhs, dTdq, momentum_rate (n, 1);
-    Phi (m, 1); J (m, n); gamma (m, 1); E scalar. Jacobian matrices are (n, n) unless noted.
+    Phi, Phi_t = dPhi/dt (m, 1); J (m, n); gamma (m, 1); E scalar (the energy function
+    T2 - T0 + V, T + V when T is scleronomic). Jacobian matrices are (n, n) unless noted.
     The equations of motion are H qddot + h + g = Q + J^T lambda with Phi(q) = 0, and
     rhs = Q - h - g (smooth forces only: nonsmooth element forces are the steppers' business).
     Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 3),
-    elem_hess_w (n, n). ``momentum_rate`` = dT/dq - dV/dq + Q is dp/dt for p = H qdot.
+    elem_hess_w (n, n). ``momentum_rate`` = dL/dq + Q_nc is dp/dt for the canonical momentum
+    p = H qdot + b, b (n, 1) = dT/dqdot at qdot = 0 (T1 = b . qdot), db = db/dq (n, n).
 
     Each field is a sympy Matrix (or Expr) built from ``native[field]`` when first read; code
     generation reads ``native`` and ``jac.native(name)`` and never pays for the conversion.
@@ -67,7 +69,27 @@ class Dynamics:
 
     @property
     def mass_is_constant(self):
-        return not ({str(s) for s in self.native["H"].free_symbols} & {s.name for s in self.q})
+        return not ({str(s) for s in self.native["H"].free_symbols} & ({s.name for s in self.q} | {"t"}))
+
+    @property
+    def has_work(self):
+        """True when E = T2 - T0 + V is not conserved: non-conservative forces, dissipation or
+        an explicit t in L (P = qd . Q_nc - dL/dt nonzero)."""
+        return self.native["power"][0, 0] != 0
+
+    @property
+    def has_transport(self):
+        """True when T has a term T1 = b(q, t) . qdot linear in the velocities."""
+        return any(e != 0 for e in self.native["b"])
+
+    @property
+    def mass_depends_on_t(self):
+        return "t" in {str(s) for s in self.native["H"].free_symbols}
+
+    @property
+    def constraints_rheonomic(self):
+        """True when some constraint Phi(q, t) depends on t (Phi_t nonzero)."""
+        return any(e != 0 for e in self.native["Phi_t"])
 
     @property
     def forces_velocity_free(self):

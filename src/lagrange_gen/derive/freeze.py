@@ -8,28 +8,9 @@ FROZEN; passing it at run time is an error (lagrange_gen.params.resolve_params).
 from __future__ import annotations
 
 import copy
-import math
-
 import sympy as sp
 
 from ..errors import GenerationError
-
-
-def parse_freeze(text):
-    """'g=9.81,l=1' -> {'g': 9.81, 'l': 1.0} (GenerationError on a malformed item)."""
-    frozen = {}
-    for item in (text or "").split(","):
-        if not item.strip():
-            continue
-        name, sep, value = item.partition("=")
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not sep or not name.strip() or not math.isfinite(number):
-            raise GenerationError(f"--freeze {item.strip()}: expected NAME=NUMBER (finite), e.g. g=9.81")
-        frozen[name.strip()] = number
-    return frozen
 
 
 def freeze_model(model, frozen):

@@ -10,9 +10,9 @@ from .lagrangian import _dot
 #: name -> what it is (shapes for n coordinates, m constraints).
 JACOBIANS = {
     "drhs_dq": "d rhs/dq (n, n) of rhs = Q - h - g",
-    "drhs_dqd": "d rhs/dqd (n, n), from dH/dq: dQ/dqd - (D + Hdot - D^T), D_jl = (dH/dq_l qd)_j",
+    "drhs_dqd": "d rhs/dqd (n, n), from dH/dq: dQ/dqd - (D + Hdot - D^T + dH/dt), D_jl = (dH/dq_l qd)_j",
     "dmom_dq": "d momentum_rate/dq (n, n) of momentum_rate = dT/dq - dV/dq + Q",
-    "dmom_dqd": "d momentum_rate/dqd (n, n) = D^T + dQ/dqd",
+    "dmom_dqd": "d momentum_rate/dqd (n, n) = D^T + dQ/dqd + db/dq (Q with the T1 forces)",
     "dHw_dq": "d(H(q) w)/dq (n, n) for an input vector w",
     "dQ_dqd": "dQ/dqd (n, n) of the generalized forces",
     "dJw_dq": "d(J(q) w)/dq (m, n)",
@@ -74,15 +74,17 @@ class Jacobians(Mapping):
 
     def _drhs_dqd(self):
         D, Hdot, dQ = self._D(self._qd), self._p["Hdot"], self._dQ_dqd()
-        n = len(self._q)
+        n, Ht = len(self._q), self._p["Ht"]
+        if Ht is not None:         # h holds dH/dt qd (a rheonomic T2)
+            return self._contract(n, n, lambda j, l: dQ[j, l] - (D[j, l] + Hdot[j, l] - D[l, j] + Ht[j, l]))
         return self._contract(n, n, lambda j, l: dQ[j, l] - (D[j, l] + Hdot[j, l] - D[l, j]))
 
     def _dmom_dq(self):
         return self._o.jacobian(self._p["momentum_rate"], self._q)
 
     def _dmom_dqd(self):
-        D, dQ, n = self._D(self._qd), self._dQ_dqd(), len(self._q)
-        return self._contract(n, n, lambda j, l: D[l, j] + dQ[j, l])
+        D, dQ, n, db = self._D(self._qd), self._dQ_dqd(), len(self._q), self._p["db"]
+        return self._contract(n, n, lambda j, l: D[l, j] + dQ[j, l] + db[j, l])
 
     def _dHw_dq(self):
         return self._D(self._w)

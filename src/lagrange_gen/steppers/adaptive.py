@@ -92,7 +92,7 @@ from numba import njit
 
 from ..status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 from . import events
-from .base import FAST, _last, _save, check_state
+from .base import FAST, STAT_WORK, _last, _save, check_state
 
 
 SAFETY = 0.9          # Hairer's safe
@@ -138,6 +138,7 @@ def _save_row(kern, row, t, q, v, p, since, err, out_t, out_q, out_v, out_stats,
     if not math.isfinite(energy):
         return False
     _save(row, t, q, v, energy, since, err, out_t, out_q, out_v, out_stats, extra, out_extra)
+    out_stats[row, STAT_WORK] = 0.0          # the work W is tracked by fixed-step runs only
     return True
 
 

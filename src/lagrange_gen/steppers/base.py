@@ -67,7 +67,8 @@ FAST = dict(_nrt=False, error_model="numpy")
 STAT_ENERGY = 0     # E = T + V at the saved state
 STAT_ITERS = 1      # Newton iterations summed over the steps since the previous save
 STAT_RESIDUAL = 2   # largest Newton residual (max norm, last iterate of a step) over those steps
-N_STATS = 3
+STAT_WORK = 3       # W, the work of non-conservative forces and explicit time since t0 (work.py)
+N_STATS = 4
 
 @njit(**FAST)
 def explicit_path(kern, settings):
@@ -187,18 +188,34 @@ def accel(kern, q, v, t, p, H, a):
 
 
 @njit(**FAST)
-def velocity_from_momentum(kern, q, mom, p, H, v):
-    """v = H(q)^-1 mom (the inverse Legendre transform). Returns OK or SINGULAR_MASS."""
-    kern.mass_matrix(q, p, H)
+def velocity_from_momentum(kern, q, mom, t, p, H, v):
+    """v = H(q, t)^-1 (mom - b(q, t)) (the inverse Legendre transform; b = 0 unless T has a
+    term T1 = b . v, kern.TRANSPORT). Returns OK or SINGULAR_MASS."""
+    kern.mass_matrix(q, t, p, H)
     copy_into(v, mom)
+    subtract_transport(kern, q, t, p, v)
     return OK if mass_solve(H, v) else SINGULAR_MASS
 
 
 @njit(**FAST)
-def momentum_from_velocity(kern, q, v, p, H, mom):
-    """mom = H(q) v (the Legendre transform)."""
-    kern.mass_matrix(q, p, H)
+def subtract_transport(kern, q, t, p, x):
+    """x (n,) <- x - b(q, t) on a model with T1 = b . v (kern.TRANSPORT; nothing otherwise). The
+    generated ``transport`` adds b, so x is negated around it."""
+    if kern.TRANSPORT:
+        for i in range(x.shape[0]):
+            x[i] = -x[i]
+        kern.transport(q, t, p, x)
+        for i in range(x.shape[0]):
+            x[i] = -x[i]
+
+
+@njit(**FAST)
+def momentum_from_velocity(kern, q, v, t, p, H, mom):
+    """mom = H(q, t) v + b(q, t) (the Legendre transform, canonical momentum dL/dv)."""
+    kern.mass_matrix(q, t, p, H)
     matvec(H, v, mom)
+    if kern.TRANSPORT:
+        kern.transport(q, t, p, mom)
 
 
 @njit(cache=True, **FAST)
@@ -238,14 +255,15 @@ def _last(out_last, t, q, v, iters, resid, extra):
         out_last[3 + 2 * n + k] = extra[k]
 
 
-# Imported here, not at the top: events.py and hermite.py import FAST, accel and copy_into
-# from this module.
-from . import events, hermite  # noqa: E402
+# Imported here, not at the top: events.py, hermite.py and work.py import FAST, accel and
+# copy_into from this module.
+from . import events, hermite, work  # noqa: E402
 
 
 @njit(inline="always")
 def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_every, p,
-             settings, out_t, out_q, out_v, out_stats, out_extra, out_last, out_events):
+             settings, out_t, out_q, out_v, out_stats, out_extra, out_last, out_events,
+             control=None, control_data=None):
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
 
     ``method`` is a stepper module (its workspace, prepare and step are called), ``kern`` the
@@ -256,6 +274,9 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
     S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
     also holds the initial values of those fields (element states, multipliers).
+    out_stats[:, STAT_WORK] holds W, the work since t0 (steppers/work.py; 0 when kern.WORK is
+    False), continued from out_stats[0, STAT_WORK]; an out_last one entry longer receives the
+    final W in its last entry.
     out_last (2n + 3 + n_saved,) receives [t, q, v, Newton iterations since the last save,
     Newton residual, saved fields] of the final state, or on failure: of the state the failing
     step started from (Newton failure, singular mass) or of the offending state after it
@@ -271,6 +292,10 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
     and the root refinement only a step where some g changed sign. Without events the literal
     n_event_fns = 0 lets numba prune the event branches before typing them: no work, no
     allocation and no compile time (typing them cost about 2.5 s per module).
+    Inputs (lagrange_gen.control): ``control(control_data, t, q, v, p) -> changed``, a jitted
+    function, writes the model's inputs (the trailing entries of p) from the state at the start
+    of each step and at t0 (zero-order hold over a step), and the method's prepare runs again
+    when they changed; None (the generated glue) prunes the calls.
     Returns (status, steps_done, n_events): steps_done = n_steps, or the index of the failing
     step on failure (or of the step in which a terminal event stopped the run), -1 when the
     initial state itself is refused (non-finite or past the bound, its energy non-finite, or
@@ -278,9 +303,15 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
     most E).
     """
     n = q0.shape[0]
-    if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved:
+    if out_extra.shape[1] != n_saved or out_last.shape[0] - 2 * n - 3 - n_saved not in (0, 1):
         raise ValueError("run_<method>: out_extra needs n_saved columns and out_last "
-                         "2 n + 3 + n_saved entries (n_saved = SPEC.n_saved(n, m, ne))")
+                         "2 n + 3 + n_saved entries, or one more for W (n_saved = "
+                         "SPEC.n_saved(n, m, ne))")
+    # W, the work since t0 (work.py), continues from row 0 of out_stats (a run in chunks);
+    # NaN there (an ensemble's fresh buffers) starts it at 0.
+    W = out_stats[0, STAT_WORK]
+    if W != W:
+        W = 0.0
     q = q0.copy()
     v = v0.copy()
     mom = np.zeros(n)
@@ -292,6 +323,8 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
         extra[k] = out_extra[0, k]
     bound = settings.blowup_bound
     status = check_state(q, v, bound)
+    if control is not None:
+        control(control_data, t0, q, v, p)
     if status == OK:
         status = method.prepare(kern, q, v, mom, t0, p, settings, ws, extra)
     energy = kern.energy(q, v, t0, p)
@@ -301,6 +334,10 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
     if status != OK:
         return status, -1, 0
     _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
+    out_stats[0, STAT_WORK] = W
+    if kern.WORK:
+        ww = work.workspace(kern, n)
+        P0, D0 = work.rate(kern, ww, q, v, t0, p)
     if n_event_fns > 0:       # (ew, iw exist only on a model with events)
         ew = events.workspace(kern, n)
         iw = hermite.workspace(n)
@@ -313,6 +350,12 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
         t = t0 + i * h       # not accumulated: no drift of t over millions of steps
         if n_event_fns > 0:
             hermite.begin(iw, q, v)
+        if control is not None and control(control_data, t, q, v, p):
+            # A changed input invalidates what prepare cached (verlet's acceleration).
+            status = method.prepare(kern, q, v, mom, t, p, settings, ws, extra)
+            if status != OK:
+                _last(out_last, t, q, v, iters_acc, 0.0, extra)
+                return status, i, n_events
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
         iters_acc += iters
         resid_max = max(resid_max, resid)
@@ -324,6 +367,10 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
         if status != OK:
             _last(out_last, t_new, q, v, iters_acc, resid, extra)
             return status, i, n_events
+        if kern.WORK:
+            P1, D1 = work.rate(kern, ww, q, v, t_new, p)
+            W += work.increment(h, P0, D0, P1, D1)
+            P0, D0 = P1, D1
         if n_event_fns > 0:
             if events.crossed(kern, ew, q, v, t_new, p):
                 hermite.fit(kern, iw, t, t_new, q, v, p)
@@ -331,6 +378,8 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
                                                   out_events, n_events)
                 if stopped:
                     _last(out_last, ew.stop[0], ew.q, ew.v, iters_acc, resid_max, extra)
+                    if out_last.shape[0] > 2 * n + 3 + n_saved:
+                        out_last[out_last.shape[0] - 1] = W     # (W at the end of the step)
                     return OK, i, n_events
             events.advance(ew)
         since += 1
@@ -342,7 +391,10 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
                 return NON_FINITE, i, n_events
             _save((i + 1) // save_every, t_new, q, v, energy, iters_acc,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
+            out_stats[(i + 1) // save_every, STAT_WORK] = W
             iters_acc = 0.0
             resid_max = 0.0
     _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max, extra)
+    if out_last.shape[0] > 2 * n + 3 + n_saved:
+        out_last[out_last.shape[0] - 1] = W
     return OK, n_steps, n_events

@@ -121,4 +121,4 @@ SPEC = Spec(
     stable="stable for tau < 1.57", stable_tau=1.5734, rho=partial(linear_radius, COEFFS),
     settings=PartitionedSettings,
     kernels=("forward_dynamics", "mass_matrix", "mass_matvec_dq",
-             "momentum_rate", "momentum_rate_jacobian"))
+             "momentum_rate", "momentum_rate_jacobian", "transport", "transport_dq"))

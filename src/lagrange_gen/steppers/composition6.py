@@ -52,4 +52,4 @@ SPEC = Spec(
     stable="stable for tau < 2.53", stable_tau=2.5326, rho=partial(linear_radius, COEFFS),
     settings=PartitionedSettings,
     kernels=("forward_dynamics", "mass_matrix", "mass_matvec_dq",
-             "momentum_rate", "momentum_rate_jacobian"))
+             "momentum_rate", "momentum_rate_jacobian", "transport", "transport_dq"))

@@ -36,7 +36,7 @@ from numba import njit
 from ..status import OK
 from . import newton
 from .base import FAST
-from .constrained import SAVED, record, velocity_projection
+from .constrained import SAVED, constraint_rate, record, velocity_projection
 from .spec import NewtonSettings, Spec
 
 #: Scratch of one run (n coordinates, m constraints): the Newton unknown x = (v1, nu), residual
@@ -78,9 +78,9 @@ def assemble(kern, args, x, F, K):
         dv[i] = v1[i] - v[i]
     kern.dynamics(q1, v1, t1, p, H, rhs)
     kern.rhs_jacobian(q1, v1, t1, p, Jq, Jqd)
-    kern.mass_matvec_dq(q1, dv, p, dHw)
-    kern.constraints(q1, v1, p, phi, Jb, gam)
-    kern.constraint_dq(q1, v1, nu, p, T, DJ)     # T = d(J v1)/dq is not needed
+    kern.mass_matvec_dq(q1, dv, t1, p, dHw)
+    kern.constraints(q1, v1, t1, p, phi, Jb, gam)
+    kern.constraint_dq(q1, v1, nu, t1, p, T, DJ)     # T = d(J v1)/dq is not needed
     for i in range(n):
         r = -h * rhs[i]
         for j in range(n):
@@ -116,15 +116,16 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     for i in range(n):
         q1[i] = q[i] + h * x[i]
         vp[i] = x[i]
-    kern.constraints(q1, vp, p, phi, Jb, ws.gam)
-    status = velocity_projection(kern, q1, p, Jb, ws.Y, ws.H, ws.S, eta, vp, False)
+    kern.constraints(q1, vp, t + h, p, phi, Jb, ws.gam)
+    constraint_rate(kern, q1, t + h, p, ws.gam)        # gam: dPhi/dt from here on
+    status = velocity_projection(kern, q1, t + h, p, Jb, ws.Y, ws.H, ws.S, eta, vp, False, ws.gam)
     if status != OK:
         return status, iters, resid
     for i in range(n):
         q[i], v[i] = q1[i], vp[i]
     for k in range(m):
         extra[k] = (x[n + k] + eta[k]) / h    # total impulse over h
-    record(extra, m, phi, Jb, v)
+    record(extra, m, phi, Jb, v, ws.gam)
     return OK, iters, resid
 
 
@@ -138,5 +139,5 @@ SPEC = Spec(
     constraints=True,
     saved=SAVED, constraint_drift="none",
     settings=NewtonSettings,
-    kernels=("constraint_dq", "constraints", "dynamics", "mass_matrix",
+    kernels=("constraint_dq", "constraint_rate", "constraints", "dynamics", "mass_matrix",
              "mass_matvec_dq", "rhs_jacobian"))

@@ -63,8 +63,8 @@ def workspace(kern, n):
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps, and J(q) in ws.Ja (each step leaves
     J(q+) there for the next)."""
-    momentum_from_velocity(kern, q, v, p, ws.H, mom)
-    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
+    momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
+    kern.constraints(q, v, t, p, ws.phi, ws.Ja, ws.gam)
     return OK
 
 
@@ -78,11 +78,13 @@ def assemble(kern, args, x, F, K):
     for i in range(n):
         qb[i] = q[i] + hh * x[i]
         q1[i] = q[i] + h * x[i]
-    kern.mass_matrix(qb, p, H)
-    kern.mass_matvec_dq(qb, x[:n], p, dHw)
+    kern.mass_matrix(qb, tm, p, H)
+    kern.mass_matvec_dq(qb, x[:n], tm, p, dHw)
     kern.momentum_rate(qb, x[:n], tm, p, f)
     kern.momentum_rate_jacobian(qb, x[:n], tm, p, Jq, Jqd)
-    kern.constraints(q1, x[:n], p, phi, Jb, gam)
+    kern.constraints(q1, x[:n], tm + hh, p, phi, Jb, gam)
+    if kern.TRANSPORT:                        # p = H v + b: R1 gains b(qb), its Jacobian h/2 db/dq
+        kern.transport_dq(qb, tm, p, dHw)
     for i in range(n):
         r = -mom[i] - hh * f[i]
         for j in range(n):
@@ -98,6 +100,8 @@ def assemble(kern, args, x, F, K):
             K[n + k, j] = Jb[k, j]
         for j in range(m):
             K[n + k, n + j] = 0.0
+    if kern.TRANSPORT:
+        kern.transport(qb, tm, p, F[:n])
 
 
 @njit(**FAST)
@@ -126,7 +130,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         for k in range(m):
             s += ws.Ja[k, i] * x[n + k]
         pt[i] = s
-    status = finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, vb, ws.phi, ws.Jb, ws.gam,
+    status = finish_momentum_step(kern, q, v, mom, q1, t + h, pt, p, hh, vb, ws.phi, ws.Jb, ws.gam,
                                   ws.Y, ws.H, ws.S, ws.eta, ws.v1, extra, ws.Ja)
     return status, iters, resid
 
@@ -141,5 +145,5 @@ SPEC = Spec(
     constraints=True,
     saved=SAVED, constraint_drift="none",
     settings=NewtonSettings,
-    kernels=("constraints", "mass_matrix", "mass_matvec_dq", "momentum_rate",
-             "momentum_rate_jacobian"))
+    kernels=("constraint_rate", "constraints", "mass_matrix", "mass_matvec_dq", "momentum_rate",
+             "momentum_rate_jacobian", "transport", "transport_dq"))

@@ -54,7 +54,7 @@ def assemble(kern, args, v1, R, A):
         dv[i] = v1[i] - v[i]
     kern.dynamics(q1, v1, t1, p, H, rhs)
     kern.rhs_jacobian(q1, v1, t1, p, Jq, Jqd)
-    kern.mass_matvec_dq(q1, dv, p, dHw)
+    kern.mass_matvec_dq(q1, dv, t1, p, dHw)
     for i in range(n):
         s = -h * rhs[i]
         for j in range(n):

@@ -33,7 +33,7 @@ from numba import njit
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
 from .base import FAST
-from .constrained import SAVED, record, solve_rows
+from .constrained import SAVED, constraint_rate, record, solve_rows
 from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 from .spec import Spec
 
@@ -66,13 +66,14 @@ def _accel(kern, q, v, t, p, alpha, beta, H, a, lam, phi, J, gam, Y, S):
     kernel's outputs at q) stay available to the caller. Status OK or SINGULAR_MASS."""
     n, m = q.shape[0], phi.shape[0]
     kern.dynamics(q, v, t, p, H, a)
-    kern.constraints(q, v, p, phi, J, gam)
+    kern.constraints(q, v, t, p, phi, J, gam)
+    constraint_rate(kern, q, t, p, lam)       # lam holds dPhi/dt until overwritten below
     if not cholesky_inplace(H):
         return SINGULAR_MASS
     cholesky_solve_inplace(H, a)              # unconstrained acceleration
     solve_rows(H, J, Y)
     for i in range(m):
-        s = gam[i] - beta * beta * phi[i]
+        s = gam[i] - beta * beta * phi[i] - 2.0 * alpha * lam[i]
         for j in range(n):
             s -= J[i, j] * (2.0 * alpha * v[j] + a[j])
         lam[i] = s
@@ -129,7 +130,8 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         q[i], v[i], a0[i] = q_new[i], v_new[i], stage_a[0, i]
     for k in range(m):
         extra[k] = ws.ls[k]
-    record(extra, m, ws.phi, ws.J, v)
+    constraint_rate(kern, q, t + h, p, ws.gam)
+    record(extra, m, ws.phi, ws.J, v, ws.gam)
     return OK, 0, 0.0
 
 
@@ -144,4 +146,4 @@ SPEC = Spec(
     saved=SAVED, constraint_drift="grows",
     limits={"baumgarte": (0.0, True, False)},
     settings=Index1Settings,
-    kernels=("constraints", "dynamics"))
+    kernels=("constraint_rate", "constraints", "dynamics"))

@@ -13,6 +13,10 @@ the Newton tolerance). On a linear system with constant H it is exactly the impl
 rule: on x'' = -omega^2 x the step matrix is a rotation (Cayley transform), rho = 1 for every
 tau = h omega, with phase 2 atan(tau/2) per step (A-stable, no numerical damping).
 
+Rheonomic models: H, b and f are evaluated at tm = t + h/2 and v+ = H(q+, t + h)^-1 (p+ - b);
+with a term T1 = b(q, t) . v in T, p is the canonical momentum H v + b and R gains b(qb, tm)
+(its Jacobian h/2 db/dq), so the scheme stays the variational one for L = T - V.
+
 Newton uses the exact Jacobian
     dR/dvb = H(qb) + h/2 d(H vb)/dq - h^2/4 df/dq - h/2 df/dv
 from ``mass_matvec_dq`` and ``momentum_rate_jacobian``.
@@ -47,7 +51,7 @@ def workspace(kern, n):
 @njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps."""
-    momentum_from_velocity(kern, q, v, p, ws.H, mom)
+    momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
     return OK
 
 
@@ -58,16 +62,20 @@ def assemble(kern, args, vb, R, A):
     n = q.shape[0]
     for i in range(n):
         qb[i] = q[i] + hh * vb[i]
-    kern.mass_matrix(qb, p, H)
-    kern.mass_matvec_dq(qb, vb, p, dHw)
+    kern.mass_matrix(qb, tm, p, H)
+    kern.mass_matvec_dq(qb, vb, tm, p, dHw)
     kern.momentum_rate(qb, vb, tm, p, f)
     kern.momentum_rate_jacobian(qb, vb, tm, p, Jq, Jqd)
+    if kern.TRANSPORT:                        # p = H v + b: R gains b(qb), dR/dvb h/2 db/dq
+        kern.transport_dq(qb, tm, p, dHw)
     for i in range(n):
         s = -mom[i] - hh * f[i]
         for j in range(n):
             s += H[i, j] * vb[j]
             A[i, j] = H[i, j] + hh * dHw[i, j] - hh * hh * Jq[i, j] - hh * Jqd[i, j]
         R[i] = s
+    if kern.TRANSPORT:
+        kern.transport(qb, tm, p, R)
 
 
 @njit(**FAST)
@@ -90,7 +98,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     kern.momentum_rate(qb, vb, tm, p, f)      # at the converged vb: p+ = p + h f exactly
     for i in range(n):
         p_new[i] = mom[i] + h * f[i]
-    status = velocity_from_momentum(kern, q_new, p_new, p, ws.A, v_new)
+    status = velocity_from_momentum(kern, q_new, p_new, t + h, p, ws.A, v_new)
     if status != OK:
         return status, iters, resid
     for i in range(n):
@@ -118,4 +126,4 @@ SPEC = Spec(
     stable_tau=math.inf, rho=linear_radius, phase=linear_phase,
     settings=NewtonSettings,
     kernels=("mass_matrix", "mass_matvec_dq", "momentum_rate",
-             "momentum_rate_jacobian"))
+             "momentum_rate_jacobian", "transport", "transport_dq"))

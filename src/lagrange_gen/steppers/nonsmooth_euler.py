@@ -91,7 +91,7 @@ def _smooth_and_sliders(kern, q, v, t1, h, p, v1, q1, dv, rhs, F, H, A, Jq, Jqd,
         dv[i] = v1[i] - v[i]
     kern.dynamics(q1, v1, t1, p, H, rhs)
     kern.rhs_jacobian(q1, v1, t1, p, Jq, Jqd)
-    kern.mass_matvec_dq(q1, dv, p, dHw)
+    kern.mass_matvec_dq(q1, dv, t1, p, dHw)
     kern.elements(q1, p, s1, G, coef)
     for e in range(ne):
         we[e] = 0.0

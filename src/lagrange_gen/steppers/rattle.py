@@ -45,8 +45,8 @@ from numba import njit
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
 from . import newton
-from .base import FAST, explicit_path, momentum_from_velocity
-from .constrained import SAVED, finish_momentum_step, project, record, solve_rows
+from .base import FAST, explicit_path, momentum_from_velocity, subtract_transport
+from .constrained import SAVED, constraint_rate, finish_momentum_step, project, record, solve_rows
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run (n coordinates, m constraints); every array costs a little in each call of
@@ -82,7 +82,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """J(q) into ws.Ja (then each step leaves J(q+) there for the next). Explicit path: factor
     the constant M once (ws.M), cache a(q, t) in ws.acc and the rows M^-1 J(q)^T in ws.Y.
     Newton path: carry p = H(q) v."""
-    kern.constraints(q, v, p, ws.phi, ws.Ja, ws.gam)
+    kern.constraints(q, v, t, p, ws.phi, ws.Ja, ws.gam)
     if explicit_path(kern, settings):
         L, acc = ws.M, ws.acc
         kern.dynamics(q, v, t, p, L, acc)
@@ -91,7 +91,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
         cholesky_solve_inplace(L, acc)
         solve_rows(L, ws.Ja, ws.Y)
         return OK
-    momentum_from_velocity(kern, q, v, p, ws.M, mom)
+    momentum_from_velocity(kern, q, v, t, p, ws.M, mom)
     return OK
 
 
@@ -99,14 +99,14 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def assemble_multiplier(kern, args, kap, F, K):
     """Newton system of the explicit path: F (m) <- Phi(q+) at q+ = z + Y^T kappa, K (m, m) <-
     J(q+) Y^T = J(q+) M^-1 J(q)^T."""
-    z, vh, p, Y, q1, phi, Jb, gam = args
+    z, vh, t1, p, Y, q1, phi, Jb, gam = args
     n, m = z.shape[0], kap.shape[0]
     for i in range(n):
         s = z[i]
         for k in range(m):
             s += Y[k, i] * kap[k]
         q1[i] = s
-    kern.constraints(q1, vh, p, phi, Jb, gam)
+    kern.constraints(q1, vh, t1, p, phi, Jb, gam)
     for i in range(m):
         F[i] = phi[i]
         for k in range(m):
@@ -127,7 +127,7 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
         z[i] = q[i] + h * vh[i]
     for k in range(m):                        # Y: rows M^-1 J(q)_k^T, q+ = z + Y^T kappa
         kap[k] = hh * h * extra[k]
-    status, iters, resid = newton.solve(_MULTIPLIER, kern, (z, vh, p, Y, q1, phi, Jb, ws.gam),
+    status, iters, resid = newton.solve(_MULTIPLIER, kern, (z, vh, t + h, p, Y, q1, phi, Jb, ws.gam),
                                         kap, ws.Fk, ws.S, ws.piv, ws.s,
                                         settings.newton_tol, settings.max_iter)
     if status != OK:
@@ -138,14 +138,15 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
             s += Y[k, i] * kap[k]
         q1[i] = z[i] + s
         vh[i] += s / h
-    kern.constraints(q1, vh, p, phi, Jb, ws.gam)
+    kern.constraints(q1, vh, t + h, p, phi, Jb, ws.gam)
     # Velocity stage: forces are velocity-free here, so a(q+) does not depend on vh.
     kern.dynamics(q1, vh, t + h, p, ws.H1, f)
     cholesky_solve_inplace(L, f)
     for i in range(n):
         v1[i] = vh[i] + hh * f[i]
     solve_rows(L, Jb, T)
-    if not project(Jb, T, v1, ws.S, ws.eta):           # eta = h/2 mu
+    constraint_rate(kern, q1, t + h, p, ws.gam)        # gam: dPhi/dt from here on
+    if not project(Jb, T, v1, ws.S, ws.eta, ws.gam):   # eta = h/2 mu
         return SINGULAR_MASS, iters, resid
     for i in range(n):
         q[i], v[i], acc[i] = q1[i], v1[i], f[i]
@@ -153,7 +154,7 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
         extra[k] = ws.eta[k] / hh
         for j in range(n):
             Ja[k, j], Y[k, j] = Jb[k, j], T[k, j]       # J(q), M^-1 J(q)^T of the next step
-    record(extra, m, phi, Jb, v)
+    record(extra, m, phi, Jb, v, ws.gam)
     return OK, iters, resid
 
 
@@ -161,7 +162,7 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
 def assemble_position(kern, args, x, F, K):
     """Newton system of the Newton path: F (2n + m) <- (kick, drift, Phi(q+)/h) at
     x = (u, w, nu), K its Jacobian (module docstring)."""
-    q, mom, t, h, p, q1, f, H0, H1, Jq, Jqd, D, phi, Ja, Jb, gam = args
+    q, mom, pm, t, h, p, q1, f, H0, H1, Jq, Jqd, D, phi, Ja, Jb, gam = args
     n, m = q.shape[0], phi.shape[0]
     u, w = x[:n], x[n:2 * n]
     hh = 0.5 * h
@@ -169,12 +170,17 @@ def assemble_position(kern, args, x, F, K):
         q1[i] = q[i] + hh * (u[i] + w[i])
     kern.momentum_rate(q, u, t, p, f)
     kern.momentum_rate_jacobian(q, u, t, p, Jq, Jqd)
-    kern.mass_matrix(q1, p, H1)
-    kern.mass_matvec_dq(q1, w, p, D)
-    kern.constraints(q1, w, p, phi, Jb, gam)
+    kern.mass_matrix(q1, t + h, p, H1)
+    kern.mass_matvec_dq(q1, w, t + h, p, D)
+    kern.constraints(q1, w, t + h, p, phi, Jb, gam)
+    if kern.TRANSPORT:                        # p = H v + b: the drift conserves H u + b
+        kern.transport_dq(q1, t + h, p, D)
     for i in range(n):
-        ra = -mom[i] - hh * f[i]
-        rb = 0.0
+        # pm = p - b(q, t) (see _step_newton; pm = p when T1 = 0): the kick H(q) u + b(q) = p +
+        # h/2 f + J^T nu and, once b(q+) is added below, the drift residual
+        # rb = H(q+) w + b(q+) - (H(q) u + b(q)).
+        ra = -pm[i] - hh * f[i]
+        rb = pm[i] - mom[i]
         for j in range(n):
             ra += H0[i, j] * u[j]
             rb += H1[i, j] * w[j] - H0[i, j] * u[j]
@@ -195,6 +201,8 @@ def assemble_position(kern, args, x, F, K):
             K[2 * n + k, n + j] = 0.5 * Jb[k, j]
         for j in range(m):
             K[2 * n + k, 2 * n + j] = 0.0
+    if kern.TRANSPORT:
+        kern.transport(q1, t + h, p, F[n:2 * n])
 
 
 @njit(inline="always")
@@ -202,13 +210,17 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
     n, m = q.shape[0], kern.N_CONSTRAINTS
     x, q1, f, pt, H0 = ws.x, ws.q1, ws.f, ws.pt, ws.M
     hh = 0.5 * h
-    kern.mass_matrix(q, p, H0)
+    kern.mass_matrix(q, t, p, H0)
     for i in range(n):
         x[i] = v[i]
         x[n + i] = v[i]
     for k in range(m):
         x[2 * n + k] = hh * extra[k]          # nu from the previous step's multiplier
-    args = (q, mom, t, h, p, q1, f, H0, ws.H1, ws.Jq, ws.Jqd, ws.D, ws.phi, ws.Ja, ws.Jb,
+    # pt (free until the end of the step) holds p - b(q, t) for the Newton system (assemble).
+    for i in range(n):
+        pt[i] = mom[i]
+    subtract_transport(kern, q, t, p, pt)
+    args = (q, mom, pt, t, h, p, q1, f, H0, ws.H1, ws.Jq, ws.Jqd, ws.D, ws.phi, ws.Ja, ws.Jb,
             ws.gam)
     status, iters, resid = newton.solve(_POSITION, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
                                         settings.newton_tol, settings.max_iter)
@@ -219,11 +231,11 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
         q1[i] = q[i] + hh * (u[i] + w[i])
     kern.momentum_rate(q1, w, t + h, p, f)
     for i in range(n):
-        s = hh * f[i]
+        s = hh * f[i] + mom[i] - pt[i]        # b(q, t) (pt holds p - b)
         for j in range(n):
-            s += H0[i, j] * u[j]              # H(q) u = p + h/2 f + J^T nu, exactly
+            s += H0[i, j] * u[j]              # H(q) u + b = p + h/2 f + J^T nu, exactly
         pt[i] = s
-    status = finish_momentum_step(kern, q, v, mom, q1, pt, p, hh, w, ws.phi, ws.Jb, ws.gam,
+    status = finish_momentum_step(kern, q, v, mom, q1, t + h, pt, p, hh, w, ws.phi, ws.Jb, ws.gam,
                                   ws.Y, ws.H1, ws.S, ws.eta, ws.v1, extra, ws.Ja)
     return status, iters, resid
 
@@ -247,5 +259,5 @@ SPEC = Spec(
     constraints=True,
     saved=SAVED, constraint_drift="none",
     settings=PartitionedSettings,
-    kernels=("constraints", "dynamics", "mass_matrix", "mass_matvec_dq",
-             "momentum_rate", "momentum_rate_jacobian"))
+    kernels=("constraint_rate", "constraints", "dynamics", "mass_matrix", "mass_matvec_dq",
+             "momentum_rate", "momentum_rate_jacobian", "transport", "transport_dq"))

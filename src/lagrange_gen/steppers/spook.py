@@ -38,7 +38,7 @@ from numba import njit
 
 from ..status import OK
 from .base import FAST, newton_solve
-from .constrained import SAVED, record
+from .constrained import SAVED, constraint_rate, record
 from .spec import Spec
 
 #: Scratch of one run (n coordinates, m constraints): the unknown x = (v+, nu) (right-hand side
@@ -79,7 +79,8 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     ups = 1.0 / (1.0 + 4.0 * settings.relaxation)
     sigma = 4.0 * settings.compliance * ups / (h * h)
     kern.dynamics(q, v, t, p, M, ws.f)
-    kern.constraints(q, v, p, phi, G, ws.gam)
+    kern.constraints(q, v, t, p, phi, G, ws.gam)
+    constraint_rate(kern, q, t, p, ws.gam)             # gam: dPhi/dt (spook needs no gamma)
     for i in range(n):                        # [M, -G^T] x = M v + h f
         s = h * ws.f[i]
         for j in range(n):
@@ -89,7 +90,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
             K[i, n + k] = -G[k, i]
         x[i] = s
     for k in range(m):                        # [G, sigma I] x = -(4/h) ups Phi + ups G v
-        s = -4.0 / h * ups * phi[k]
+        s = -4.0 / h * ups * phi[k] + (ups - 1.0) * ws.gam[k]   # J v + dPhi/dt as velocity error
         for j in range(n):
             s += ups * G[k, j] * v[j]
             K[n + k, j] = G[k, j]
@@ -104,8 +105,9 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         q[i] += h * x[i]
     for k in range(m):
         extra[k] = x[n + k] / h
-    kern.constraints(q, v, p, phi, ws.Jb, ws.gam)
-    record(extra, m, phi, ws.Jb, v)
+    kern.constraints(q, v, t + h, p, phi, ws.Jb, ws.gam)
+    constraint_rate(kern, q, t + h, p, ws.gam)
+    record(extra, m, phi, ws.Jb, v, ws.gam)
     return OK, 0, 0.0
 
 
@@ -117,4 +119,4 @@ SPEC = Spec(
     saved=SAVED, constraint_drift="bounded",
     limits={"compliance": (0.0, True, False), "relaxation": (0.0, False, False)},
     settings=SpookSettings,
-    kernels=("constraints", "dynamics"))
+    kernels=("constraint_rate", "constraints", "dynamics"))

@@ -44,7 +44,7 @@ def workspace(kern, n):
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps (Newton path only)."""
     if not explicit_path(kern, settings):
-        momentum_from_velocity(kern, q, v, p, ws.H, mom)
+        momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
     return OK
 
 
@@ -72,7 +72,9 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     for i in range(n):
         q_new[i] = q[i] + h * u[i]
     matvec(ws.H, u, p_new)                     # solve_kick leaves H(q) in ws.H
-    status = velocity_from_momentum(kern, q_new, p_new, p, ws.A, v_new)
+    if kern.TRANSPORT:
+        kern.transport(q, t, p, p_new)         # the canonical momentum H u + b
+    status = velocity_from_momentum(kern, q_new, p_new, t + h, p, ws.A, v_new)
     if status != OK:
         return status, iters, resid
     for i in range(n):
@@ -87,4 +89,4 @@ SPEC = Spec(
     # Step matrix [[1 - tau^2, tau], [-tau, 1]]: verlet's trace and determinant, so its rho.
     stable="stable for tau < 2", stable_tau=2.0, rho=verlet.linear_radius,
     settings=PartitionedSettings,
-    kernels=("forward_dynamics", "mass_matrix", "momentum_rate", "momentum_rate_jacobian"))
+    kernels=("forward_dynamics", "mass_matrix", "momentum_rate", "momentum_rate_jacobian", "transport"))

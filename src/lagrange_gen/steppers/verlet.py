@@ -54,7 +54,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Explicit path: cache a(q, t) in ws.acc. Newton path: carry p = H(q) v."""
     if explicit_path(kern, settings):
         return accel(kern, q, v, t, p, ws.H, ws.acc)
-    momentum_from_velocity(kern, q, v, p, ws.H, mom)
+    momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
     return OK
 
 
@@ -92,10 +92,12 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
                                    ws.Jq, ws.Jqd, ws.piv, u, ws.R, f, ws.s)
     if status != OK:
         return status, it1, res1
-    matvec(ws.H, u, p_half)                    # p* = H(q) u (solve_kick leaves H(q) in ws.H)
+    matvec(ws.H, u, p_half)                    # p* = H(q) u + b (solve_kick leaves H(q) in ws.H)
+    if kern.TRANSPORT:
+        kern.transport(q, t, p, p_half)
     for i in range(n):
         w[i] = u[i]
-    status, it2, res2 = solve_drift(kern, q, u, p_half, 0.5 * h, p, tol, max_iter, ws.H, ws.A,
+    status, it2, res2 = solve_drift(kern, q, u, p_half, 0.5 * h, t + h, p, tol, max_iter, ws.H, ws.A,
                                     ws.dHw, ws.piv, w, ws.R, q_new, ws.s)
     iters, resid = it1 + it2, max(res1, res2)
     if status != OK:
@@ -103,7 +105,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     kern.momentum_rate(q_new, w, t + h, p, f)
     for i in range(n):
         p_half[i] += 0.5 * h * f[i]            # now p+
-    status = velocity_from_momentum(kern, q_new, p_half, p, ws.A, v_new)
+    status = velocity_from_momentum(kern, q_new, p_half, t + h, p, ws.A, v_new)
     if status != OK:
         return status, iters, resid
     for i in range(n):
@@ -139,4 +141,4 @@ SPEC = Spec(
     stable="stable for tau < 2", stable_tau=2.0, rho=linear_radius,
     settings=PartitionedSettings,
     kernels=("forward_dynamics", "mass_matrix", "mass_matvec_dq",
-             "momentum_rate", "momentum_rate_jacobian"))
+             "momentum_rate", "momentum_rate_jacobian", "transport", "transport_dq"))

@@ -1,0 +1,17 @@
+"""The test model of this directory, generated once per session (a fixture the tests import:
+no conftest.py here, whose name would shadow tests/conftest.py for `from conftest import ...`)."""
+
+from pathlib import Path
+
+import pytest
+
+from lagrange_gen.codegen import generate_model
+from lagrange_gen.loader import import_generated
+
+HERE = Path(__file__).resolve().parent
+
+
+@pytest.fixture(scope="session")
+def torque_pendulum(gen_dir):
+    """tests/control/torque_pendulum.py: an input without default, two outputs."""
+    return import_generated(generate_model(HERE / "torque_pendulum.py", gen_dir).path)

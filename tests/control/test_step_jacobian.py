@@ -1,0 +1,34 @@
+"""Jacobians of one discrete step (state and input) against central differences of the
+steppers' own steps, at a moving state with a nonzero input."""
+
+import numpy as np
+import pytest
+
+import lagrange_gen as lg
+from control_util import torque_pendulum  # noqa: F401  (a fixture)
+from lagrange_gen.step_derivatives import METHODS
+
+@pytest.mark.parametrize("method", METHODS)
+def test_step_jacobian_matches_finite_differences(torque_pendulum, method):
+    """H(q) is not constant and the torque u cos(x) depends on the state: every term of the
+    implicit-function-theorem formulas is exercised. Newton at 1e-15 so the differences of the
+    steps (eps = 1e-6) are not dominated by the Newton tolerance."""
+    settings = {} if method == "rk4" else dict(newton_tol=1e-15)
+    q, v, u, h = np.array([0.3, 0.9]), np.array([-0.4, 1.1]), 0.7, 0.05
+    q1, v1, Fx, Gu = lg.step_jacobian(torque_pendulum, method, h, q, v, u=[u], **settings)
+
+    def step(z):
+        a, b, _, _ = lg.step_jacobian(torque_pendulum, method, h, z[:2], z[2:4], u=[z[4]], **settings)
+        return np.concatenate((a, b))
+
+    z, eps = np.concatenate((q, v, [u])), 1e-6
+    J = np.array([(step(z + eps * e) - step(z - eps * e)) / (2 * eps) for e in np.eye(5)]).T
+    np.testing.assert_allclose(np.concatenate((q1, v1)), step(z), rtol=0, atol=0)
+    np.testing.assert_allclose(Fx, J[:, :4], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(Gu, J[:, 4:], rtol=0, atol=1e-8)
+    assert np.abs(Fx - np.eye(4)).max() > 1e-2       # not the identity: the test can fail
+
+
+def test_step_jacobian_refuses_uncovered_method(torque_pendulum):
+    with pytest.raises(lg.SimulationError, match="'composition' is not covered"):
+        lg.step_jacobian(torque_pendulum, "composition", 0.01, [0, 0], [0, 0], u=[0.0])
