@@ -76,14 +76,8 @@ def _panels(traj):
 
 def _energy_panel(traj):
     """E - E0, or E - E0 - W with the work W (S,) when the trajectory has one."""
-    work = getattr(traj, "work", None)
-    if work is None:
-        return "E - E0", lambda ax: ax.plot(traj.t, traj.energy_error, lw=1, label="E - E0")
-    balance = traj.energy_error - (np.asarray(work) - work[0])
-
-    def draw(ax):
-        ax.plot(traj.t, balance, lw=1, label="E - E0 - W")
-    return "E - E0 - W", draw
+    label = "E - E0" if traj.work is None else "E - E0 - W"
+    return label, lambda ax: ax.plot(traj.t, traj.energy_balance, lw=1, label=label)
 
 
 def _constraint_errors(ax, traj):

@@ -89,9 +89,11 @@ class Trajectory:
 
     @property
     def energy_balance(self) -> np.ndarray:
-        """E - E0 - W (S,): zero up to the method's error when the work is tracked (``work``),
-        else E - E0."""
-        return self.energy_error if self.work is None else self.energy_error - self.work
+        """E - E0 - (W - W0) (S,): zero up to the method's error when the work is tracked
+        (``work``), else E - E0. (W0 = 0 unless the trajectory was cut from a longer one.)"""
+        if self.work is None:
+            return self.energy_error
+        return self.energy_error - (np.asarray(self.work) - self.work[0])
 
     @property
     def max_energy_balance_error(self) -> float:

@@ -74,8 +74,9 @@ class Dynamics:
     @property
     def has_work(self):
         """True when E = T2 - T0 + V is not conserved: non-conservative forces, dissipation or
-        an explicit t in L (P = qd . Q_nc - dL/dt nonzero)."""
-        return self.native["power"][0, 0] != 0
+        an explicit t in L (P = qd . Q_nc - dL/dt nonzero), or nonsmooth elements (which
+        dissipate; steppers/work.py)."""
+        return self.native["power"][0, 0] != 0 or self.n_elements > 0
 
     @property
     def has_transport(self):

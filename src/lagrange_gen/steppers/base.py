@@ -356,6 +356,8 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
             if status != OK:
                 _last(out_last, t, q, v, iters_acc, 0.0, extra)
                 return status, i, n_events
+        if kern.WORK and kern.N_ELEMENTS > 0:
+            work.elements_begin(kern, ww, q, p, extra)
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
         iters_acc += iters
         resid_max = max(resid_max, resid)
@@ -371,6 +373,8 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
             P1, D1 = work.rate(kern, ww, q, v, t_new, p)
             W += work.increment(h, P0, D0, P1, D1)
             P0, D0 = P1, D1
+            if kern.N_ELEMENTS > 0:      # (only element methods run on such a model: extra
+                W += work.elements_increment(kern, ww, q, p, extra)   # holds their states)
         if n_event_fns > 0:
             if events.crossed(kern, ew, q, v, t_new, p):
                 hermite.fit(kern, iw, t, t_new, q, v, p)
