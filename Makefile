@@ -23,7 +23,7 @@ demo: generate
 		--q0 0.1 0.5 --v0 0 0 --out out/cart_pendulum.npz --plot out/cart_pendulum.png
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 clean:
 	rm -rf $(VENV) out .pytest_cache
