@@ -1,5 +1,6 @@
 """Shared fixtures: every model in models/ is generated once per session into a temp dir."""
 
+import json
 from pathlib import Path
 
 import pytest
@@ -53,3 +54,37 @@ def derived():
             cache[stem] = derive(load_model(MODELS_DIR / f"{stem}.py"))
         return cache[stem]
     return get
+
+
+# The differential harness's report (tests/harness): here, not in tests/harness/conftest.py,
+# because this is the conftest the pytest-xdist controller loads.
+
+def pytest_sessionfinish(session):
+    """On a pytest-xdist worker: hand this worker's harness counts to the controller."""
+    from harness import report
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None:
+        workeroutput["harness"] = report.worker_counts()
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """On the xdist controller: add a finished worker's harness counts."""
+    from harness import report
+    counts = getattr(node, "workeroutput", {}).get("harness")
+    if counts:
+        report.add_worker_counts(counts)
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    from harness import report
+    s = report.summary()
+    path = config.getoption("harness_summary", default=None)
+    if path:
+        with open(path, "w") as fh:
+            json.dump(s, fh, indent=1, sort_keys=True)
+    if s["models"]:
+        bug = config.getoption("printer_bug", default=False)
+        terminalreporter.write_line(
+            f"harness ({s['profile']}): {s['models']} models drawn, {s['kernel_checks']} kernel checks, "
+            f"{len(s['kinds'])} kernel kinds" + (f", {s['failed_models']} models failed (--printer-bug)" if bug else ""))
