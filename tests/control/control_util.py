@@ -15,3 +15,9 @@ HERE = Path(__file__).resolve().parent
 def torque_pendulum(gen_dir):
     """tests/control/torque_pendulum.py: an input without default, two outputs."""
     return import_generated(generate_model(HERE / "torque_pendulum.py", gen_dir).path)
+
+
+@pytest.fixture(scope="session")
+def modulated_pendulum(gen_dir):
+    """tests/control/modulated_pendulum.py: torque_pendulum with H(q, t)."""
+    return import_generated(generate_model(HERE / "modulated_pendulum.py", gen_dir).path)
