@@ -97,3 +97,77 @@ def test_non_finite_jacobian_is_non_finite_not_singular():
     x = START.copy()
     status, _, _ = _solve(INF_JACOBIAN, A, x, 1e-12, 50)
     assert status == NON_FINITE
+
+
+# ---------------------------------------------------------------- simplified Newton
+# The same systems as residual and Jacobian, counting evaluations (args = (kind, a, counts),
+# counts (2,): [Jacobians, residuals]).
+
+@njit(**FAST)
+def residual_counted(kern, args, x, F):
+    kind, a, counts = args
+    counts[1] += 1.0
+    for i in range(x.shape[0]):
+        F[i] = x[i] * x[i] - a[i]
+    if kind == NAN_RESIDUAL:
+        F[x.shape[0] - 1] = math.nan
+
+
+@njit(**FAST)
+def jacobian_counted(kern, args, x, J):
+    kind, a, counts = args
+    counts[0] += 1.0
+    n = x.shape[0]
+    for i in range(n):
+        for j in range(n):
+            J[i, j] = 0.0
+        J[i, i] = 2.0 * x[i]
+    if kind == SINGULAR:
+        for j in range(n):
+            J[n - 1, j] = J[0, j]
+    elif kind == INF_JACOBIAN:
+        J[0, 0] = math.inf
+
+
+_SIMPLIFIED = newton.problem(__name__ + "._simplified", residual=residual_counted,
+                             jacobian=jacobian_counted)
+
+
+@njit
+def _solve_simplified(kind, a, x, tol, max_iter, counts):
+    n = x.shape[0]
+    F, scratch = np.zeros(n), np.zeros(n)
+    J, piv = np.zeros((n, n)), np.zeros(n, dtype=np.int64)
+    return newton.solve_simplified(_SIMPLIFIED, None, (kind, a, counts), x, F, J, piv, scratch,
+                                   tol, max_iter)
+
+
+def test_simplified_newton_reaches_newtons_root_with_fewer_jacobians():
+    """From a start near the root (J barely changes) the factors are reused: one Jacobian for
+    all the iterations; the root is Newton's to the tolerance."""
+    root = np.sqrt(A)
+    x, counts = root * (1 + 1e-3), np.zeros(2)
+    status, iters, _ = _solve_simplified(ROOTS, A, x, 1e-13, 50, counts)
+    assert status == OK and np.max(np.abs(x - root)) < 1e-13
+    assert counts[0] == 1 and counts[1] == iters and iters >= 3
+
+
+def test_simplified_newton_refactors_when_the_contraction_is_slow():
+    """From START (far: the first Jacobian is off by a factor up to 1.7) the contraction is
+    slower than THETA_REFRESH, so J is assembled again; it still converges to the root."""
+    x, counts = START.copy(), np.zeros(2)
+    status, iters, _ = _solve_simplified(ROOTS, A, x, 1e-12, 50, counts)
+    # the stopping rule is relative to max(1, |x|) = 1.73 and estimates a linear tail
+    assert status == OK and np.max(np.abs(x - np.sqrt(A))) < 1e-11
+    assert 1 < counts[0] < iters and counts[1] == iters
+
+
+def test_simplified_newton_failures_are_newtons():
+    for kind, expected in ((SINGULAR, SINGULAR_NEWTON), (NAN_RESIDUAL, NON_FINITE),
+                           (INF_JACOBIAN, NON_FINITE)):
+        x = START.copy()
+        status, iters, _ = _solve_simplified(kind, A, x, 1e-12, 50, np.zeros(2))
+        assert status == expected and iters == 1
+    x = START.copy()
+    status, iters, _ = _solve_simplified(ROOTS, A, x, 1e-12, 2, np.zeros(2))
+    assert status == NEWTON_DIVERGED and iters == 2

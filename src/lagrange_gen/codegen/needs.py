@@ -46,8 +46,8 @@ def _reached(roots) -> frozenset:
             continue
         needs |= fn.kern_attrs
         roots += [target for target in (info.resolve(c) for c in fn.calls) if target]
-        # A module-level Newton problem (newton.problem(name, assemble)) the function passes on.
-        roots += [(key[0], info.problems[n]) for n in fn.names if n in info.problems]
+        # A module-level Newton problem (newton.problem(name, ...)) the function passes on.
+        roots += [(key[0], f) for n in fn.names if n in info.problems for f in info.problems[n]]
     return frozenset(needs)
 
 
@@ -77,16 +77,18 @@ class _Module:
     def __init__(self, dotted, tree):
         self.dotted = dotted
         self.functions = {n.name: _Function(n) for n in tree.body if isinstance(n, ast.FunctionDef)}
-        # NAME = newton.problem("...", assemble_fn): the assembly newton.solve(NAME, ...) calls.
+        # NAME = newton.problem("...", assemble_fn, residual=..., jacobian=...): the functions
+        # newton.solve / solve_simplified(NAME, ...) call.
         self.problems = {}
         for node in tree.body:
             value = getattr(node, "value", None)
             if (isinstance(node, ast.Assign) and isinstance(value, ast.Call)
-                    and isinstance(value.func, ast.Attribute) and value.func.attr == "problem"
-                    and len(value.args) >= 2 and isinstance(value.args[1], ast.Name)):
+                    and isinstance(value.func, ast.Attribute) and value.func.attr == "problem"):
+                functions = [a.id for a in value.args[1:] if isinstance(a, ast.Name)]
+                functions += [k.value.id for k in value.keywords if isinstance(k.value, ast.Name)]
                 for target in node.targets:
                     if isinstance(target, ast.Name):
-                        self.problems[target.id] = value.args[1].id
+                        self.problems[target.id] = functions
         self.names, self.modules = {}, {}   # imported function name -> module; alias -> module
         for node in tree.body:
             if isinstance(node, ast.ImportFrom) and node.level:

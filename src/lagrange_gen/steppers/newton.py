@@ -9,7 +9,8 @@ attribute ``assemble`` of the module it passes as ``problem``, the jitted assemb
 parameters, its scratch arrays). ``solve`` then owns everything else: the non-finite check of the
 residual, the LU solve of J dx = -F (base.newton_solve: SINGULAR_NEWTON or NON_FINITE when J
 cannot be factored), the update x += dx and the one stopping rule (base.newton_converged),
-counting iterations.
+counting iterations. ``solve_simplified`` is the same iteration keeping J's factors while the
+iteration contracts fast; its problem gives the residual and the Jacobian as two functions.
 
 Why a module and not the assembly function itself: like ``kern`` and ``run_loop``'s ``method``
 (see base.py), numba types a module as a compile-time constant with no runtime value, so
@@ -32,15 +33,22 @@ import types
 
 from numba import njit
 
+from ..linalg import lu_solve_inplace
 from ..status import NEWTON_DIVERGED, NON_FINITE, OK
 from .base import max_abs, newton_converged, newton_solve
 
+#: solve_simplified keeps its factored Jacobian while each increment is at most this fraction of
+#: the previous one; a slower contraction re-assembles and re-factors J at the current iterate.
+THETA_REFRESH = 0.25
 
-def problem(name, assemble):
-    """A module (registered in sys.modules as ``name``) whose ``assemble`` is the given jitted
-    assembly: what ``solve`` takes as ``problem``."""
-    module = types.ModuleType(name, f"Newton system {assemble.__name__} (steppers/newton.py).")
-    module.assemble = assemble
+
+def problem(name, assemble=None, *, residual=None, jacobian=None):
+    """A module (registered in sys.modules as ``name``) holding a Newton system: ``assemble``
+    (what ``solve`` calls), or ``residual(kern, args, x, F)`` and ``jacobian(kern, args, x, J)``
+    (what ``solve_simplified`` calls: the residual alone, and J at the iterate the residual was
+    last evaluated at, reading what the residual left in ``args``)."""
+    module = types.ModuleType(name, f"Newton system {name} (steppers/newton.py).")
+    module.assemble, module.residual, module.jacobian = assemble, residual, jacobian
     sys.modules[name] = module
     return module
 
@@ -67,4 +75,41 @@ def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
         done, prev = newton_converged(F, x, prev, tol)
         if done:
             return OK, it, resid
+    return NEWTON_DIVERGED, max_iter, resid
+
+
+@njit(inline="always")
+def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
+    """Simplified Newton on F(x) = 0 (Hairer-Wanner, Solving ODEs II, sec. IV.8): J = dF/dx is
+    assembled (problem.jacobian) and LU-factored at the initial guess and kept; the following
+    iterations evaluate F alone (problem.residual) and reuse the factors. While the iteration
+    contracts by theta = |dx_k| / |dx_k-1| <= THETA_REFRESH it goes on with the old J; a slower
+    contraction (far from the solution, or a Jacobian that changes fast) re-assembles and
+    re-factors J at the current iterate, so the worst case is Newton itself. Same arguments,
+    stopping rule and returns as ``solve``; worth it when the Jacobian and its factorization
+    cost much more than a residual and J changes little over the iteration (the partitioned
+    kick and drift, whose J is H(q) plus O(h) terms: see partitioned.py for the measurements).
+    The stopping rule's error bound theta / (1 - theta) |dx| is the one made for this linear
+    convergence."""
+    resid = prev = 0.0
+    fresh = True
+    for it in range(1, max_iter + 1):
+        problem.residual(kern, args, x, F)
+        resid = max_abs(F)
+        if not resid < math.inf:        # NaN or inf in F
+            return NON_FINITE, it, resid
+        if fresh:
+            problem.jacobian(kern, args, x, J)
+            status = newton_solve(J, piv, F, scratch)    # J <- its LU factors, F <- J^-1 F
+            if status != OK:
+                return status, it, resid
+        else:
+            lu_solve_inplace(J, piv, F, scratch)
+        for i in range(x.shape[0]):
+            x[i] -= F[i]
+        done, d = newton_converged(F, x, prev, tol)
+        if done:
+            return OK, it, resid
+        fresh = prev > 0.0 and not d <= THETA_REFRESH * prev
+        prev = d
     return NEWTON_DIVERGED, max_iter, resid
