@@ -81,3 +81,28 @@ def test_two_by_two_scalar_paths_are_bitwise_the_loops(A):
         linalg.cholesky_solve_inplace(L1, c1)
         linalg._cholesky_solve_loops(L2, c2)
         _same(c1, c2)
+    F, pf = A.copy(), np.zeros(2, np.int64)
+    if linalg.lu_inplace(F, pf):
+        c1, c2 = b.copy(), b.copy()
+        linalg.lu_solve_inplace(F, pf, c1, np.zeros(2))
+        linalg._lu_solve_inplace_loops(F, pf, c2, np.zeros(2))
+        _same(c1, c2)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 8, 16])
+def test_cholesky_factors_as_lu_solve_and_reconstruct(n):
+    """cholesky_as_lu rewrites L (L L^T = A) as unit-lower L D^-1 and U = D L^T: their product
+    is A, piv is the identity, and lu_solve_inplace with them solves A x = b as numpy does."""
+    rng = np.random.default_rng(n)
+    M = rng.normal(size=(n, n))
+    A = M @ M.T + n * np.eye(n)
+    b = rng.normal(size=n)
+    F, piv = A.copy(), np.full(n, -1, np.int64)
+    assert linalg.cholesky_inplace(F)
+    linalg.cholesky_as_lu(F, piv)
+    np.testing.assert_array_equal(piv, np.arange(n))
+    L, U = np.tril(F, -1) + np.eye(n), np.triu(F)
+    np.testing.assert_allclose(L @ U, A, rtol=1e-13, atol=1e-13 * np.abs(A).max())
+    x = b.copy()
+    linalg.lu_solve_inplace(F, piv, x, np.zeros(n))
+    np.testing.assert_allclose(x, np.linalg.solve(A, b), rtol=1e-12, atol=1e-13)

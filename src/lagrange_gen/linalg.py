@@ -217,8 +217,38 @@ def _lu_solve_system_loops(A, piv, b):
 
 
 @njit(cache=True, _nrt=False)
+def cholesky_as_lu(A, piv):
+    """Rewrite in place the Cholesky factor L of an SPD matrix (lower triangle of A (n, n), from
+    cholesky_inplace) as the LU factors of L L^T in lu_inplace's layout: the unit lower factor
+    L D^-1 below the diagonal, U = D L^T on and above it (D = diag(L)), piv (n,) the identity;
+    lu_solve_inplace then solves with them (the partitioned methods keep the factors of H this
+    way as the first matrix of their simplified Newton, steppers/partitioned.py)."""
+    n = A.shape[0]
+    for k in range(n):
+        piv[k] = k
+        d = A[k, k]
+        for i in range(k + 1, n):
+            A[k, i] = d * A[i, k]
+            A[i, k] /= d
+        A[k, k] = d * d
+
+
+@njit(cache=True, _nrt=False)
 def lu_solve_inplace(LU, piv, b, work):
     """Solve A x = b from lu_inplace's output; b (n,) is overwritten by x, work (n,) is scratch."""
+    if LU.shape[0] == 2:        # the loops' operations on scalars (see the module docstring)
+        y0, y1 = b[piv[0]], b[piv[1]]
+        y1 -= LU[1, 0] * y0
+        x1 = y1 / LU[1, 1]
+        b[0] = (y0 - LU[0, 1] * x1) / LU[0, 0]
+        b[1] = x1
+    else:
+        _lu_solve_inplace_loops(LU, piv, b, work)
+
+
+@njit(cache=True, _nrt=False)
+def _lu_solve_inplace_loops(LU, piv, b, work):
+    """lu_solve_inplace for any n."""
     n = LU.shape[0]
     for i in range(n):
         work[i] = b[piv[i]]

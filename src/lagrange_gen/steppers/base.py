@@ -179,6 +179,30 @@ def newton_solve(A, piv, b, scratch):
 
 
 @njit(**FAST)
+def factor_mass(H, A, piv):
+    """A (n, n) <- the factors of the SPD mass matrix H in lu_solve_inplace's layout (Cholesky,
+    rewritten by linalg.cholesky_as_lu; piv the identity), H unchanged. One factorization then
+    serves v = H^-1 (p - b) and the first Newton matrix of the partitioned methods' next kick
+    and drift (partitioned.py). False when H is not numerically positive definite."""
+    n = H.shape[0]
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = H[i, j]
+    if not _cholesky(A):
+        return False
+    linalg.cholesky_as_lu(A, piv)
+    return True
+
+
+@njit(**FAST)
+def velocity_from_factors(kern, q, mom, t, p, A, piv, v, scratch):
+    """v = H(q, t)^-1 (mom - b(q, t)) (n,) from H's factors in A, piv (factor_mass)."""
+    copy_into(v, mom)
+    subtract_transport(kern, q, t, p, v)
+    linalg.lu_solve_inplace(A, piv, v, scratch)
+
+
+@njit(**FAST)
 def accel(kern, q, v, t, p, H, a):
     """a = H(q)^-1 rhs(q, v, t) (n,), H (n, n) workspace; OK or SINGULAR_MASS.
 

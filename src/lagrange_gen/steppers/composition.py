@@ -90,7 +90,7 @@ def composed_step(kern, q, v, mom, t, h, p, settings, ws, coeffs):
             status, it, res = verlet.step_explicit(kern, q, v, t_sub, g * h, p, ws.verlet), 0, 0.0
         else:
             status, it, res = verlet.step_newton(kern, q, v, mom, t_sub, g * h, p, settings,
-                                                 ws.verlet)
+                                                 ws.verlet, False)
         iters += it
         resid = max(resid, res)
         if status != OK:

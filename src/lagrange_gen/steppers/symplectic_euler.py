@@ -21,15 +21,15 @@ from numba import njit
 
 from ..status import OK
 from . import verlet
-from .base import (FAST, accel, explicit_path, matvec, momentum_from_velocity,
-                   velocity_from_momentum)
-from .partitioned import solve_kick
+from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity
+from .partitioned import begin_step, end_step, solve_kick
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run (n,): the kick's unknown u, residual R, momentum rate f (the acceleration
 #: on the explicit path), solver scratch s, pivots, the new state; (n, n): H, the Newton matrix
-#: A, df/dq, df/dv.
-Workspace = namedtuple("Workspace", "u R f s piv q_new v_new p_new H A Jq Jqd")
+#: A, df/dq, df/dv; what one step leaves the next (partitioned.begin_step): history (2, n)
+#: earlier kick solutions, carried (2,) int.
+Workspace = namedtuple("Workspace", "u R f s piv q_new v_new p_new H A Jq Jqd history carried")
 
 
 @njit
@@ -37,7 +37,7 @@ def workspace(kern, n):
     """Allocated once per run by base.run_loop."""
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)), np.zeros((n, n)))
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), np.zeros(2, np.int64))
 
 
 @njit(**FAST)
@@ -45,6 +45,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps (Newton path only)."""
     if not explicit_path(kern, settings):
         momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
+        ws.carried[0] = ws.carried[1] = 0
     return OK
 
 
@@ -62,8 +63,10 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
             q[i] += h * v[i]
         return OK, 0, 0.0
     u, q_new, v_new, p_new = ws.u, ws.q_new, ws.v_new, ws.p_new
-    for i in range(n):
-        u[i] = v[i]
+    status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried,
+                              True)
+    if status != OK:
+        return status, 0, 0.0
     status, iters, resid = solve_kick(kern, q, mom, t, h, p, settings.newton_tol,
                                       settings.max_iter, ws.H, ws.A, ws.Jq, ws.Jqd, ws.piv, u,
                                       ws.R, ws.f, ws.s)
@@ -71,10 +74,12 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         return status, iters, resid
     for i in range(n):
         q_new[i] = q[i] + h * u[i]
-    matvec(ws.H, u, p_new)                     # solve_kick leaves H(q) in ws.H
+    matvec(ws.H, u, p_new)                     # ws.H holds H(q)
     if kern.TRANSPORT:
         kern.transport(q, t, p, p_new)         # the canonical momentum H u + b
-    status = velocity_from_momentum(kern, q_new, p_new, t + h, p, ws.A, v_new)
+    kern.mass_matrix(q_new, t + h, p, ws.H)
+    status = end_step(kern, q_new, p_new, t + h, p, ws.H, ws.A, ws.piv, v_new, ws.s, ws.carried,
+                      kept)
     if status != OK:
         return status, iters, resid
     for i in range(n):

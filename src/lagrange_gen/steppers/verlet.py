@@ -28,16 +28,16 @@ import numpy as np
 from numba import njit
 
 from ..status import OK
-from .base import (FAST, accel, explicit_path, matvec, momentum_from_velocity,
-                   velocity_from_momentum)
-from .partitioned import solve_drift, solve_kick
+from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity
+from .partitioned import begin_step, end_step, solve_drift, solve_kick
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run (n,): the cached acceleration acc (explicit path, kept between steps), the
 #: kick's and drift's unknowns u, w (u is v* on the explicit path), residual R, momentum rate f
 #: (a(q+) on the explicit path), solver scratch s, pivots, q+, v+, p_half (p* then p+);
-#: (n, n): H, the Newton matrix A, df/dq, df/dv, d(H w)/dq.
-Workspace = namedtuple("Workspace", "acc u w R f s piv q_new v_new p_half H A Jq Jqd dHw")
+#: (n, n): H, the Newton matrix A, df/dq, df/dv, d(H w)/dq; what one step leaves the next
+#: (partitioned.begin_step): history (2, n) earlier kick solutions, carried (2,) int.
+Workspace = namedtuple("Workspace", "acc u w R f s piv q_new v_new p_half H A Jq Jqd dHw history carried")
 
 
 @njit
@@ -46,7 +46,7 @@ def workspace(kern, n):
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)))
+                     np.zeros((n, n)), np.zeros((2, n)), np.zeros(2, np.int64))
 
 
 @njit(**FAST)
@@ -55,6 +55,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     if explicit_path(kern, settings):
         return accel(kern, q, v, t, p, ws.H, ws.acc)
     momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
+    ws.carried[0] = ws.carried[1] = 0
     return OK
 
 
@@ -81,22 +82,27 @@ def step_explicit(kern, q, v, t, h, p, ws):
 
 
 @njit(inline="always")
-def step_newton(kern, q, v, mom, t, h, p, settings, ws):
-    """The Newton path's step; returns (status, Newton iterations, residual)."""
+def step_newton(kern, q, v, mom, t, h, p, settings, ws, extrapolate):
+    """The Newton path's step; returns (status, Newton iterations, residual). extrapolate (a
+    literal): guess the kick's u from the earlier steps' (partitioned.begin_step) and the
+    drift's w as u + (w_k - u_k), the previous step's difference; only for steps of one size
+    (not in a composition's substeps)."""
     n = q.shape[0]
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
-    for i in range(n):
-        u[i] = v[i]
+    status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried,
+                              extrapolate)
+    if status != OK:
+        return status, 0, 0.0
     status, it1, res1 = solve_kick(kern, q, mom, t, 0.5 * h, p, tol, max_iter, ws.H, ws.A,
                                    ws.Jq, ws.Jqd, ws.piv, u, ws.R, f, ws.s)
     if status != OK:
         return status, it1, res1
-    matvec(ws.H, u, p_half)                    # p* = H(q) u + b (solve_kick leaves H(q) in ws.H)
+    matvec(ws.H, u, p_half)                    # p* = H(q) u + b (ws.H holds H(q))
     if kern.TRANSPORT:
         kern.transport(q, t, p, p_half)
     for i in range(n):
-        w[i] = u[i]
+        w[i] = u[i] + (w[i] - ws.history[0, i] if kept >= 1 else 0.0)
     status, it2, res2 = solve_drift(kern, q, u, p_half, 0.5 * h, t + h, p, tol, max_iter, ws.H, ws.A,
                                     ws.dHw, ws.piv, w, ws.R, q_new, ws.s)
     iters, resid = it1 + it2, max(res1, res2)
@@ -105,7 +111,9 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     kern.momentum_rate(q_new, w, t + h, p, f)
     for i in range(n):
         p_half[i] += 0.5 * h * f[i]            # now p+
-    status = velocity_from_momentum(kern, q_new, p_half, t + h, p, ws.A, v_new)
+    # (solve_drift leaves H(q+) in ws.H)
+    status = end_step(kern, q_new, p_half, t + h, p, ws.H, ws.A, ws.piv, v_new, ws.s, ws.carried,
+                      kept)
     if status != OK:
         return status, iters, resid
     for i in range(n):
@@ -118,7 +126,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
         return step_explicit(kern, q, v, t, h, p, ws), 0, 0.0
-    return step_newton(kern, q, v, mom, t, h, p, settings, ws)
+    return step_newton(kern, q, v, mom, t, h, p, settings, ws, True)
 
 
 def linear_step_matrix(tau):
