@@ -85,10 +85,10 @@ def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, 
     iterations evaluate F alone (problem.residual) and reuse the factors. While the iteration
     contracts by theta = |dx_k| / |dx_k-1| <= THETA_REFRESH it goes on with the old J; a slower
     contraction (far from the solution, or a Jacobian that changes fast) re-assembles and
-    re-factors J at the current iterate, so the worst case is Newton itself. Same arguments and
-    returns as ``solve``; worth it when the Jacobian and its factorization
-    cost much more than a residual and J changes little over the iteration (the partitioned
-    kick and drift, whose J is H(q) plus O(h) terms: see partitioned.py for the measurements).
+    re-factors J at the current iterate, so the worst case is Newton itself. The arguments of
+    ``solve`` and ``factored`` (below), the same returns; worth it when the Jacobian and its
+    factorization cost much more than a residual and J changes little over the iteration (the
+    partitioned kick and drift, whose J is H(q) plus O(h) terms: partitioned.py measures it).
     It stops when the increment is below the tolerance (increment_converged), without
     newton_converged's early stop on the contraction: see the comment in the loop.
 
