@@ -35,8 +35,11 @@ from .base import FAST, copy_into, explicit_path
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run: verlet's workspace (its cached acceleration included) and the state at
-#: the start of the step, q, v, mom, acc (n,), restored when a substep fails.
-Workspace = namedtuple("Workspace", "verlet q v mom acc")
+#: the start of the step, q, v, mom, acc (n,), restored when a substep fails; per substep j
+#: (Newton path), guesses (s, 4, n): the last three kick solutions and the last drift solution
+#: of substep j, kept (s,) how many kick solutions are there: each substep's own sequence has
+#: steps of one size, so verlet extrapolates its guesses along it (verlet.step_newton).
+Workspace = namedtuple("Workspace", "verlet q v mom acc guesses kept")
 
 
 def palindrome(*half):
@@ -58,16 +61,42 @@ def linear_radius(coeffs, tau):
 
 
 @njit
+def allocate(kern, n, substeps):
+    """The workspace of a composition of ``substeps`` verlet steps (n coordinates)."""
+    return Workspace(verlet.workspace(kern, n), np.zeros(n), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros((substeps, 4, n)), np.zeros(substeps, np.int64))
+
+
+@njit
 def workspace(kern, n):
     """Allocated once per run by base.run_loop."""
-    return Workspace(verlet.workspace(kern, n), np.zeros(n), np.zeros(n), np.zeros(n),
-                     np.zeros(n))
+    return allocate(kern, n, len(COEFFS))
 
 
 @njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
-    """The per-run state of verlet (its cached acceleration or the momentum)."""
+    """The per-run state of verlet (its cached acceleration or the momentum); the substeps'
+    guesses start over."""
+    for j in range(ws.kept.shape[0]):
+        ws.kept[j] = 0
     return verlet.prepare(kern, q, v, mom, t, p, settings, ws.verlet, extra)
+
+
+@njit(inline="always")
+def _substep_newton(kern, q, v, mom, t, h, p, settings, ws, j):
+    """verlet's Newton-path step as substep j, with the guesses of substep j's own sequence."""
+    vw, mine = ws.verlet, ws.guesses[j]
+    for i in range(q.shape[0]):
+        vw.u[i], vw.history[0, i], vw.history[1, i], vw.w[i] = (mine[0, i], mine[1, i],
+                                                                mine[2, i], mine[3, i])
+    vw.carried[1] = ws.kept[j]
+    status, it, res = verlet.step_newton(kern, q, v, mom, t, h, p, settings, vw)
+    if status == OK:
+        for i in range(q.shape[0]):
+            mine[0, i], mine[1, i], mine[2, i], mine[3, i] = (vw.u[i], vw.history[0, i],
+                                                              vw.history[1, i], vw.w[i])
+        ws.kept[j] = vw.carried[1]
+    return status, it, res
 
 
 @njit(inline="always")
@@ -84,13 +113,13 @@ def composed_step(kern, q, v, mom, t, h, p, settings, ws, coeffs):
     resid = 0.0
     t_sub = t
     explicit = explicit_path(kern, settings)
-    for g in coeffs:
+    for j in range(len(coeffs)):
+        g = coeffs[j]
         # verlet.step's two paths, inlined here (see verlet.py: no workspace passed per substep)
         if explicit:
             status, it, res = verlet.step_explicit(kern, q, v, t_sub, g * h, p, ws.verlet), 0, 0.0
         else:
-            status, it, res = verlet.step_newton(kern, q, v, mom, t_sub, g * h, p, settings,
-                                                 ws.verlet, False)
+            status, it, res = _substep_newton(kern, q, v, mom, t_sub, g * h, p, settings, ws, j)
         iters += it
         resid = max(resid, res)
         if status != OK:

@@ -29,14 +29,20 @@ from functools import partial
 from numba import njit
 
 from .base import FAST
-from .composition import (Workspace, composed_step, linear_radius, palindrome,  # noqa: F401
-                          prepare, workspace)
+from .composition import (Workspace, allocate, composed_step, linear_radius,  # noqa: F401
+                          palindrome, prepare)
 from .spec import PartitionedSettings, Spec
 
 #: (g1, ..., g5, ..., g1), see the module docstring.
 COEFFS = palindrome(0.39216144400731413927925056, 0.33259913678935943859974864,
                     -0.70624617255763935980996482, 0.08221359629355080023149045,
                     0.79854399093482996339895035)
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by base.run_loop (composition's, for these nine substeps)."""
+    return allocate(kern, n, len(COEFFS))
 
 
 @njit(**FAST)

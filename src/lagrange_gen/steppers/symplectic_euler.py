@@ -63,8 +63,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
             q[i] += h * v[i]
         return OK, 0, 0.0
     u, q_new, v_new, p_new = ws.u, ws.q_new, ws.v_new, ws.p_new
-    status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried,
-                              True)
+    status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried)
     if status != OK:
         return status, 0, 0.0
     status, iters, resid = solve_kick(kern, q, mom, t, h, p, settings.newton_tol,

@@ -82,16 +82,15 @@ def step_explicit(kern, q, v, t, h, p, ws):
 
 
 @njit(inline="always")
-def step_newton(kern, q, v, mom, t, h, p, settings, ws, extrapolate):
-    """The Newton path's step; returns (status, Newton iterations, residual). extrapolate (a
-    literal): guess the kick's u from the earlier steps' (partitioned.begin_step) and the
-    drift's w as u + (w_k - u_k), the previous step's difference; only for steps of one size
-    (not in a composition's substeps)."""
+def step_newton(kern, q, v, mom, t, h, p, settings, ws):
+    """The Newton path's step; returns (status, Newton iterations, residual). The kick's guess
+    is extrapolated from the earlier steps' solutions (partitioned.begin_step), the drift's is
+    u + (w_k - u_k), the previous step's difference: ws holds a sequence of steps of one size
+    (composition.py gives each of its substeps its own)."""
     n = q.shape[0]
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
-    status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried,
-                              extrapolate)
+    status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried)
     if status != OK:
         return status, 0, 0.0
     status, it1, res1 = solve_kick(kern, q, mom, t, 0.5 * h, p, tol, max_iter, ws.H, ws.A,
@@ -126,7 +125,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
         return step_explicit(kern, q, v, t, h, p, ws), 0, 0.0
-    return step_newton(kern, q, v, mom, t, h, p, settings, ws, True)
+    return step_newton(kern, q, v, mom, t, h, p, settings, ws)
 
 
 def linear_step_matrix(tau):
