@@ -146,8 +146,9 @@ def begin_step(kern, q, v, t, p, H, A, piv, u, history, carried):
     3 u_k - 3 u_k-1 + u_k-2 (error O(h^3) against O(h) for v: measured 5.5 -> 4.75 iterations per
     step on the 16-link chain), else v. Both carried entries are cleared until end_step: a
     failed step leaves nothing to reuse.
-    Returns (status, kept): SINGULAR_MASS when H(q) cannot be factored; kept = solutions
-    before u_k available (for end_step and the drift's guess)."""
+    Returns (status, kept): SINGULAR_MASS when H(q) cannot be factored; kept = how many of
+    u_k, u_k-1, u_k-2 there were (0 on the first step; end_step stores one more, and the drift
+    extrapolates from the previous step when kept >= 1)."""
     if carried[0] == 0:
         kern.mass_matrix(q, t, p, H)
         if not factor_mass(H, A, piv):
