@@ -10,7 +10,7 @@ import pytest
 
 from lagrange_gen import compile_notice
 from lagrange_gen.adaptive_run import _warm_up
-from lagrange_gen.fixed_run import warm_up
+from lagrange_gen.fixed_run import warm_up, warm_up_args
 
 LINE = re.compile(r"^lagrange-gen: compiling (\S+) for (\S+) \(first use\) \.\.\. "
                   r"(done in|failed after) (\d+\.\d) s\n$")
@@ -28,8 +28,11 @@ def _glue(seconds, error=None):
 
 def _fixed_warm_up(run):
     q = np.zeros(2)
-    return warm_up(run, q, q, 0.0, 1e-3, np.ones(5), (), np.zeros((1, 0)), np.empty(7),
-                   np.zeros((0, 7)), label="run_rattle for four_bar")
+    args = warm_up_args(q, q, 0.0, 1e-3, np.ones(5), (), np.zeros((1, 0)), np.empty(7),
+                        np.zeros((0, 7)))
+    glue, seconds = warm_up(lambda: run, args, label="run_rattle for four_bar")
+    assert glue is run
+    return seconds
 
 
 def test_slow_fixed_step_first_call_prints_one_line(monkeypatch, capsys):
@@ -51,7 +54,7 @@ def test_fast_call_prints_nothing(capsys):
 
 def test_adaptive_first_call_names_method_and_model(monkeypatch, capsys):
     monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
-    task = SimpleNamespace(run=_glue(0.2), t0=0.0, p=np.ones(5), settings=(), method="dop853",
+    task = SimpleNamespace(glue=lambda args: _glue(0.2), t0=0.0, p=np.ones(5), settings=(), method="dop853",
                            module=SimpleNamespace(NAME="cart_pendulum"))
     _warm_up(task, np.zeros(2), np.zeros(2), np.zeros(0), np.empty(7), np.zeros((0, 7)))
     match = LINE.match(capsys.readouterr().err)

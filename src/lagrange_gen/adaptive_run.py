@@ -40,7 +40,7 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
     counters = np.array([task.h or 0.0, 0.0, 0.0, 0.0])
     events = np.zeros((EVENT_ROWS if getattr(m, "N_EVENTS", 0) else 0, 3 + 2 * n))
     wanted = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=np.float64)
-    compile_time = _warm_up(task, q, v, initial, last.copy(), events[:0])
+    run, compile_time = _warm_up(task, q, v, initial, last.copy(), events[:0])
     parts, n_events, t, start = [], 0, t0, time.perf_counter()
     bar = ProgressBar(1000) if progress else None
     extra0 = initial.copy()
@@ -51,7 +51,7 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
                    stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)))
         buf["extra"][0] = extra0
         found = min(n_events, events.shape[0])
-        code, filled, got = task.run(q, v, t, t_end, task.p, task.settings, wanted, buf["t"],
+        code, filled, got = run(q, v, t, t_end, task.p, task.settings, wanted, buf["t"],
                                      buf["q"], buf["v"], buf["stats"], buf["extra"], last,
                                      events[found:], counters)
         n_events += got
@@ -86,13 +86,16 @@ def _stopped(module, events, n_events, t):
 
 
 def _warm_up(task, q, v, initial, last, events):
-    """Compile (or load from numba's cache) the glue with a call that stops at t0 (the glue
-    needs two rows at least); a call longer than a second prints a notice (compile_notice)."""
+    """Choose the glue (task.glue: specialized or portable) and compile or load it from numba's
+    cache with a call that stops at t0 (the glue needs two rows at least); a call longer than a
+    second prints a notice (compile_notice). Returns (glue, seconds)."""
     n = q.shape[0]
     start = time.perf_counter()
     extra = np.vstack((initial, initial))
+    args = (q, v, task.t0, task.t0, task.p, task.settings, np.zeros(0), np.empty(2),
+            np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra, last, events,
+            np.zeros(4))
     with first_use_notice(f"run_{task.method} for {task.module.NAME}"):
-        task.run(q, v, task.t0, task.t0, task.p, task.settings, np.zeros(0), np.empty(2),
-                 np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra, last,
-                 events, np.zeros(4))
-    return time.perf_counter() - start
+        run = task.glue(args)
+        run(*args)
+    return run, time.perf_counter() - start

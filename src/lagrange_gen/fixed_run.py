@@ -23,6 +23,13 @@ from .steppers.base import N_STATS, STAT_ITERS
 #: Python overhead per chunk (a few microseconds) is negligible, small enough for a progress bar.
 CHUNK_STEPS = 200_000
 
+#: A portable run under simulate(jit="auto") compiles the specialized glue between chunks once
+#: its projected remaining time passes this many seconds. The specialized loop saves about a
+#: third of the step time on small models and less on large ones (kernel calls weigh less), and
+#: its compile costs 10 to 20 s (bench speed): below a minute of remaining work it would not
+#: pay for itself.
+SPECIALIZE_AFTER_S = 60.0
+
 #: Rows of located events kept per run (steppers/events.py); more are counted, not stored.
 EVENT_ROWS = 10_000
 
@@ -52,17 +59,20 @@ def allocate(rows, n, n_saved, initial, n_events):
 def integrate_fixed(task, q, v, out, progress):
     """Run the glue chunk by chunk from (q, v), filling ``out``; sets out["last"], out["rows"]
     (rows used), out["steps"] (steps done: fewer than task.n_steps after a terminal event) and
-    out["n_events"]. Returns (compile seconds, integration seconds). Raises the exception of a
-    failure status (failures.raise_for_status)."""
+    out["n_events"]. The glue is task.glue's choice (specialized or portable); a portable run
+    under jit="auto" switches to the specialized glue between chunks once its projected
+    remaining time passes SPECIALIZE_AFTER_S (task.ran records it). Returns (compile seconds,
+    integration seconds). Raises the exception of a failure status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     last = np.zeros(2 * n + 4 + out["extra"].shape[1])     # the last entry: W (base.run_loop)
-    compile_time = warm_up(task.run, q, v, t0, h, task.p, task.settings,
-                           out["extra"][:1].copy(), last.copy(), out["events"][:0],
-                           label=f"run_{task.method} for {m.NAME}")
+    args = warm_up_args(q, v, t0, h, task.p, task.settings, out["extra"][:1].copy(),
+                        last.copy(), out["events"][:0])
+    label = f"run_{task.method} for {m.NAME}"
+    run, compile_time = warm_up(lambda: task.glue(args), args, label)
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
-    done, row = 0, 0
+    done, row, switch = 0, 0, 0.0
     while True:
         k = min(chunk, task.n_steps - done)
         rows = slice(row, row + k // task.save_every + 1)
@@ -70,7 +80,7 @@ def integrate_fixed(task, q, v, out, progress):
         # Newton statistics, which belong to the steps before it.
         kept = out["stats"][row].copy()
         found = min(out["n_events"], out["events"].shape[0])
-        code, steps, n_events = task.run(
+        code, steps, n_events = run(
             q, v, t0 + done * h, h, k, task.save_every, task.p, task.settings, out["t"][rows],
             out["q"][rows], out["v"][rows], out["stats"][rows], out["extra"][rows], last,
             out["events"][found:])
@@ -91,24 +101,45 @@ def integrate_fixed(task, q, v, out, progress):
             bar.update(done)
         if done >= task.n_steps:
             break
-    wall = time.perf_counter() - start
+        if task.ran == "portable" and task.jit == "auto" and _worth_specializing(
+                time.perf_counter() - start - switch, done, task.n_steps):
+            run, seconds = warm_up(lambda: task.run, args, label + ", specialized for this long run")
+            compile_time += seconds
+            switch += seconds
+            task.ran = f"portable, then specialized from step {done}"
+    wall = time.perf_counter() - start - switch
     if bar:
         bar.close()
     out["last"], out["rows"], out["steps"] = last, row + 1, done
     return compile_time, wall
 
 
-def warm_up(run, q, v, t0, h, p, settings, extra, last, events, label="run"):
-    """Compile (or load from numba's cache) run_<method> with a zero-step call, so that the
-    measured wall time is integration only. extra (1, n_saved) and last are scratch copies with
-    the method's sizes; label ("run_verlet for cart_pendulum") names the glue in the notice a
-    call longer than a second prints (compile_notice). Returns the seconds it took."""
+def warm_up_args(q, v, t0, h, p, settings, extra, last, events):
+    """The arguments of a zero-step call of run_<method>: extra (1, n_saved) and last are
+    scratch copies with the method's sizes."""
     n = q.shape[0]
+    return (q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
+            np.empty((1, N_STATS)), extra, last, events)
+
+
+def warm_up(glue, args, label="run"):
+    """Compile (or load from numba's cache) the glue ``glue()`` returns (a choice that may
+    compile the model's kernels, see portable.choose) with a zero-step call (warm_up_args), so
+    that the measured wall time is integration only. label ("run_verlet for cart_pendulum")
+    names the glue in the notice a call longer than a second prints (compile_notice). Returns
+    (the glue, the seconds it took)."""
     start = time.perf_counter()
     with first_use_notice(label):
-        run(q, v, t0, h, 0, 1, p, settings, np.empty(1), np.empty((1, n)), np.empty((1, n)),
-            np.empty((1, N_STATS)), extra, last, events)
-    return time.perf_counter() - start
+        run = glue()
+        run(*args)
+    return run, time.perf_counter() - start
+
+
+def _worth_specializing(elapsed, done, n_steps):
+    """Whether a portable run (jit="auto") that took ``elapsed`` seconds for ``done`` of its
+    n_steps steps should compile the specialized glue now: its projected remaining time passes
+    SPECIALIZE_AFTER_S."""
+    return done > 0 and elapsed * (n_steps - done) / done > SPECIALIZE_AFTER_S
 
 
 class ProgressBar:

@@ -31,6 +31,7 @@ from .errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
 from .fixed_run import allocate, integrate_fixed, n_steps_to
 from .keys import regeneration_command_for
+from .portable import JIT_MODES, choose
 from .control import attach_inputs_outputs, controlled_run, resolve_inputs
 from .steppers import registry
 from .steppers.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK
@@ -98,7 +99,8 @@ def _element_energy(module, p, state):
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
              save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
-             element_state0=None, force=False, keep=None, control=None, **settings) -> Trajectory:
+             element_state0=None, force=False, keep=None, control=None, jit="auto",
+             **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -126,6 +128,15 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         u = f(t, q, qd, p) or a lagrange_gen.control.Signal (see lagrange_gen.control); constant
         inputs are given in params. The Trajectory then saves "input_<name>" and, for a model
         with outputs, "output_<name>" (Trajectory.saved).
+    jit: which compiled loop runs (lagrange_gen.portable). "specialized": the generated
+        module's run_<method>, the model's kernels inlined into the stepper (fastest per step;
+        its first use compiles the stepper for this model, seconds). "portable": the stepper
+        compiled once for every model, calling this model's kernels through pointers (a new
+        model compiles only its kernels; about 1.5x the step time on a small model; the
+        same results bit for bit). "auto" (default): specialized when numba's cache already
+        holds it, else portable, switching to specialized between chunks of a fixed-step run
+        whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S). Runs
+        with a control= hook are always specialized. Trajectory.jit says what ran.
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.consistent), and the Trajectory carries the multipliers and
@@ -140,6 +151,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     """
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+    if jit not in JIT_MODES:
+        raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
     module = load_module(module_or_path, out_dir, method, force)
     method = _element_method(module, method)
     from .consistent import check_method
@@ -154,6 +167,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     p, hook, data = resolve_inputs(module, params, control, h, t0, q, v)     # inputs: control.py
     if hook is not None:
         run = _with_data(controlled_run(module, method, hook), data)
+        jit = "specialized"       # the control glue is compiled per model and controller
     run_checks.check_element_coefficients(module, p)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS)
@@ -167,7 +181,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
     if spec.adaptive:
-        task = _Task(module, spec, run, p, config, h, t0, 0, 1)
+        task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit)
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
         out, compile_time, wall = integrate_adaptive(
             task, q, v, initial, t_end, None if wanted is None else wanted[wanted > t0], progress)
@@ -176,7 +190,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     n_steps = n_steps_to(t0, t_end, h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
-    task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None)
+    task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
+                 jit=jit)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     compile_time, wall = integrate_fixed(task, q, v, out, progress)
@@ -224,6 +239,14 @@ class _Task:
     n_steps: int        # fixed-step methods
     save_every: int
     controlled: bool = False    # inputs written by a controller or a signal (control.py)
+    jit: str = "specialized"    # simulate(jit=): "auto", "specialized" or "portable"
+    ran: str = ""               # what ran (Trajectory.jit), set by fixed_run / adaptive_run
+
+    def glue(self, args):
+        """The glue to run (``run`` or the portable one, see portable.choose) for a first call
+        with ``args``; records the choice in ``ran``."""
+        run, self.ran = choose(self.jit, self.run, self.module, self.method, args)
+        return run
 
     @property
     def method(self):
@@ -296,7 +319,7 @@ def _build(task, rows, out, steps, h, wall, compile_time):
                       newton_residual=rows["stats"][:, STAT_RESIDUAL].copy(), method=spec.name,
                       h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
                       coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
-                      compile_time=compile_time, saved=saved,
+                      compile_time=compile_time, jit=task.ran, saved=saved,
                       work=rows["stats"][:, STAT_WORK].copy() if _has_work(m, spec) else None,
                       element_names=tuple(m.ELEMENTS) if spec.elements else (),
                       constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),

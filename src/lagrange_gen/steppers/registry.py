@@ -120,6 +120,26 @@ def run_{method}({wrapped}):
     Argument shapes: see lagrange_gen.steppers.registry; lagrange_gen.simulate wraps this."""
     return _{loop}(_stepper_{method}, _THIS_MODULE, {n_saved}, {n_events}, {wrapped_call})'''
 
+# The portable glue (lagrange_gen.portable): the same loop and method module, with the kernels
+# and constants of any model passed in as ``kern``, a named tuple of first-class functions whose
+# numba type is the same for every model, so that the method compiles once for all models.
+_PORTABLE_GLUE = '''"""Portable glue of {method}, written by lagrange_gen.portable; DO NOT EDIT.
+
+Library version {digest} (a hash of the package files it compiles)."""
+from numba import njit
+
+from lagrange_gen.steppers import {method} as _stepper_{method}
+from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}
+
+
+@njit(cache=True, error_model="numpy")
+def run_{method}(kern, n_saved, {wrapped}):
+    """run_{method} of a generated module, on the kernel table ``kern`` (portable.kernel_table)
+    of any model; n_saved: the method's saved fields on that model (SPEC.n_saved)."""
+    return _{loop}(_stepper_{method}, kern, n_saved, kern.N_EVENTS, {wrapped_call})
+'''
+
+
 #: Arguments of the ensemble glue of a fixed-step method (lagrange_gen.ensemble wraps it).
 ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
                       "out_q, out_v, out_stats, out_extra, out_last, out_status")
@@ -205,6 +225,19 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
                         summary=spec(method).summary, loop_module=loop_module, loop=loop,
                         n_saved=n_saved, n_events=n_events)
+
+
+def portable_glue_source(method: str, digest: str) -> str:
+    """Source text of the portable ``run_<method>(kern, n_saved, ...)`` (lagrange_gen.portable)
+    for the library version ``digest``; deterministic."""
+    loop_module, loop = LOOPS[spec(method).adaptive]
+    args = glue_args(method)
+    indent = " " * len(f"def run_{method}(")
+    wrapped = args.replace("settings, ", "settings,\n" + indent)
+    call_indent = " " * len(f"    return _{loop}(")
+    wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
+    return _PORTABLE_GLUE.format(method=method, digest=digest, loop_module=loop_module,
+                                 loop=loop, wrapped=wrapped, wrapped_call=wrapped_call)
 
 
 def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:

@@ -1,0 +1,205 @@
+"""Portable glue: one compiled copy of each stepper for every model.
+
+The generated ``run_<method>`` (steppers/registry.py) reaches the model's kernels through the
+generated module, a numba compile-time constant: numba inlines the kernels into the stepper and
+compiles the whole stepper library again for every model (seconds to tens of seconds on first
+use). The portable glue ``run_<method>(kern, n_saved, ...)`` is the same loop (base.run_loop or
+adaptive.run_adaptive) with the same method module, but ``kern`` is a named tuple of
+first-class functions (the addresses of the model's compiled kernels, typed by numba as
+``FunctionType(signature)``) and of the module constants the method reads. Its numba type is
+the same for every model, so the stepper is compiled once per method and then loaded from
+numba's cache for every model: a model just written compiles only its own kernels.
+
+The price is a call through a pointer per kernel evaluation, without inlining across kernels
+(measured on the cart pendulum: verlet 505 against 356 ns per step). The results are the same
+floating-point operations in the same order, so a portable run equals the specialized run
+bit for bit (tests/test_portable.py checks every method). simulate(jit="auto") runs the
+specialized glue when numba's cache already holds it, and otherwise starts portable and
+switches to the specialized glue between chunks when the run is long enough to pay for its
+compile (fixed_run.py).
+
+Layout: the portable glue sources (registry.portable_glue_source) are written to
+``portable_dir()/<library hash>/``; the hash covers every package file the glue compiles, so a
+changed library gives new files and numba never loads a stale entry (numba's cache checks only
+the glue file itself).
+"""
+
+from __future__ import annotations
+
+import collections
+import functools
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+#: Environment variable naming the directory of the portable glue sources (default
+#: ~/.cache/lagrange_gen/portable, or a temporary directory when the home is not writable).
+DIR_ENV = "LAGRANGE_GEN_PORTABLE_DIR"
+
+#: The values of simulate(jit=...).
+JIT_MODES = ("auto", "specialized", "portable")
+
+
+def portable_dir() -> Path:
+    """Directory under which the portable glue sources are written."""
+    if os.environ.get(DIR_ENV):
+        return Path(os.environ[DIR_ENV])
+    home = Path(os.path.expanduser("~"))
+    if os.access(home, os.W_OK):
+        return home / ".cache" / "lagrange_gen" / "portable"
+    return Path(tempfile.gettempdir()) / "lagrange_gen_portable"
+
+
+def _kernel_arg_types(fn):
+    """numba types of a kernel's arguments, from their names: t a float, the outputs that are
+    always 2-D (codegen.spec._ALWAYS_2D) 2-D arrays, every other argument a 1-D array; layout
+    'A' so that any view (a workspace row, a slice) can be passed without a copy."""
+    from numba import types
+    from .codegen.spec import _ALWAYS_2D
+    names = list(inspect.signature(fn).parameters)
+    return tuple(types.float64 if a == "t" else types.float64[:, :] if a in _ALWAYS_2D
+                 else types.float64[:] for a in names)
+
+
+def _function_kernel_class():
+    from numba.experimental.function_type import WrapperAddressProtocol
+
+    class FunctionKernel(WrapperAddressProtocol):
+        """A generated kernel as a numba first-class function: the address of its compiled C
+        wrapper for the portable argument types (the dispatcher, kept alive here, owns it)."""
+
+        def __init__(self, dispatcher):
+            args = _kernel_arg_types(dispatcher.py_func)
+            dispatcher.compile(args)
+            result = dispatcher.overloads[args]
+            self.dispatcher, self.sig = dispatcher, result.signature
+            self.address = result.library.get_pointer_to_function(
+                result.fndesc.llvm_cfunc_wrapper_name)
+
+        def __wrapper_address__(self):
+            return self.address
+
+        def signature(self):
+            return self.sig
+
+    return FunctionKernel
+
+
+FunctionKernel = None
+
+
+@functools.lru_cache(maxsize=None)
+def table_class(method: str):
+    """The named tuple class of ``method``'s kernel table: one field per ``kern.<name>`` its
+    glue reaches (codegen.needs: kernels and module constants) and N_EVENTS (the glue passes
+    it to the loop), sorted. Defined in this module
+    under a fixed name, so that numba's cache can pickle the type by reference."""
+    from .codegen.needs import method_needs
+    name = f"Kernels_{method}"
+    cls = collections.namedtuple(name, sorted(method_needs(method) | {"N_EVENTS"}))
+    cls.__module__ = __name__
+    globals()[name] = cls
+    return cls
+
+
+def kernel_table(module, method):
+    """The kernel table of ``module`` for ``method`` (cached on the module): kernels as
+    FunctionKernel (compiled for the portable types on first use), constants as they are."""
+    global FunctionKernel
+    tables = module.__dict__.setdefault("_PORTABLE_TABLES", {})
+    if method not in tables:
+        if FunctionKernel is None:
+            FunctionKernel = _function_kernel_class()
+        cls = table_class(method)
+        values = []
+        for field in cls._fields:
+            value = getattr(module, field)
+            values.append(value if field.isupper() else FunctionKernel(value))
+        tables[method] = cls(*values)
+    return tables[method]
+
+
+def _library_hash(method: str) -> str:
+    """sha256 prefix of every package file the portable glue of ``method`` compiles."""
+    from .codegen.needs import source_closure
+    from .keys import source_hashes
+    from .steppers.registry import LOOPS, spec
+    loop_module = LOOPS[spec(method).adaptive][0]
+    files = source_closure([f"steppers.{method}", f"steppers.{loop_module}"])
+    digest = hashlib.sha256(repr(sorted(source_hashes(files).items())).encode())
+    return digest.hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=None)
+def glue(method: str):
+    """The portable ``run_<method>(kern, n_saved, <glue arguments>)`` dispatcher: its source is
+    written (atomically, once per library version) and imported under a unique module name."""
+    from .steppers.registry import portable_glue_source
+    digest = _library_hash(method)
+    source = portable_glue_source(method, digest)
+    folder = portable_dir() / digest
+    path = folder / f"run_{method}.py"
+    if not path.exists() or path.read_text() != source:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".run_{method}.", suffix=".tmp")
+        with os.fdopen(fd, "w") as f:
+            f.write(source)
+        os.replace(tmp, path)
+    name = f"lagrange_gen_portable_{digest}_{method}"
+    module = sys.modules.get(name)
+    if module is None:
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return getattr(module, f"run_{method}")
+
+
+def runner(module, method):
+    """A callable with the arguments of ``module.run_<method>`` (registry.GLUE_ARGS or
+    ADAPTIVE_GLUE_ARGS) that runs the portable glue on ``module``'s kernels."""
+    from .steppers.registry import spec
+    run, table = glue(method), kernel_table(module, method)
+    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
+
+    def run_portable(*args):
+        return run(table, n_saved, *args)
+
+    run_portable.portable = True
+    return run_portable
+
+
+def choose(jit, specialized, module, method, args):
+    """(glue, "specialized" or "portable") for a first call with ``args``: jit="specialized"
+    the module's glue; "portable" the portable one; "auto" the module's glue when it runs
+    ``args`` without compiling (specialized_ready), else the portable one."""
+    if jit == "specialized" or (jit == "auto" and specialized_ready(specialized, args)):
+        return specialized, "specialized"
+    return runner(module, method), "portable"
+
+
+def specialized_ready(dispatcher, args) -> bool:
+    """Whether the specialized glue ``dispatcher`` can run ``args`` without compiling: already
+    compiled in this process, or in numba's on-disk cache (then it is loaded now, as numba's own
+    first call would load it)."""
+    try:
+        sig = tuple(dispatcher.typeof_pyval(a) for a in args)
+        if sig in dispatcher.overloads:
+            return True
+        cache = getattr(dispatcher, "_cache", None)
+        if cache is None:
+            return False
+        result = cache.load_overload(sig, dispatcher.targetctx)
+        if result is None:
+            return False
+        # as numba's Dispatcher.compile does with a cache hit
+        dispatcher.targetctx.insert_user_function(result.entry_point, result.fndesc,
+                                                  [result.library])
+        dispatcher.add_overload(result)
+        return True
+    except Exception:       # numba internals moved: treat as not cached (portable runs)
+        return False

@@ -1,0 +1,145 @@
+"""The portable glue (lagrange_gen.portable): one compiled stepper for every model.
+
+A portable run is the specialized run's floating-point operations in the same order, with the
+kernels called through pointers instead of inlined: its trajectory must equal the specialized
+one bit for bit, for every method (including the branches a model switches on at run time:
+explicit time and T1, constraints, nonsmooth elements, events). Its numba type must not depend
+on the model, or it would compile again for every model, which is what it is for."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lagrange_gen import fixed_run, portable
+from lagrange_gen.codegen import generate_model
+from lagrange_gen.errors import SimulationError
+from lagrange_gen.loader import import_generated
+from lagrange_gen.simulation import simulate
+from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.spec import make_settings
+
+EVENT_MODELS = Path(__file__).resolve().parent / "events" / "models"
+
+# (method, model, q0, h, t_end): every method once, on a model that exercises the run-time
+# branches it has: driven_pendulum (explicit time, T1 = b . qd, the work W), slider_crank
+# (rheonomic constraints), prandtl (nonsmooth elements), the events models of tests/events.
+CASES = [(m, "driven_pendulum", [2.9], 1e-3, 0.2) for m in registry.METHODS
+         if not registry.spec(m).constraints and not registry.spec(m).elements]
+CASES += [(m, "slider_crank", ([0.0, 1.3, 0.1], [1.8, 0.0, 0.0]), 1e-3, 0.1)
+          for m in registry.CONSTRAINED_METHODS]
+CASES += [("nonsmooth_euler", "prandtl", [0.0], 1e-3, 2.0)]
+EVENT_CASES = [("verlet", "cart_pendulum_events", [0.3, 1.0], 1e-3, 3.0),
+               ("dop853", "cart_pendulum_events", [0.3, 1.0], None, 3.0),
+               ("rattle", "cartesian_pendulum_events", [np.sin(1.0), -np.cos(1.0)], 1e-3, 3.0)]
+
+
+@pytest.fixture(scope="module")
+def event_module(tmp_path_factory):
+    folder, modules = tmp_path_factory.mktemp("portable_events"), {}
+
+    def get(stem):
+        if stem not in modules:
+            modules[stem] = import_generated(generate_model(EVENT_MODELS / f"{stem}.py",
+                                                            folder).path)
+        return modules[stem]
+    return get
+
+
+def _assert_same(a, b):
+    for name in ("t", "q", "v", "energy", "newton_iters", "newton_residual"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert a.saved.keys() == b.saved.keys()
+    for name in a.saved:
+        np.testing.assert_array_equal(a.saved[name], b.saved[name], err_msg=name)
+    if a.work is not None or b.work is not None:
+        np.testing.assert_array_equal(a.work, b.work, err_msg="work")
+    assert len(a.events) == len(b.events)
+    np.testing.assert_array_equal(a.events, b.events, err_msg="events")
+
+
+def _both(mod, method, q0, v0, h, t_end):
+    kwargs = dict(t_end=t_end, h=h)
+    portable_run = simulate(mod, method, q0, v0, jit="portable", **kwargs)
+    specialized_run = simulate(mod, method, q0, v0, jit="specialized", **kwargs)
+    assert portable_run.jit == "portable" and specialized_run.jit == "specialized"
+    return portable_run, specialized_run
+
+
+@pytest.mark.parametrize("method, stem, q0, h, t_end", CASES, ids=[c[0] for c in CASES])
+def test_portable_run_equals_specialized_bit_for_bit(generated, method, stem, q0, h, t_end):
+    q0, v0 = q0 if isinstance(q0, tuple) else (q0, None)
+    a, b = _both(generated(stem), method, q0, v0, h, t_end)
+    assert len(a.t) > 10
+    _assert_same(a, b)
+
+
+@pytest.mark.parametrize("method, stem, q0, h, t_end", EVENT_CASES,
+                         ids=[f"{c[0]}-{c[1]}" for c in EVENT_CASES])
+def test_portable_events_equal_specialized(event_module, method, stem, q0, h, t_end):
+    mod = event_module(stem)
+    assert mod.N_EVENTS > 0
+    a, b = _both(mod, method, q0, None, h, t_end)
+    assert len(a.events) > 0
+    _assert_same(a, b)
+
+
+def test_one_compile_serves_every_model(generated):
+    """The portable verlet runs three models with one compiled signature."""
+    for stem, q0 in (("cart_pendulum", [0.1, 1.0]), ("double_pendulum", [0.3, 0.2]),
+                     ("kepler", [1.0, 0.0])):
+        v0 = [0.0, 1.1] if stem == "kepler" else None
+        simulate(generated(stem), "verlet", q0, v0, t_end=0.01, h=1e-3, jit="portable")
+    assert len(portable.glue("verlet").overloads) == 1
+
+
+def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypatch):
+    mod = generated("double_pendulum")
+    monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
+    monkeypatch.setattr(fixed_run, "SPECIALIZE_AFTER_S", 0.0)
+    monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
+    auto = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3)
+    assert auto.jit == "portable, then specialized from step 100"
+    specialized = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3,
+                           jit="specialized")
+    _assert_same(auto, specialized)
+
+
+def test_auto_keeps_portable_on_a_short_run(generated, monkeypatch):
+    monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
+    monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
+    run = simulate(generated("double_pendulum"), "symplectic_euler", [0.3, 0.2], None,
+                   t_end=0.5, h=1e-3)
+    assert run.jit == "portable"
+
+
+def test_auto_runs_the_specialized_loop_once_it_is_compiled(generated):
+    mod = generated("double_pendulum")
+    simulate(mod, "rk4", [0.3, 0.2], None, t_end=0.01, h=1e-3, jit="specialized")
+    assert simulate(mod, "rk4", [0.3, 0.2], None, t_end=0.01, h=1e-3).jit == "specialized"
+
+
+def test_specialized_ready_is_false_before_any_compile(tmp_path):
+    mod = import_generated(generate_model(Path(__file__).resolve().parent.parent / "models"
+                                          / "damped_oscillator.py", tmp_path,
+                                          methods=["explicit_euler"]).path)
+    q = np.zeros(mod.N_COORDS)
+    args = fixed_run.warm_up_args(q, q, 0.0, 1e-3, mod.DEFAULT_PARAMS.copy(),
+                                  make_settings(registry.spec("explicit_euler"), {}),
+                                  np.zeros((1, 0)), np.zeros(2 * mod.N_COORDS + 4),
+                                  np.zeros((0, 3 + 2 * mod.N_COORDS)))
+    assert not portable.specialized_ready(mod.run_explicit_euler, args)
+    mod.run_explicit_euler(*args)
+    assert portable.specialized_ready(mod.run_explicit_euler, args)
+
+
+def test_unknown_jit_is_refused(generated):
+    with pytest.raises(SimulationError, match="jit='fast'.*auto, specialized, portable"):
+        simulate(generated("cart_pendulum"), "rk4", [0.1, 1.0], None, t_end=0.01, h=1e-3,
+                 jit="fast")
+
+
+def test_glue_source_is_deterministic_and_names_its_library_version():
+    a = registry.portable_glue_source("rattle", "0123456789abcdef")
+    assert a == registry.portable_glue_source("rattle", "0123456789abcdef")
+    assert "0123456789abcdef" in a and "def run_rattle(kern, n_saved, q0, v0" in a
