@@ -19,6 +19,7 @@ from pathlib import Path
 
 from .cli_options import BUILD, NUMBER, one_line_warnings, parse_assignments, velocity_names
 from .errors import SimulationError
+from .portable import JIT_MODES
 from .steppers.registry import INFO, METHODS
 from .steppers.spec import SETTING_HELP
 
@@ -64,6 +65,12 @@ def add_parser(subparsers):
     p.add_argument("--gen-dir", default="generated", metavar="DIR",
                    help="where model files are generated (default: generated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
+    p.add_argument("--jit", choices=JIT_MODES,
+                   help="compiled loop: specialized (the model's kernels inlined: fastest steps, "
+                        "compiled per model on first use), portable (the stepper compiled once "
+                        "for every model: a new model compiles only its kernels), auto "
+                        "(default, or $LAGRANGE_GEN_JIT: specialized when cached, else "
+                        "portable, switching to specialized during a long run)")
     _add_setting_options(p)
     p.add_argument("--force", action="store_true",
                    help="regenerate the module even when the one on disk comes from another model "
@@ -154,7 +161,7 @@ def run(args) -> int:
         traj = simulate(model, args.method, args.q0, args.v0, t_end=args.t_end,
                         h=args.h, params=params, save_every=args.save_every,
                         t_eval=args.t_eval, t0=args.t0, progress=args.progress,
-                        out_dir=args.gen_dir, force=args.force, keep=keep,
+                        out_dir=args.gen_dir, force=args.force, keep=keep, jit=args.jit,
                         **_given_settings(args))
     _summary(traj)
     _write_outputs(traj, args.out, args.plot)
@@ -171,7 +178,7 @@ def _summary(traj):
     for event in traj.events[:10]:
         print(f"event {event}")
     print(f"wall time {traj.wall_time:.3f} s ({per_step * 1e9:.0f} ns/step), "
-          f"compile/load {traj.compile_time:.2f} s")
+          f"compile/load {traj.compile_time:.2f} s ({traj.jit} loop)")
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")
     if traj.work is None:
         print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")

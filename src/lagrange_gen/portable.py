@@ -43,6 +43,15 @@ DIR_ENV = "LAGRANGE_GEN_PORTABLE_DIR"
 #: The values of simulate(jit=...).
 JIT_MODES = ("auto", "specialized", "portable")
 
+#: Environment variable giving simulate's jit when the call does not (the bench sets it to
+#: "specialized": it measures the specialized loops unless a row says otherwise).
+JIT_ENV = "LAGRANGE_GEN_JIT"
+
+
+def default_jit() -> str:
+    """simulate's jit when none is given: $LAGRANGE_GEN_JIT, else "auto"."""
+    return os.environ.get(JIT_ENV) or "auto"
+
 
 def portable_dir() -> Path:
     """Directory under which the portable glue sources are written."""
@@ -56,13 +65,13 @@ def portable_dir() -> Path:
 
 def _kernel_arg_types(fn):
     """numba types of a kernel's arguments, from their names: t a float, the outputs that are
-    always 2-D (codegen.spec._ALWAYS_2D) 2-D arrays, every other argument a 1-D array; layout
-    'A' so that any view (a workspace row, a slice) can be passed without a copy."""
+    always 2-D (codegen.spec._ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
+    C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
     from numba import types
     from .codegen.spec import _ALWAYS_2D
     names = list(inspect.signature(fn).parameters)
-    return tuple(types.float64 if a == "t" else types.float64[:, :] if a in _ALWAYS_2D
-                 else types.float64[:] for a in names)
+    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in _ALWAYS_2D
+                 else types.float64[::1] for a in names)
 
 
 def _function_kernel_class():

@@ -31,7 +31,7 @@ from .errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
 from .fixed_run import allocate, integrate_fixed, n_steps_to
 from .keys import regeneration_command_for
-from .portable import JIT_MODES, choose
+from .portable import JIT_MODES, choose, default_jit
 from .control import attach_inputs_outputs, controlled_run, resolve_inputs
 from .steppers import registry
 from .steppers.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK
@@ -99,7 +99,7 @@ def _element_energy(module, p, state):
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
              save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
-             element_state0=None, force=False, keep=None, control=None, jit="auto",
+             element_state0=None, force=False, keep=None, control=None, jit=None,
              **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
@@ -136,7 +136,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         same results bit for bit). "auto" (default): specialized when numba's cache already
         holds it, else portable, switching to specialized between chunks of a fixed-step run
         whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S). Runs
-        with a control= hook are always specialized. Trajectory.jit says what ran.
+        with a control= hook are always specialized. None: the environment variable
+        LAGRANGE_GEN_JIT, else "auto". Trajectory.jit says what ran.
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.consistent), and the Trajectory carries the multipliers and
@@ -151,6 +152,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     """
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+    jit = jit or default_jit()
     if jit not in JIT_MODES:
         raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
     module = load_module(module_or_path, out_dir, method, force)

@@ -137,7 +137,7 @@ def test_corrupt_numba_cache_is_a_miss(oscillator):
     model, out = oscillator
     assert main([str(model), "-o", str(out), *ONE_METHOD]) == 0
     simulate = [CLI, "simulate", out / "damped_oscillator.py", "--method", "midpoint",
-                "--h", "0.01", "--t-end", "0.1", "--q0", "1", "--v0", "0"]
+                "--h", "0.01", "--t-end", "0.1", "--q0", "1", "--v0", "0", "--jit", "specialized"]
     first = run(*simulate)
     assert first.returncode == 0, first.stderr
     cache = out / "__pycache__"

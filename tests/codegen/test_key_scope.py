@@ -27,12 +27,13 @@ from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, METHODS
 UNCONSTRAINED = [m for m in METHODS if m not in CONSTRAINED_METHODS]
 
 # A fresh process loads the module from the model file (load() decides it is current), runs
-# explicit_euler a few steps and prints numba's cache statistics of the glue it ran.
+# explicit_euler a few steps with the module's own (specialized) glue and prints numba's cache
+# statistics of that glue.
 RUN = """
 import json, sys
 import lagrange_gen as lg
 mod = lg.load(sys.argv[1], out_dir=sys.argv[2])
-lg.simulate(mod, "explicit_euler", [0.1, 0.3], [0.0, 0.0], t_end=0.01, h=0.001)
+lg.simulate(mod, "explicit_euler", [0.1, 0.3], [0.0, 0.0], t_end=0.01, h=0.001, jit="specialized")
 stats = mod.run_explicit_euler.stats
 print(json.dumps({"hits": sum(stats.cache_hits.values()), "misses": sum(stats.cache_misses.values())}))
 """

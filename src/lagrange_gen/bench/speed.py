@@ -101,14 +101,14 @@ import numba, numpy  # noqa: F401
 from lagrange_gen.loader import load
 from lagrange_gen.simulation import simulate
 t1 = time.perf_counter()
-path, out_dir, method, options, q0 = sys.argv[1], sys.argv[2], sys.argv[3], \
-    json.loads(sys.argv[4]), json.loads(sys.argv[5])
+path, out_dir, method, options, q0, jit = sys.argv[1], sys.argv[2], sys.argv[3], \
+    json.loads(sys.argv[4]), json.loads(sys.argv[5]), sys.argv[6]
 mod = load(path, out_dir=out_dir, methods=[method], options=options)
 t2 = time.perf_counter()
-simulate(mod, method, q0, None, t_end=0.01, h=1e-3)
+traj = simulate(mod, method, q0, None, t_end=0.01, h=1e-3, jit=jit)
 t3 = time.perf_counter()
 print(json.dumps({"imports": t1 - t0, "generate": t2 - t1, "first_simulate": t3 - t2,
-                  "path": mod.__file__}))
+                  "path": mod.__file__, "jit": traj.jit}))
 """
 
 
@@ -119,11 +119,12 @@ WARMUP_STEM = {"rattle": ("cartesian_double_pendulum", [0.6, -0.8, 1.2, -1.6])}
 WARMUP_DEFAULT = ("double_pendulum", [0.1, 0.2])
 
 
-def _cold_child(models_dir, stem, options, method, q0, out_dir, cache):
-    """Run _COLD_CHILD in a new process with NUMBA_CACHE_DIR=cache; its timings (dict)."""
+def _cold_child(models_dir, stem, options, method, q0, out_dir, cache, jit="auto"):
+    """Run _COLD_CHILD in a new process with NUMBA_CACHE_DIR=cache (numba's cache of the
+    portable glue included: it lives there too) and simulate(jit=jit); its timings (dict)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
     done = subprocess.run([sys.executable, "-c", _COLD_CHILD, str(Path(models_dir) / f"{stem}.py"),
-                           str(out_dir), method, json.dumps(options), json.dumps(q0)],
+                           str(out_dir), method, json.dumps(options), json.dumps(q0), jit],
                           env=env, capture_output=True, text=True)
     if done.returncode != 0:
         last = (done.stderr.strip().splitlines() or ["no output"])[-1]
@@ -132,24 +133,36 @@ def _cold_child(models_dir, stem, options, method, q0, out_dir, cache):
 
 
 def measure_cold(models_dir, work):
-    """Per COLD row: {label, method, generate, first_simulate, total (beyond imports), goal,
-    path, cache, library_cached}: a new process, fresh numba cache, model generated into a fresh
-    directory. library_cached is the same total in a numba cache where another model
-    (WARMUP_STEM) already ran the method: what a user pays for a new model once the package's
-    own cached functions exist, which is every model but the first after an install."""
+    """Per COLD row: {label, method, goal, generate, first_simulate, total, jit, library_cached,
+    library_jit, specialized}, seconds beyond the interpreter's imports of a new process that
+    generates the model into a fresh directory and simulates a few steps with the default
+    simulate(jit="auto"):
+
+    - library_cached: a model just written, in a numba cache where another model
+      (WARMUP_STEM) already ran the method, so the portable stepper is cached and nothing of
+      this model is: what a user pays for every new model but the first after an install;
+    - total: everything cold (fresh NUMBA_CACHE_DIR): the first model after an install also
+      compiles the portable stepper;
+    - specialized: everything cold with jit="specialized" (the model's own stepper compiled,
+      as before the portable glue existed)."""
     rows = []
     for i, (label, stem, options, method, q0, goal) in enumerate(COLD):
-        cache, out_dir = Path(work) / f"cache{i}", Path(work) / f"gen{i}"
-        data = _cold_child(models_dir, stem, options, method, q0, out_dir, cache)
+        cold = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"gen{i}",
+                           Path(work) / f"cache{i}")
         warm_cache = Path(work) / f"libcache{i}"
         warm_stem, warm_q0 = WARMUP_STEM.get(method, WARMUP_DEFAULT)
         _cold_child(models_dir, warm_stem, {}, method, warm_q0, Path(work) / f"wgen{i}", warm_cache)
         lib = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"lgen{i}", warm_cache)
-        rows.append({"label": label, "method": method, "goal": goal, "cache": cache, **data,
-                     "total": data["generate"] + data["first_simulate"],
-                     "library_cached": lib["generate"] + lib["first_simulate"]})
-        print(f"cold {label}: {rows[-1]['total']:.1f} s (library cached: "
-              f"{rows[-1]['library_cached']:.1f} s)", flush=True)
+        own = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"sgen{i}",
+                          Path(work) / f"scache{i}", jit="specialized")
+        rows.append({"label": label, "method": method, "goal": goal, **cold,
+                     "total": cold["generate"] + cold["first_simulate"],
+                     "library_cached": lib["generate"] + lib["first_simulate"],
+                     "library_generate": lib["generate"], "library_jit": lib["jit"],
+                     "specialized": own["generate"] + own["first_simulate"]})
+        print(f"cold {label}: model just written {rows[-1]['library_cached']:.1f} s "
+              f"({lib['jit']}), fully cold {rows[-1]['total']:.1f} s, specialized fully cold "
+              f"{rows[-1]['specialized']:.1f} s", flush=True)
     return rows
 
 
