@@ -144,9 +144,11 @@ def _library_hash(method: str) -> str:
 
 
 @functools.lru_cache(maxsize=None)
-def glue(method: str):
-    """The portable ``run_<method>(kern, n_saved, <glue arguments>)`` dispatcher: its source is
-    written (atomically, once per library version) and imported under a unique module name."""
+def glue(method: str, events: bool = False):
+    """The portable ``run_<method>(kern, n_saved, <glue arguments>)`` dispatcher, or with
+    ``events`` its variant for models with events (``run_<method>_events``; the other one
+    compiles no event code): the source is written (atomically, once per library version) and
+    imported under a unique module name."""
     from .steppers.registry import portable_glue_source
     digest = _library_hash(method)
     source = portable_glue_source(method, digest)
@@ -165,14 +167,14 @@ def glue(method: str):
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         spec.loader.exec_module(module)
-    return getattr(module, f"run_{method}")
+    return getattr(module, f"run_{method}_events" if events else f"run_{method}")
 
 
 def runner(module, method):
     """A callable with the arguments of ``module.run_<method>`` (registry.GLUE_ARGS or
     ADAPTIVE_GLUE_ARGS) that runs the portable glue on ``module``'s kernels."""
     from .steppers.registry import spec
-    run, table = glue(method), kernel_table(module, method)
+    run, table = glue(method, module.N_EVENTS > 0), kernel_table(module, method)
     n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
 
     def run_portable(*args):

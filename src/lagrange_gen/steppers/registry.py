@@ -135,7 +135,14 @@ from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}
 @njit(cache=True, error_model="numpy")
 def run_{method}(kern, n_saved, {wrapped}):
     """run_{method} of a generated module, on the kernel table ``kern`` (portable.kernel_table)
-    of any model; n_saved: the method's saved fields on that model (SPEC.n_saved)."""
+    of any model without events; n_saved: the method's saved fields on that model
+    (SPEC.n_saved). The literal 0 prunes the event code before numba types it."""
+    return _{loop}(_stepper_{method}, kern, n_saved, 0, {wrapped_call})
+
+
+@njit(cache=True, error_model="numpy")
+def run_{method}_events(kern, n_saved, {wrapped}):
+    """run_{method} on the kernel table of a model with events (kern.N_EVENTS > 0)."""
     return _{loop}(_stepper_{method}, kern, n_saved, kern.N_EVENTS, {wrapped_call})
 '''
 
@@ -228,11 +235,12 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
 
 
 def portable_glue_source(method: str, digest: str) -> str:
-    """Source text of the portable ``run_<method>(kern, n_saved, ...)`` (lagrange_gen.portable)
-    for the library version ``digest``; deterministic."""
+    """Source text of the portable ``run_<method>(kern, n_saved, ...)`` and
+    ``run_<method>_events`` (lagrange_gen.portable) for the library version ``digest``;
+    deterministic."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
-    indent = " " * len(f"def run_{method}(")
+    indent = " " * len(f"def run_{method}_events(")
     wrapped = args.replace("settings, ", "settings,\n" + indent)
     call_indent = " " * len(f"    return _{loop}(")
     wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
