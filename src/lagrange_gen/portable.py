@@ -74,7 +74,10 @@ def _kernel_arg_types(fn):
                  else types.float64[::1] for a in names)
 
 
+@functools.lru_cache(maxsize=None)
 def _function_kernel_class():
+    """The FunctionKernel class (defined on first use: numba is imported only when a run
+    needs it)."""
     from numba.experimental.function_type import WrapperAddressProtocol
 
     class FunctionKernel(WrapperAddressProtocol):
@@ -98,15 +101,12 @@ def _function_kernel_class():
     return FunctionKernel
 
 
-FunctionKernel = None
-
-
 @functools.lru_cache(maxsize=None)
 def table_class(method: str):
     """The named tuple class of ``method``'s kernel table: one field per ``kern.<name>`` its
     glue reaches (codegen.needs: kernels and module constants) and N_EVENTS (the glue passes
-    it to the loop), sorted. Defined in this module
-    under a fixed name, so that numba's cache can pickle the type by reference."""
+    it to the loop), sorted. Defined in this module under a fixed name, so that numba's cache
+    can pickle the type by reference."""
     from .codegen.needs import method_needs
     name = f"Kernels_{method}"
     cls = collections.namedtuple(name, sorted(method_needs(method) | {"N_EVENTS"}))
@@ -118,17 +118,12 @@ def table_class(method: str):
 def kernel_table(module, method):
     """The kernel table of ``module`` for ``method`` (cached on the module): kernels as
     FunctionKernel (compiled for the portable types on first use), constants as they are."""
-    global FunctionKernel
     tables = module.__dict__.setdefault("_PORTABLE_TABLES", {})
     if method not in tables:
-        if FunctionKernel is None:
-            FunctionKernel = _function_kernel_class()
+        kernel = _function_kernel_class()
         cls = table_class(method)
-        values = []
-        for field in cls._fields:
-            value = getattr(module, field)
-            values.append(value if field.isupper() else FunctionKernel(value))
-        tables[method] = cls(*values)
+        tables[method] = cls(*(getattr(module, field) if field.isupper()
+                               else kernel(getattr(module, field)) for field in cls._fields))
     return tables[method]
 
 

@@ -133,8 +133,8 @@ def _cold_child(models_dir, stem, options, method, q0, out_dir, cache, jit="auto
 
 
 def measure_cold(models_dir, work):
-    """Per COLD row: {label, method, goal, generate, first_simulate, total, jit, library_cached,
-    library_jit, specialized}, seconds beyond the interpreter's imports of a new process that
+    """Per COLD row: {label, method, goal, path, cache (the fully cold run's numba cache),
+    generate, first_simulate, total, jit, library_cached, library_jit, specialized}, seconds beyond the interpreter's imports of a new process that
     generates the model into a fresh directory and simulates a few steps with the default
     simulate(jit="auto"):
 
@@ -147,15 +147,15 @@ def measure_cold(models_dir, work):
       as before the portable glue existed)."""
     rows = []
     for i, (label, stem, options, method, q0, goal) in enumerate(COLD):
-        cold = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"gen{i}",
-                           Path(work) / f"cache{i}")
+        cache = Path(work) / f"cache{i}"
+        cold = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"gen{i}", cache)
         warm_cache = Path(work) / f"libcache{i}"
         warm_stem, warm_q0 = WARMUP_STEM.get(method, WARMUP_DEFAULT)
         _cold_child(models_dir, warm_stem, {}, method, warm_q0, Path(work) / f"wgen{i}", warm_cache)
         lib = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"lgen{i}", warm_cache)
         own = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"sgen{i}",
                           Path(work) / f"scache{i}", jit="specialized")
-        rows.append({"label": label, "method": method, "goal": goal, **cold,
+        rows.append({"label": label, "method": method, "goal": goal, "cache": cache, **cold,
                      "total": cold["generate"] + cold["first_simulate"],
                      "library_cached": lib["generate"] + lib["first_simulate"],
                      "library_generate": lib["generate"], "library_jit": lib["jit"],
