@@ -30,6 +30,7 @@ from .errors import LagrangeGenError, SimulationError
 from .failures import raise_for_status
 from .fixed_run import ProgressBar, n_steps_to
 from .keys import regeneration_command_for
+from .portable import JIT_MODES, choose_ensemble, default_jit
 from .steppers import registry
 from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
 from .steppers.spec import make_settings
@@ -72,6 +73,7 @@ class EnsembleResult:
     wall_time: float
     compile_time: float
     messages: dict = field(default_factory=dict)    # {member: one-line failure message}
+    jit: str = ""       # the glue that ran: "specialized" or "portable" (ensemble(jit=))
 
     @property
     def ok(self):
@@ -85,7 +87,7 @@ class EnsembleResult:
 
 def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
              save_every=1, t0=0.0, progress=False, out_dir="generated", client=None,
-             worker_threads=1, **settings):
+             worker_threads=1, jit=None, **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
     q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
@@ -95,10 +97,17 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     one warning counts the members moved). Raises SimulationError (one line) on bad input or
     when the saved output would not fit in memory; failing members do not raise (failures()).
     client: a dask.distributed Client: the members run as Dask tasks in chunks on its workers,
-    each on ``worker_threads`` numba threads (ensemble_dask.py); the result is the same."""
+    each on ``worker_threads`` numba threads (ensemble_dask.py); the result is the same.
+    jit: as simulate's (lagrange_gen.portable): "auto" runs the generated ensemble_<method> when
+    numba's cache holds it, else the portable ensemble glue, compiled once for every model
+    (models with events: always the generated one); the Dask path runs the generated one.
+    EnsembleResult.jit says which ran."""
     from .simulation import _check_times, _element_method, load_module
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+    jit = jit or default_jit()
+    if jit not in JIT_MODES:
+        raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
     module = load_module(module_or_path, out_dir, method)
     method = _element_method(module, method)
     from .consistent import check_method
@@ -126,9 +135,11 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if spec.constraints:
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
     if client is None:
-        compile_time = _warm_up(run, q, v, p, t0, h, save_every, config, out)
+        run, ran, compile_time = _warm_up(
+            lambda args: choose_ensemble(jit, run, module, method, args),
+            q, v, p, t0, h, save_every, config, out)
     else:
-        compile_time = 0.0          # done by each worker, inside its first task
+        ran, compile_time = "specialized", 0.0   # done by each worker, inside its first task
     start = time.perf_counter()
     if client is None:
         _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress)
@@ -137,8 +148,10 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
         run_on_client(client, module, method, q, v, p, t0, h, n_steps, save_every, config, out,
                       progress, worker_threads)
     wall = time.perf_counter() - start
-    return _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time,
-                   getattr(config, "max_iter", 0))
+    result = _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time,
+                     getattr(config, "max_iter", 0))
+    result.jit = ran
+    return result
 
 
 def _ensemble_glue(module, method):
@@ -194,17 +207,25 @@ def _consistent_starts(module, q, v, p, t0, config, extra):
     return q, v
 
 
-def _call(run, q, v, p, t0, h, n_steps, save_every, config, out, members):
+def _args(q, v, p, t0, h, n_steps, save_every, config, out, members):
+    """The arguments of ensemble_<method> for the members (a slice)."""
     s = members
-    run(q[s], v[s], t0, h, n_steps, save_every, p[s], config, out["q"][s], out["v"][s],
-        out["stats"][s], out["extra"][s], out["last"][s], out["status"][s])
+    return (q[s], v[s], t0, h, n_steps, save_every, p[s], config, out["q"][s], out["v"][s],
+            out["stats"][s], out["extra"][s], out["last"][s], out["status"][s])
 
 
-def _warm_up(run, q, v, p, t0, h, save_every, config, out):
-    """Compile (or load from numba's cache) the glue with zero members; seconds it took."""
+def _call(run, q, v, p, t0, h, n_steps, save_every, config, out, members):
+    run(*_args(q, v, p, t0, h, n_steps, save_every, config, out, members))
+
+
+def _warm_up(choose, q, v, p, t0, h, save_every, config, out):
+    """Choose the glue (``choose(args)`` -> (glue, what ran), portable.choose_ensemble) and
+    compile or load it from numba's cache with zero members; (glue, what ran, seconds)."""
     start = time.perf_counter()
-    _call(run, q, v, p, t0, h, 0, save_every, config, out, slice(0, 0))
-    return time.perf_counter() - start
+    args = _args(q, v, p, t0, h, 0, save_every, config, out, slice(0, 0))
+    run, ran = choose(args)
+    run(*args)
+    return run, ran, time.perf_counter() - start
 
 
 def _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress):

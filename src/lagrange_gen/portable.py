@@ -138,12 +138,17 @@ def _library_hash(method: str) -> str:
     return digest.hexdigest()[:16]
 
 
-@functools.lru_cache(maxsize=None)
 def glue(method: str, events: bool = False):
     """The portable ``run_<method>(kern, n_saved, <glue arguments>)`` dispatcher, or with
     ``events`` its variant for models with events (``run_<method>_events``; the other one
-    compiles no event code): the source is written (atomically, once per library version) and
-    imported under a unique module name."""
+    compiles no event code)."""
+    return getattr(_glue_module(method), f"run_{method}_events" if events else f"run_{method}")
+
+
+@functools.lru_cache(maxsize=None)
+def _glue_module(method: str):
+    """The module of the portable glue of ``method``: its source is written (atomically, once
+    per library version) and imported under a unique module name."""
     from .steppers.registry import portable_glue_source
     digest = _library_hash(method)
     source = portable_glue_source(method, digest)
@@ -162,7 +167,7 @@ def glue(method: str, events: bool = False):
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         spec.loader.exec_module(module)
-    return getattr(module, f"run_{method}_events" if events else f"run_{method}")
+    return module
 
 
 def runner(module, method):
@@ -177,6 +182,35 @@ def runner(module, method):
 
     run_portable.portable = True
     return run_portable
+
+
+def ensemble_runner(module, method):
+    """A callable with the arguments of ``module.ensemble_<method>`` (registry.ENSEMBLE_GLUE_ARGS)
+    that runs the portable ensemble glue on ``module``'s kernels, or None for a model with events
+    (the portable ensemble has no event code; the specialized one runs them)."""
+    from .steppers.registry import spec
+    if module.N_EVENTS:
+        return None
+    run = getattr(_glue_module(method), f"ensemble_{method}")
+    table = kernel_table(module, method)
+    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
+
+    def ensemble_portable(*args):
+        return run(table, n_saved, *args)
+
+    return ensemble_portable
+
+
+def choose_ensemble(jit, specialized, module, method, args):
+    """(ensemble glue, "specialized" or "portable") as choose does for run_<method>."""
+    portable = None if jit == "specialized" else ensemble_runner(module, method)
+    if portable is None and jit == "portable":
+        from .errors import SimulationError
+        raise SimulationError(f"{module.NAME}: the portable ensemble glue has no event code and "
+                              f"this model has events; use jit='auto' or 'specialized'")
+    if portable is None or (jit == "auto" and specialized_ready(specialized, args)):
+        return specialized, "specialized"
+    return portable, "portable"
 
 
 def choose(jit, specialized, module, method, args):

@@ -126,6 +126,7 @@ def run_{method}({wrapped}):
 _PORTABLE_GLUE = '''"""Portable glue of {method}, written by lagrange_gen.portable; DO NOT EDIT.
 
 Library version {digest} (a hash of the package files it compiles)."""
+import numpy as np
 from numba import njit
 
 from lagrange_gen.steppers import {method} as _stepper_{method}
@@ -166,14 +167,14 @@ from lagrange_gen.status import NON_FINITE as _NON_FINITE
 
 
 @njit(cache=True, error_model="numpy")
-def _member_{method}(q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last):
+def _member_{method}({member_args}):
     """One member of ensemble_{method}: (status, steps_done, n_events) as run_{method}."""
     n = q0.shape[0]
     saves = n_steps // save_every + 1
     out_t = np.empty(saves)
     events = np.empty((0, 3 + 2 * n))
     status, steps, n_events = _run_loop(
-        _stepper_{method}, _THIS_MODULE, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
+        _stepper_{method}, {kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
         save_every, p, settings, out_t, q[:saves], v[:saves], stats[:saves], extra[:saves],
         last, events)
     if status == 0 and (steps % save_every != 0 or steps < n_steps):
@@ -181,7 +182,7 @@ def _member_{method}(q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stat
         for k in range(n):
             q[row, k] = last[1 + k]
             v[row, k] = last[1 + n + k]
-        energy = _THIS_MODULE.energy(q[row], v[row], last[0], p)
+        energy = {kern}.energy(q[row], v[row], last[0], p)
         stats[row, 0] = energy
         stats[row, 1] = last[1 + 2 * n]
         stats[row, 2] = last[2 + 2 * n]
@@ -193,7 +194,7 @@ def _member_{method}(q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stat
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def ensemble_{method}({wrapped}):
+def ensemble_{method}({table}{wrapped}):
     """Integrate members i = 0..M-1 with {method} in one parallel loop; nothing returned.
 
     q0, v0 (M, n); p (M, n_params); out_q, out_v (M, S, n); out_stats (M, S, N_STATS);
@@ -202,7 +203,7 @@ def ensemble_{method}({wrapped}):
     See lagrange_gen.steppers.registry; lagrange_gen.ensemble wraps this."""
     for i in _prange(q0.shape[0]):
         status, steps, n_events = _member_{method}(
-            q0[i], v0[i], t0, h, n_steps, save_every, p[i], settings, out_q[i], out_v[i],
+            {table}q0[i], v0[i], t0, h, n_steps, save_every, p[i], settings, out_q[i], out_v[i],
             out_stats[i], out_extra[i], out_last[i])
         out_status[i, 0] = status
         out_status[i, 1] = steps
@@ -235,8 +236,9 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
 
 
 def portable_glue_source(method: str, digest: str) -> str:
-    """Source text of the portable ``run_<method>(kern, n_saved, ...)`` and
-    ``run_<method>_events`` (lagrange_gen.portable) for the library version ``digest``;
+    """Source text of the portable ``run_<method>(kern, n_saved, ...)``,
+    ``run_<method>_events`` and, for a fixed-step method, ``ensemble_<method>(kern, n_saved,
+    ...)`` (models without events) (lagrange_gen.portable) for the library version ``digest``;
     deterministic."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
@@ -244,8 +246,12 @@ def portable_glue_source(method: str, digest: str) -> str:
     wrapped = args.replace("settings, ", "settings,\n" + indent)
     call_indent = " " * len(f"    return _{loop}(")
     wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
-    return _PORTABLE_GLUE.format(method=method, digest=digest, loop_module=loop_module,
-                                 loop=loop, wrapped=wrapped, wrapped_call=wrapped_call)
+    source = _PORTABLE_GLUE.format(method=method, digest=digest, loop_module=loop_module,
+                                   loop=loop, wrapped=wrapped, wrapped_call=wrapped_call)
+    if spec(method).adaptive:
+        return source
+    # ensemble_<method>(kern, n_saved, ...) for models without events (the literal 0)
+    return source + "\n\n" + _ensemble_source(method, "n_saved", 0, "kern", "kern, n_saved, ")
 
 
 def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:
@@ -253,7 +259,20 @@ def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:
     ``run_<method>`` (whose block imports the stepper and run_loop); deterministic."""
     if spec(method).adaptive:
         raise ValueError(f"{method} chooses its own steps: no ensemble glue (fixed-step only)")
+    return _ensemble_source(method, n_saved, n_events, "_THIS_MODULE", "")
+
+
+def _ensemble_source(method, n_saved, n_events, kern, table):
+    """_ENSEMBLE_GLUE for the generated module (kern "_THIS_MODULE", no table argument) or the
+    portable glue (kern "kern", table "kern, n_saved, ": the kernel table passed in)."""
     indent = " " * len(f"def ensemble_{method}(")
     wrapped = ENSEMBLE_GLUE_ARGS.replace("settings, ", "settings,\n" + indent)
+    member_args = _MEMBER_ARGS if not table else (
+        table + _MEMBER_ARGS.replace("settings, ", "settings,\n" + " " * len(
+            f"def _member_{method}(")))
     return _ENSEMBLE_GLUE.format(method=method, wrapped=wrapped, n_saved=n_saved,
-                                 n_events=n_events)
+                                 n_events=n_events, kern=kern, table=table,
+                                 member_args=member_args)
+
+
+_MEMBER_ARGS = "q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last"
