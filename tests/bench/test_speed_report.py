@@ -17,8 +17,10 @@ def _results():
     return {
         "quick": True, "mujoco": False,
         "precision": {"ours": {"rk4": 5e-4}, "peers": {}, "pydy": None},
-        "steps": [{"method": "rk4", "ours_ns": 130.0, "hand_ns": 76.0, "iters": 0.0}],
+        "steps": [{"method": "rk4", "ours_ns": 130.0, "hand_ns": 76.0, "iters": 0.0,
+                   "portable_ns": 195.0}],
         "chain": {"ours": {"symplectic_euler": 4800.0, "verlet": 8600.0, "rk4": 6800.0},
+                  "portable": {"symplectic_euler": 5000.0, "verlet": 9000.0, "rk4": 7000.0},
                   "mujoco": None, "equivalence": None},
         "cold": [_cold_row("cart pendulum, verlet", 3.0, 1.7, 15.2),
                  _cold_row("10-link chain, verlet", 10.0, 11.0, 21.0)],
@@ -37,6 +39,8 @@ def test_first_use_rows_state_both_verdicts():
     detail = [line for line in lines if line.startswith("| cart pendulum, verlet |")]
     assert detail == ["| cart pendulum, verlet | 0.40 | 1.30 | 1.70 | portable | 15.20 | 12.00 "
                       "| <= 3 |"]
+    assert "| rk4 | 130 | 76 | 1.71 | 0.00 | 195 (1.50x) |" in lines
+    assert "- ours verlet: 8600 ns (portable loop: 9000 ns)" in lines
 
 
 def test_cold_cases_cover_the_issue_goals():

@@ -71,6 +71,16 @@ def measure_precision(models_dir, gen_dir, quick, progress):
     return {"ours": ours, "peers": peer_times, "pydy": pydy and pydy[2]}
 
 
+def portable_step_ns(mod, method, steps, repeats):
+    """ns per step of the portable glue (lagrange_gen.portable) of ``method`` on ``mod``, timed
+    as bench/steppers.py times the module's own run_<method>."""
+    from .. import portable
+    from .steppers import _best_of, _library_runner
+    go = _library_runner(mod, method, steps, portable.runner(mod, method))
+    go()                                                  # compile or load
+    return _best_of(go, repeats)[0] / steps * 1e9
+
+
 def measure_chain(models_dir, gen_dir, quick):
     """ns per step on the 16-link chain: {"ours": {method: ns}, "mujoco": {integrator: {c_loop,
     python_loop}} or None, "equivalence": max abs state difference of the two rk4 runs}."""
@@ -80,17 +90,20 @@ def measure_chain(models_dir, gen_dir, quick):
                methods=list(CHAIN_METHODS), options={"n": CHAIN_N})
     th0, v0 = 0.3 * np.sin(np.arange(1, CHAIN_N + 1)), np.zeros(CHAIN_N)
     steps, repeats = (5_000, 2) if quick else (20_000, 3)
-    ours = {}
+    ours, portable = {}, {}
     for method in CHAIN_METHODS:
         walls = [simulate(mod, method, th0, v0, t_end=steps * CHAIN_H, h=CHAIN_H,
                           save_every=steps).wall_time for _ in range(repeats)]
         ours[method] = 1e9 * min(walls) / steps
+        walls = [simulate(mod, method, th0, v0, t_end=steps * CHAIN_H, h=CHAIN_H,
+                          save_every=steps, jit="portable").wall_time for _ in range(repeats)]
+        portable[method] = 1e9 * min(walls) / steps
     if not mujoco_chain.available():
-        return {"ours": ours, "mujoco": None, "equivalence": None}
+        return {"ours": ours, "portable": portable, "mujoco": None, "equivalence": None}
     params = runs.params_of(mod)                          # (m, l, g)
     theirs = {name: mujoco_chain.ns_per_step(CHAIN_N, CHAIN_H, name, params, th0, v0, steps,
                                              repeats) for name in ("Euler", "RK4")}
-    return {"ours": ours, "mujoco": theirs,
+    return {"ours": ours, "portable": portable, "mujoco": theirs,
             "equivalence": mujoco_chain.equivalence(mod, params, th0, CHAIN_H)}
 
 
@@ -183,6 +196,8 @@ def run_speed_bench(models_dir="models", gen_dir="generated", reports_dir="repor
     steps, repeats = (20_000, 2) if quick else (100_000, 5)
     results["steps"] = [r for r in measure_step_times(mod, steps, repeats)
                         if r["method"] in HAND_CLOSED_FORM]
+    for row in results["steps"]:
+        row["portable_ns"] = portable_step_ns(mod, row["method"], steps, repeats)
     results["chain"] = measure_chain(models_dir, gen_dir, quick)
     lines = markdown(results)
     path = common.write_report(Path(reports_dir) / "speed.md", lines)

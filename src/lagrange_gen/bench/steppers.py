@@ -251,8 +251,11 @@ def _best_of(fn, repeats):
     return best, result
 
 
-def _library_runner(mod, method, n_steps):
-    run = getattr(mod, f"run_{method}")
+def _library_runner(mod, method, n_steps, run=None):
+    """A zero-argument call of ``run`` (default: the module's run_<method>; the portable glue's
+    runner, lagrange_gen.portable, takes the same arguments) for n_steps steps from (Q0, V0),
+    returning (final state, Newton iterations per step)."""
+    run = run or getattr(mod, f"run_{method}")
     n = mod.N_COORDS
     q0, v0 = np.array(Q0), np.array(V0)
     out = (np.empty(2), np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)),
