@@ -170,47 +170,23 @@ def _glue_module(method: str):
     return module
 
 
+def _bound(module, method, function):
+    """``function`` of the portable glue of ``method`` with ``module``'s kernel table and the
+    method's n_saved on that model (SPEC.n_saved) passed in front of the glue arguments."""
+    from .steppers.registry import spec
+    run, table = getattr(_glue_module(method), function), kernel_table(module, method)
+    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
+
+    def bound(*args):
+        return run(table, n_saved, *args)
+
+    return bound
+
+
 def runner(module, method):
     """A callable with the arguments of ``module.run_<method>`` (registry.GLUE_ARGS or
     ADAPTIVE_GLUE_ARGS) that runs the portable glue on ``module``'s kernels."""
-    from .steppers.registry import spec
-    run, table = glue(method, module.N_EVENTS > 0), kernel_table(module, method)
-    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
-
-    def run_portable(*args):
-        return run(table, n_saved, *args)
-
-    run_portable.portable = True
-    return run_portable
-
-
-def ensemble_runner(module, method):
-    """A callable with the arguments of ``module.ensemble_<method>`` (registry.ENSEMBLE_GLUE_ARGS)
-    that runs the portable ensemble glue on ``module``'s kernels, or None for a model with events
-    (the portable ensemble has no event code; the specialized one runs them)."""
-    from .steppers.registry import spec
-    if module.N_EVENTS:
-        return None
-    run = getattr(_glue_module(method), f"ensemble_{method}")
-    table = kernel_table(module, method)
-    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
-
-    def ensemble_portable(*args):
-        return run(table, n_saved, *args)
-
-    return ensemble_portable
-
-
-def choose_ensemble(jit, specialized, module, method, args):
-    """(ensemble glue, "specialized" or "portable") as choose does for run_<method>."""
-    portable = None if jit == "specialized" else ensemble_runner(module, method)
-    if portable is None and jit == "portable":
-        from .errors import SimulationError
-        raise SimulationError(f"{module.NAME}: the portable ensemble glue has no event code and "
-                              f"this model has events; use jit='auto' or 'specialized'")
-    if portable is None or (jit == "auto" and specialized_ready(specialized, args)):
-        return specialized, "specialized"
-    return portable, "portable"
+    return _bound(module, method, f"run_{method}_events" if module.N_EVENTS else f"run_{method}")
 
 
 def choose(jit, specialized, module, method, args):
@@ -220,6 +196,20 @@ def choose(jit, specialized, module, method, args):
     if jit == "specialized" or (jit == "auto" and specialized_ready(specialized, args)):
         return specialized, "specialized"
     return runner(module, method), "portable"
+
+
+def choose_ensemble(jit, specialized, module, method, args):
+    """(glue, "specialized" or "portable") as choose, for ``module.ensemble_<method>`` and the
+    portable ``ensemble_<method>``, which has no event code: a model with events runs the
+    module's (jit="portable" is refused)."""
+    if module.N_EVENTS and jit == "portable":
+        from .errors import SimulationError
+        raise SimulationError(f"{module.NAME}: the portable ensemble glue has no event code and "
+                              f"this model has events; use jit='auto' or 'specialized'")
+    if jit == "specialized" or module.N_EVENTS or (
+            jit == "auto" and specialized_ready(specialized, args)):
+        return specialized, "specialized"
+    return _bound(module, method, f"ensemble_{method}"), "portable"
 
 
 def specialized_ready(dispatcher, args) -> bool:
