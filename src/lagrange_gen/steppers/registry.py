@@ -226,10 +226,8 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
     events before compiling them (a module constant would only be folded later, by LLVM)."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
-    indent = " " * (len(f"def run_{method}("))
-    wrapped = args.replace("settings, ", "settings,\n" + indent)
-    call_indent = " " * len(f"    return _{loop}(")
-    wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
+    wrapped = _wrap(args, f"def run_{method}(")
+    wrapped_call = _wrap(args, f"    return _{loop}(")
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
                         summary=spec(method).summary, loop_module=loop_module, loop=loop,
                         n_saved=n_saved, n_events=n_events)
@@ -242,10 +240,8 @@ def portable_glue_source(method: str, digest: str) -> str:
     deterministic."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
-    indent = " " * len(f"def run_{method}_events(")
-    wrapped = args.replace("settings, ", "settings,\n" + indent)
-    call_indent = " " * len(f"    return _{loop}(")
-    wrapped_call = args.replace("settings, ", "settings,\n" + call_indent)
+    wrapped = _wrap(args, f"def run_{method}_events(")
+    wrapped_call = _wrap(args, f"    return _{loop}(")
     source = _PORTABLE_GLUE.format(method=method, digest=digest, loop_module=loop_module,
                                    loop=loop, wrapped=wrapped, wrapped_call=wrapped_call)
     if spec(method).adaptive:
@@ -265,14 +261,17 @@ def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:
 def _ensemble_source(method, n_saved, n_events, kern, table):
     """_ENSEMBLE_GLUE for the generated module (kern "_THIS_MODULE", no table argument) or the
     portable glue (kern "kern", table "kern, n_saved, ": the kernel table passed in)."""
-    indent = " " * len(f"def ensemble_{method}(")
-    wrapped = ENSEMBLE_GLUE_ARGS.replace("settings, ", "settings,\n" + indent)
-    member_args = _MEMBER_ARGS if not table else (
-        table + _MEMBER_ARGS.replace("settings, ", "settings,\n" + " " * len(
-            f"def _member_{method}(")))
+    wrapped = _wrap(ENSEMBLE_GLUE_ARGS, f"def ensemble_{method}(")
+    member_args = table + _wrap(_MEMBER_ARGS, f"def _member_{method}(") if table else _MEMBER_ARGS
     return _ENSEMBLE_GLUE.format(method=method, wrapped=wrapped, n_saved=n_saved,
                                  n_events=n_events, kern=kern, table=table,
                                  member_args=member_args)
 
 
 _MEMBER_ARGS = "q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last"
+
+
+def _wrap(args, opening):
+    """The argument list ``args`` broken after "settings, " and aligned under ``opening``
+    (the text before the first argument: "def run_verlet(", "    return _run_loop(")."""
+    return args.replace("settings, ", "settings,\n" + " " * len(opening))
