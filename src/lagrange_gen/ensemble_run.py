@@ -30,7 +30,7 @@ from .errors import LagrangeGenError, SimulationError
 from .failures import raise_for_status
 from .fixed_run import ProgressBar, n_steps_to
 from .keys import regeneration_command_for
-from .portable import JIT_MODES, choose_ensemble, default_jit
+from .portable import choose_ensemble, jit_mode
 from .steppers import registry
 from .steppers.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
 from .steppers.spec import make_settings
@@ -105,9 +105,7 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     from .simulation import _check_times, _element_method, load_module
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
-    jit = jit or default_jit()
-    if jit not in JIT_MODES:
-        raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
+    jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method)
     method = _element_method(module, method)
     from .consistent import check_method

@@ -48,9 +48,14 @@ JIT_MODES = ("auto", "specialized", "portable")
 JIT_ENV = "LAGRANGE_GEN_JIT"
 
 
-def default_jit() -> str:
-    """simulate's jit when none is given: $LAGRANGE_GEN_JIT, else "auto"."""
-    return os.environ.get(JIT_ENV) or "auto"
+def jit_mode(jit) -> str:
+    """The jit of simulate / ensemble: ``jit``, or when None $LAGRANGE_GEN_JIT, else "auto";
+    SimulationError naming it when it is not one of JIT_MODES."""
+    jit = jit or os.environ.get(JIT_ENV) or "auto"
+    if jit not in JIT_MODES:
+        from .errors import SimulationError
+        raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
+    return jit
 
 
 def portable_dir() -> Path:
@@ -136,13 +141,6 @@ def _library_hash(method: str) -> str:
     files = source_closure([f"steppers.{method}", f"steppers.{loop_module}"])
     digest = hashlib.sha256(repr(sorted(source_hashes(files).items())).encode())
     return digest.hexdigest()[:16]
-
-
-def glue(method: str, events: bool = False):
-    """The portable ``run_<method>(kern, n_saved, <glue arguments>)`` dispatcher, or with
-    ``events`` its variant for models with events (``run_<method>_events``; the other one
-    compiles no event code)."""
-    return getattr(_glue_module(method), f"run_{method}_events" if events else f"run_{method}")
 
 
 @functools.lru_cache(maxsize=None)

@@ -31,7 +31,7 @@ from .errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
 from .fixed_run import allocate, integrate_fixed, n_steps_to
 from .keys import regeneration_command_for
-from .portable import JIT_MODES, choose, default_jit
+from .portable import choose, jit_mode
 from .control import attach_inputs_outputs, controlled_run, resolve_inputs
 from .steppers import registry
 from .steppers.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK
@@ -152,9 +152,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     """
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
-    jit = jit or default_jit()
-    if jit not in JIT_MODES:
-        raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
+    jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method, force)
     method = _element_method(module, method)
     from .consistent import check_method

@@ -147,9 +147,9 @@ def _cold_child(models_dir, stem, options, method, q0, out_dir, cache, jit="auto
 
 def measure_cold(models_dir, work):
     """Per COLD row: {label, method, goal, path, cache (the fully cold run's numba cache),
-    generate, first_simulate, total, jit, library_cached, library_jit, specialized}, seconds beyond the interpreter's imports of a new process that
-    generates the model into a fresh directory and simulates a few steps with the default
-    simulate(jit="auto"):
+    generate, first_simulate, total, jit, library_cached, library_jit, specialized}, seconds
+    beyond the interpreter's imports of a new process that generates the model into a fresh
+    directory and simulates a few steps with the default simulate(jit="auto"):
 
     - library_cached: a model just written, in a numba cache where another model
       (WARMUP_STEM) already ran the method, so the portable stepper is cached and nothing of
