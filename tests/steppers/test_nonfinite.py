@@ -88,3 +88,20 @@ def test_singular_newton_matrix_with_a_regular_mass_matrix(model):
     assert not isinstance(info.value, SingularMass)
     assert "step 1 of 2" in msg and "singular Newton matrix" in msg and "mass matrix" not in msg
 
+
+
+@pytest.mark.parametrize("bound", [1e150, math.inf])
+def test_check_state_sorts_every_entry_and_bound(bound):
+    """base.check_state, run after every step: NaN and +-inf in any entry of q or v are
+    NON_FINITE, also under an infinite blow-up bound (its fast path compares |x| <= bound, which
+    inf passes when bound is inf); a finite entry past a finite bound is UNSTABLE."""
+    from lagrange_gen.status import NON_FINITE, OK, UNSTABLE
+    from lagrange_gen.steppers.base import check_state
+    for bad, expected in ((math.nan, NON_FINITE), (math.inf, NON_FINITE),
+                          (-math.inf, NON_FINITE),
+                          (1e200, UNSTABLE if bound < math.inf else OK)):
+        for which in range(4):
+            state = np.array([0.5, -2.0, 1.0, 3.0])
+            state[which] = bad
+            assert check_state(state[:2], state[2:], bound) == expected, (bad, which)
+    assert check_state(np.array([0.5, -2.0]), np.array([1.0, 3.0]), bound) == OK

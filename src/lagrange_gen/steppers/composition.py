@@ -32,13 +32,16 @@ from numba import njit
 from ..status import OK
 from . import verlet
 from .base import FAST, copy_into, explicit_path
+from .partitioned import GUESS_DEGREE
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run: verlet's workspace (its cached acceleration included) and the state at
 #: the start of the step, q, v, mom, acc (n,), restored when a substep fails; per substep j
-#: (Newton path), guesses (s, 4, n): the last three kick solutions and the last drift solution
-#: of substep j, kept (s,) how many kick solutions are there: each substep's own sequence has
-#: steps of one size, so verlet extrapolates its guesses along it (verlet.step_newton).
+#: (Newton path), guesses (s, 2 GUESS_DEGREE + 3, n): the kick solution, the earlier ones and the
+#: earlier drift differences (verlet's u, history, drifts) of substep j, kept (s, 3): how many
+#: solutions are kept and the degrees of the next guesses (verlet's carried[1:]): each
+#: substep's own sequence has steps of one size, so verlet extrapolates its guesses along it
+#: (verlet.step_newton).
 Workspace = namedtuple("Workspace", "verlet q v mom acc guesses kept")
 
 
@@ -64,7 +67,8 @@ def linear_radius(coeffs, tau):
 def allocate(kern, n, substeps):
     """The workspace of a composition of ``substeps`` verlet steps (n coordinates)."""
     return Workspace(verlet.workspace(kern, n), np.zeros(n), np.zeros(n), np.zeros(n),
-                     np.zeros(n), np.zeros((substeps, 4, n)), np.zeros(substeps, np.int64))
+                     np.zeros(n), np.zeros((substeps, 2 * GUESS_DEGREE + 3, n)),
+                     np.zeros((substeps, 3), np.int64))
 
 
 @njit
@@ -78,7 +82,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """The per-run state of verlet (its cached acceleration or the momentum); the substeps'
     guesses start over."""
     for j in range(ws.kept.shape[0]):
-        ws.kept[j] = 0
+        ws.kept[j, 0] = ws.kept[j, 1] = ws.kept[j, 2] = 0
     return verlet.prepare(kern, q, v, mom, t, p, settings, ws.verlet, extra)
 
 
@@ -86,16 +90,21 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def _substep_newton(kern, q, v, mom, t, h, p, settings, ws, j):
     """verlet's Newton-path step as substep j, with the guesses of substep j's own sequence."""
     vw, mine = ws.verlet, ws.guesses[j]
+    depth = vw.history.shape[0]
     for i in range(q.shape[0]):
-        vw.u[i], vw.history[0, i], vw.history[1, i], vw.w[i] = (mine[0, i], mine[1, i],
-                                                                mine[2, i], mine[3, i])
-    vw.carried[1] = ws.kept[j]
+        vw.u[i] = mine[0, i]
+        for k in range(depth):
+            vw.history[k, i], vw.drifts[k, i] = mine[1 + k, i], mine[1 + depth + k, i]
+    for k in range(1, 4):
+        vw.carried[k] = ws.kept[j, k - 1]
     status, it, res = verlet.step_newton(kern, q, v, mom, t, h, p, settings, vw)
     if status == OK:
         for i in range(q.shape[0]):
-            mine[0, i], mine[1, i], mine[2, i], mine[3, i] = (vw.u[i], vw.history[0, i],
-                                                              vw.history[1, i], vw.w[i])
-        ws.kept[j] = vw.carried[1]
+            mine[0, i] = vw.u[i]
+            for k in range(depth):
+                mine[1 + k, i], mine[1 + depth + k, i] = vw.history[k, i], vw.drifts[k, i]
+        for k in range(1, 4):
+            ws.kept[j, k - 1] = vw.carried[k]
     return status, it, res
 
 

@@ -22,13 +22,14 @@ from numba import njit
 from ..status import OK
 from . import verlet
 from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity
-from .partitioned import begin_step, end_step, solve_kick
+from .partitioned import GUESS_DEGREE, begin_step, best_degree, end_step, solve_kick
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run (n,): the kick's unknown u, residual R, momentum rate f (the acceleration
 #: on the explicit path), solver scratch s, pivots, the new state; (n, n): H, the Newton matrix
-#: A, df/dq, df/dv; what one step leaves the next (partitioned.begin_step): history (2, n)
-#: earlier kick solutions, carried (2,) int.
+#: A, df/dq, df/dv; what one step leaves the next (partitioned.begin_step): history
+#: (GUESS_DEGREE + 1, n) earlier kick solutions, carried (3,) int: H(q) factored, solutions
+#: kept, degree of the next guess.
 Workspace = namedtuple("Workspace", "u R f s piv q_new v_new p_new H A Jq Jqd history carried")
 
 
@@ -37,7 +38,8 @@ def workspace(kern, n):
     """Allocated once per run by base.run_loop."""
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((2, n)), np.zeros(2, np.int64))
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((GUESS_DEGREE + 1, n)),
+                     np.zeros(3, np.int64))
 
 
 @njit(**FAST)
@@ -45,7 +47,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Carry the momentum p = H(q) v between steps (Newton path only)."""
     if not explicit_path(kern, settings):
         momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
-        ws.carried[0] = ws.carried[1] = 0
+        ws.carried[0] = ws.carried[1] = ws.carried[2] = 0
     return OK
 
 
@@ -71,6 +73,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
                                       ws.R, ws.f, ws.s)
     if status != OK:
         return status, iters, resid
+    ws.carried[2] = best_degree(ws.history, u, kept, v)
     for i in range(n):
         q_new[i] = q[i] + h * u[i]
     matvec(ws.H, u, p_new)                     # ws.H holds H(q)
@@ -78,7 +81,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         kern.transport(q, t, p, p_new)         # the canonical momentum H u + b
     kern.mass_matrix(q_new, t + h, p, ws.H)
     status = end_step(kern, q_new, p_new, t + h, p, ws.H, ws.A, ws.piv, v_new, ws.s, ws.carried,
-                      kept)
+                      kept, ws.history.shape[0])
     if status != OK:
         return status, iters, resid
     for i in range(n):

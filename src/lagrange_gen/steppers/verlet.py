@@ -29,15 +29,19 @@ from numba import njit
 
 from ..status import OK
 from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity
-from .partitioned import begin_step, end_step, solve_drift, solve_kick
+from .partitioned import (GUESS_DEGREE, begin_step, best_degree, end_step, extrapolate, push,
+                          solve_drift, solve_kick)
 from .spec import PartitionedSettings, Spec
 
 #: Scratch of one run (n,): the cached acceleration acc (explicit path, kept between steps), the
 #: kick's and drift's unknowns u, w (u is v* on the explicit path), residual R, momentum rate f
 #: (a(q+) on the explicit path), solver scratch s, pivots, q+, v+, p_half (p* then p+);
 #: (n, n): H, the Newton matrix A, df/dq, df/dv, d(H w)/dq; what one step leaves the next
-#: (partitioned.begin_step): history (2, n) earlier kick solutions, carried (2,) int.
-Workspace = namedtuple("Workspace", "acc u w R f s piv q_new v_new p_half H A Jq Jqd dHw history carried")
+#: (partitioned.begin_step): history (GUESS_DEGREE + 1, n) earlier kick solutions, drifts
+#: (GUESS_DEGREE + 1, n) earlier drift-minus-kick solutions w - u, carried (4,) int: H(q)
+#: factored, solutions kept, degrees of the next kick's and drift's guesses.
+Workspace = namedtuple("Workspace",
+                       "acc u w R f s piv q_new v_new p_half H A Jq Jqd dHw history drifts carried")
 
 
 @njit
@@ -46,7 +50,8 @@ def workspace(kern, n):
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)), np.zeros((2, n)), np.zeros(2, np.int64))
+                     np.zeros((n, n)), np.zeros((GUESS_DEGREE + 1, n)),
+                     np.zeros((GUESS_DEGREE + 1, n)), np.zeros(4, np.int64))
 
 
 @njit(**FAST)
@@ -55,7 +60,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     if explicit_path(kern, settings):
         return accel(kern, q, v, t, p, ws.H, ws.acc)
     momentum_from_velocity(kern, q, v, t, p, ws.H, mom)
-    ws.carried[0] = ws.carried[1] = 0
+    ws.carried[0] = ws.carried[1] = ws.carried[2] = ws.carried[3] = 0
     return OK
 
 
@@ -85,8 +90,9 @@ def step_explicit(kern, q, v, t, h, p, ws):
 def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     """The Newton path's step; returns (status, Newton iterations, residual). The kick's guess
     is extrapolated from the earlier steps' solutions (partitioned.begin_step), the drift's is
-    u + (w_k - u_k), the previous step's difference: ws holds a sequence of steps of one size
-    (composition.py gives each of its substeps its own)."""
+    u plus the extrapolation of the earlier differences w - u (on the 16-link chain 8.90 against
+    10.11 iterations per step with the last difference alone): ws holds a sequence of steps of
+    one size (composition.py gives each of its substeps its own)."""
     n = q.shape[0]
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
@@ -97,22 +103,29 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
                                    ws.Jq, ws.Jqd, ws.piv, u, ws.R, f, ws.s)
     if status != OK:
         return status, it1, res1
+    ws.carried[2] = best_degree(ws.history, u, kept, v)
     matvec(ws.H, u, p_half)                    # p* = H(q) u + b (ws.H holds H(q))
     if kern.TRANSPORT:
         kern.transport(q, t, p, p_half)
+    drifts, degree = ws.drifts, min(ws.carried[3], kept - 1)
     for i in range(n):
-        w[i] = u[i] + (w[i] - ws.history[0, i] if kept >= 1 else 0.0)
+        w[i] = u[i] + (extrapolate(drifts, degree, i) if kept >= 1 else 0.0)
     status, it2, res2 = solve_drift(kern, q, u, p_half, 0.5 * h, t + h, p, tol, max_iter, ws.H, ws.A,
                                     ws.dHw, ws.piv, w, ws.R, q_new, ws.s)
     iters, resid = it1 + it2, max(res1, res2)
     if status != OK:
         return status, iters, resid
+    for i in range(n):
+        ws.R[i] = w[i] - u[i]
+    if kept >= 1:
+        ws.carried[3] = best_degree(drifts, ws.R, kept, drifts[0])
+    push(drifts, ws.R)
     kern.momentum_rate(q_new, w, t + h, p, f)
     for i in range(n):
         p_half[i] += 0.5 * h * f[i]            # now p+
     # (solve_drift leaves H(q+) in ws.H)
     status = end_step(kern, q_new, p_half, t + h, p, ws.H, ws.A, ws.piv, v_new, ws.s, ws.carried,
-                      kept)
+                      kept, ws.history.shape[0])
     if status != OK:
         return status, iters, resid
     for i in range(n):
