@@ -33,7 +33,12 @@ symplectic_euler 12.5 us per step with Newton -> 6.9 with the Jacobian kept with
 verlet 19.5 -> 11.4 -> 8.3 us. Cart pendulum: symplectic_euler 231 -> 210 ns, verlet 394 ->
 389 ns, composition 1152 -> 1184 ns (each substep extrapolating along its own sequence, 17.9
 iterations per step; 1284 ns and 22.5 when they started from v); 16-link chain composition
-62.9 -> 27.7 us.
+62.9 -> 27.7 us. Then the guesses of degree up to GUESS_DEGREE = 4 (best_degree), on a faster
+machine (best of 3 runs of 2e4 steps, taskset to one core): 16-link chain symplectic_euler
+3535 -> 2959-3269 ns (4.75 -> 3.27 iterations per step), verlet 6472 -> 5061 ns (10.11 ->
+5.76); cart pendulum (best of 7 runs of 1e5 steps) symplectic_euler 2.88 -> 1.78 iterations,
+verlet 5.75 -> 2.78, composition 17.9 -> 8.3, composition6 48.3 -> 25.0 (at n = 2 the step
+time hardly moves: an iteration is a small part of it).
 Shapes: q, mom, u, w, R, f, scratch (n,); H, A, Jq, Jqd, dHw (n, n).
 """
 
