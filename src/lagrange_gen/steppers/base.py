@@ -50,9 +50,11 @@ fields (empty for the unconstrained methods).
 """
 
 import math
+import types
 
 import numpy as np
 from numba import njit
+from numba.core import ir
 
 from .. import linalg
 from ..status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
@@ -69,6 +71,19 @@ STAT_ITERS = 1      # Newton iterations summed over the steps since the previous
 STAT_RESIDUAL = 2   # largest Newton residual (max norm, last iterate of a step) over those steps
 STAT_WORK = 3       # W, the work of non-conservative forces and explicit time since t0 (work.py)
 N_STATS = 4
+
+def inline_where_kernels_are_a_module(expr, caller_ir, callee_ir):
+    """numba inline cost model (``@njit(inline=...)``) for a method's ``step``: inline it into
+    the run loop of a generated module's own glue, where ``kern`` (the call's first argument)
+    is the module, a global; not into the portable glue (portable.py), where ``kern`` is an
+    argument holding function pointers: inlined there, explicit Euler's step went from 52 to
+    114 ns on the cart pendulum (and from 28 to 18 ns in the module's glue)."""
+    try:
+        kern = caller_ir.get_definition(expr.args[0])
+    except Exception:          # no single definition: not a module global
+        return False
+    return isinstance(kern, ir.Global) and isinstance(kern.value, types.ModuleType)
+
 
 @njit(**FAST)
 def explicit_path(kern, settings):
