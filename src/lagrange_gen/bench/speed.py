@@ -81,6 +81,15 @@ def portable_step_ns(mod, method, steps, repeats):
     return _best_of(go, repeats)[0] / steps * 1e9
 
 
+def chain_dir():
+    """Where bench speed writes the 16-link chain's module: beside the portable glue (kept, so
+    numba's cache of it serves the next run), not in the repository's generated/, which holds
+    each model file's default build (generated/n_link_pendulum_16.py was left there untracked
+    after every run)."""
+    from .. import portable
+    return portable.portable_dir().parent / "bench"
+
+
 def measure_chain(models_dir, gen_dir, quick):
     """ns per step on the 16-link chain: {"ours": {method: ns}, "mujoco": {integrator: {c_loop,
     python_loop}} or None, "equivalence": max abs state difference of the two rk4 runs}."""
@@ -198,7 +207,7 @@ def run_speed_bench(models_dir="models", gen_dir="generated", reports_dir="repor
                         if r["method"] in HAND_CLOSED_FORM]
     for row in results["steps"]:
         row["portable_ns"] = portable_step_ns(mod, row["method"], steps, repeats)
-    results["chain"] = measure_chain(models_dir, gen_dir, quick)
+    results["chain"] = measure_chain(models_dir, chain_dir(), quick)
     lines = markdown(results)
     path = common.write_report(Path(reports_dir) / "speed.md", lines)
     return {"results": results, "report": path}
