@@ -141,7 +141,7 @@ def controlled_run(module, method, apply):
     ``apply`` (compiled on first use in this process, then kept)."""
     import importlib
     from .steppers import registry
-    from .steppers.base import run_loop
+    from .steppers.base import run_loop, stepping_loop
     key = (module.__name__, module.KEY, method, apply)
     if key not in _RUNS:
         stepper = importlib.import_module(f"lagrange_gen.steppers.{method}")
@@ -151,11 +151,12 @@ def controlled_run(module, method, apply):
         if spec.adaptive:
             raise SimulationError(f"inputs from a controller or a signal need a fixed-step method; "
                                   f"{method} chooses its own steps")
+        loop = stepping_loop(stepper, kern, n_events)
 
         @njit(error_model="numpy")
         def run(q0, v0, t0, h, n_steps, save_every, p, settings, out_t, out_q, out_v,
                 out_stats, out_extra, out_last, out_events, data):
-            return run_loop(stepper, kern, n_saved, n_events, q0, v0, t0, h, n_steps,
+            return run_loop(stepper, loop, kern, n_saved, n_events, q0, v0, t0, h, n_steps,
                             save_every, p, settings, out_t, out_q, out_v, out_stats, out_extra,
                             out_last, out_events, apply, data)
         _RUNS[key] = run

@@ -18,6 +18,10 @@ from pathlib import Path
 _PACKAGE = Path(__file__).resolve().parent.parent     # src/lagrange_gen
 _KERN = "kern"                                         # the parameter naming the generated module
 
+#: What a loop function reaches besides its own calls: base.run_loop calls the stepping loop it
+#: is passed (base.stepping_loop, a closure the glue binds), whose body is base.steps.
+_PASSED_IN = {("steppers.base", "run_loop"): [("steppers.base", "steps")]}
+
 
 def method_needs(method: str, with_loop: bool = True) -> frozenset:
     """Names ``kern.<name>`` used by ``steppers/<method>.py`` and everything it calls, and
@@ -29,6 +33,7 @@ def method_needs(method: str, with_loop: bool = True) -> frozenset:
     if with_loop:
         loop_module, loop = LOOPS[spec(method).adaptive]
         roots.append((f"steppers.{loop_module}", loop))
+        roots += _PASSED_IN.get(roots[-1], [])
     return _reached(roots)
 
 

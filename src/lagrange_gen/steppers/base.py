@@ -22,17 +22,19 @@ The rules every method module (``steppers/<method>.py``) follows:
   ``step`` advances (q, v, mom) from t to t + h in place. On failure ``step`` leaves q, v and
   mom at the start of the step, so the driver reports the state it could not step from.
 * No ``run`` function: the generated glue ``run_<method>`` calls ``run_loop`` with the method's
-  module (see registry.py for why the glue exists); adaptive methods have their own loop
-  (adaptive.py) and their own set of functions (see there).
+  module and the stepping loop it binds for it (``stepping_loop``; see registry.py for why the
+  glue exists); adaptive methods have their own loop (adaptive.py) and their own set of
+  functions (see there). ``step`` is declared ``@njit(inline=inline_step, **FAST)``.
 * No allocation per step: the workspace is allocated once per run and passed to ``step``.
 * Failures are status codes (lagrange_gen.status), never garbage and never exceptions.
 
 How the kernels reach the cores: ``kern`` is the generated module itself. numba types a module
 as a compile-time constant with no runtime representation, so ``kern.dynamics(...)`` is a direct
-call and ``kern.MASS_IS_CONSTANT`` a constant; likewise ``run_loop`` receives the method's module
-and calls ``method.step``. Passing the dispatchers themselves as values would make numba embed
-process-specific addresses ("dynamic globals") and refuse to cache the glue. None of the
-functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
+call and ``kern.MASS_IS_CONSTANT`` a constant; likewise the stepping loop holds the method's
+module as a closure constant and calls ``method.step``. Passing the dispatchers themselves as
+values would make numba embed process-specific addresses ("dynamic globals") and refuse to cache
+the glue; the stepping loop run_loop is given is a global of the glue once run_loop is inlined.
+None of the functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
 generated module's glue. ``run_loop`` is ``inline="always"`` (inlined at numba-IR level into
 the glue): every separately compiled layer re-optimizes everything below it, about 0.5 s of
 compile time per layer, per method and per model.
@@ -43,18 +45,17 @@ numba increments and decrements an atomic counter for every array argument of ev
 every array view that its pruning pass cannot prove redundant, which is most of them in
 functions with loops and early returns: on the cart pendulum that was half of the run time of
 the Newton methods (perf: NRT_incref/NRT_decref), and a 2 x 2 LU solve through calls cost 85 ns
-against 29 ns without. Only ``run_loop`` allocates (once per run) and keeps reference counting.
+against 29 ns without. Only ``run_loop`` allocates (once per run) and keeps reference counting;
+the steps run in the stepping loop it calls (stepping_loop), which does not.
 
 Shapes: n coordinates; q, v, mom (n,); p (n_params,); extra (n_saved,) the method's saved
 fields (empty for the unconstrained methods).
 """
 
 import math
-import types
 
 import numpy as np
 from numba import njit
-from numba.core import ir
 
 from .. import linalg
 from ..status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
@@ -72,17 +73,14 @@ STAT_RESIDUAL = 2   # largest Newton residual (max norm, last iterate of a step)
 STAT_WORK = 3       # W, the work of non-conservative forces and explicit time since t0 (work.py)
 N_STATS = 4
 
-def inline_where_kernels_are_a_module(expr, caller_ir, callee_ir):
-    """numba inline cost model (``@njit(inline=...)``) for a method's ``step``: inline it into
-    the run loop of a generated module's own glue, where ``kern`` (the call's first argument)
-    is the module, a global; not into the portable glue (portable.py), where ``kern`` is an
-    argument holding function pointers: inlined there, explicit Euler's step went from 52 to
-    114 ns on the cart pendulum (and from 28 to 18 ns in the module's glue)."""
-    try:
-        kern = caller_ir.get_definition(expr.args[0])
-    except Exception:          # no single definition: not a module global
-        return False
-    return isinstance(kern, ir.Global) and isinstance(kern.value, types.ModuleType)
+def inline_step(expr, caller_ir, callee_ir):
+    """numba inline cost model (``@njit(inline=inline_step)``) of every fixed-step method's
+    ``step``: inlined into the stepping loop of a generated module's glue (stepping_loop) and
+    into any other caller (the step API's loop); called from the portable glue's loops. Those
+    are compiled on every first use of a method, and inlined there the step cost more compile
+    time than it saved: cart pendulum, verlet, everything cold 18 -> 22 s for 349 against 435
+    ns per portable step, rk4 5.7 -> 8.3 s for 204 against 228 ns."""
+    return not caller_ir.func_id.func_qualname.startswith("stepping_loop.<locals>.loop_for_table")
 
 
 @njit(**FAST)
@@ -285,7 +283,7 @@ def _classify(q, v):
     return UNSTABLE
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, extra, out_extra):
     out_t[row] = t
     for i in range(q.shape[0]):
@@ -298,7 +296,7 @@ def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, ex
         out_extra[row, k] = extra[k]
 
 
-@njit(cache=True)
+@njit(cache=True, **FAST)
 def _last(out_last, t, q, v, iters, resid, extra):
     n = q.shape[0]
     out_last[0] = t
@@ -317,15 +315,16 @@ from . import events, hermite, work  # noqa: E402
 
 
 @njit(inline="always")
-def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_every, p,
+def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_every, p,
              settings, out_t, out_q, out_v, out_stats, out_extra, out_last, out_events,
              control=None, control_data=None):
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
 
-    ``method`` is a stepper module (its workspace, prepare and step are called), ``kern`` the
-    generated module, ``settings`` the method's settings record (spec.py), n_saved the width
-    of the method's saved fields on this model and n_event_fns its number of event functions
-    (N_EVENTS; the glue passes both as literals).
+    ``method`` is a stepper module (its workspace and prepare are called), ``loop`` its
+    stepping loop for these kernels (stepping_loop: it runs the steps, calling method.step),
+    ``kern`` the generated module, ``settings`` the method's settings record (spec.py),
+    n_saved the width of the method's saved fields on this model and n_event_fns its number
+    of event functions (N_EVENTS; the glue passes both as literals).
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
@@ -391,13 +390,80 @@ def run_loop(method, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, save_ev
         return status, -1, 0
     _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
     out_stats[0, STAT_WORK] = W
+    # The workspaces of work and events always exist (0-size arrays on a model without them):
+    # the stepping loop takes them as arguments.
+    ww = work.workspace(kern, n)
+    P0, D0 = 0.0, 0.0
     if kern.WORK:
-        ww = work.workspace(kern, n)
         P0, D0 = work.rate(kern, ww, q, v, t0, p)
-    if n_event_fns > 0:       # (ew, iw exist only on a model with events)
-        ew = events.workspace(kern, n)
-        iw = hermite.workspace(n)
+    ew = events.workspace(kern, n)
+    iw = hermite.workspace(n)
+    if n_event_fns > 0:
         events.start(kern, ew, q, v, t0, p)
+    # (grouped: a call of 30 or more arguments compiles to CALL_FUNCTION_EX, which numba
+    # cannot inline)
+    outs = (out_t, out_q, out_v, out_stats, out_extra, out_last, out_events)
+    aux = (ww, ew, iw, W, P0, D0, bound)
+    return loop(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps, save_every, p,
+                settings, outs, aux, control, control_data)
+
+
+def stepping_loop(method, kern=None, n_event_fns=None):
+    """The stepping loop run_loop calls (its ``loop``) for the method module ``method``: run_loop's
+    steps after its set-up (steps), compiled without reference counting. ``kern``: the
+    generated module the loop is for (the generated glue binds ``_loop_<method> =
+    stepping_loop(<method module>, <this module>, N_EVENTS)``), or None for a loop that takes
+    its kernels as an argument (the portable glue's kernel table); n_event_fns: the model's
+    number of event functions, or None for a loop that takes it as an argument (the portable
+    glue of models with events). Each given value is a closure constant of the loop, so that
+    numba prunes the event branches of a model without events before it types them (numba
+    prunes a branch on a constant, not on a literal argument).
+
+    Why a function of its own: in run_loop, which allocates and so counts references, a step
+    inlined paid for the count of every array it touched (rk4 170 against 100 ns per step on
+    the cart pendulum), and a step called paid for the call. In this loop, which counts
+    nothing, the step of a generated module's loop is inlined (inline_step): cart pendulum,
+    best of 7 runs of 1e5 steps, one process, specialized glue before -> after: rk4 102 -> 81
+    ns, symplectic_euler 183 -> 143, verlet 276 -> 247, explicit_euler 18 -> 18. The portable
+    loops call the step (see inline_step)."""
+    fixed_events = n_event_fns
+    if kern is not None:
+        if fixed_events is None:
+            raise ValueError("stepping_loop: a loop for a generated module needs its N_EVENTS")
+        module = kern
+
+        @njit(**FAST)
+        def loop_for_module(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
+                            save_every, p, settings, outs, aux, control, control_data):
+            return steps(method, module, n_saved, fixed_events, q, v, mom, ws, extra, t0, h,
+                         n_steps, save_every, p, settings, outs, aux, control, control_data)
+        return loop_for_module
+    if fixed_events is not None:
+        @njit(**FAST)
+        def loop_for_table(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
+                           save_every, p, settings, outs, aux, control, control_data):
+            return steps(method, kern, n_saved, fixed_events, q, v, mom, ws, extra, t0, h,
+                         n_steps, save_every, p, settings, outs, aux, control, control_data)
+        return loop_for_table
+
+    @njit(**FAST)
+    def loop_for_table_with_events(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h,
+                                   n_steps, save_every, p, settings, outs, aux, control,
+                                   control_data):
+        return steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
+                     save_every, p, settings, outs, aux, control, control_data)
+    return loop_for_table_with_events
+
+
+@njit(inline="always")
+def steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps, save_every,
+          p, settings, outs, aux, control, control_data):
+    """run_loop's n_steps steps from the state it set up (q, v, mom, ws, extra); outs = its
+    output arrays, aux = (work and events workspaces, W, P0, D0, blowup bound). Returns
+    run_loop's (status, steps_done, n_events)."""
+    out_t, out_q, out_v, out_stats, out_extra, out_last, out_events = outs
+    ww, ew, iw, W, P0, D0, bound = aux
+    n = q.shape[0]
     n_events = 0
     iters_acc = 0.0
     resid_max = 0.0

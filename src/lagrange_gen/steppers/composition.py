@@ -31,7 +31,7 @@ from numba import njit
 
 from ..status import OK
 from . import verlet
-from .base import FAST, copy_into, explicit_path
+from .base import FAST, copy_into, explicit_path, inline_step
 from .partitioned import GUESS_DEGREE
 from .spec import PartitionedSettings, Spec
 
@@ -146,7 +146,7 @@ G1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
 COEFFS = palindrome(G1, 1.0 - 2.0 * G1)
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     return composed_step(kern, q, v, mom, t, h, p, settings, ws, COEFFS)

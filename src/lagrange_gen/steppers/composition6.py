@@ -28,7 +28,7 @@ from functools import partial
 
 from numba import njit
 
-from .base import FAST
+from .base import FAST, inline_step
 from .composition import (Workspace, allocate, composed_step, linear_radius,  # noqa: F401
                           palindrome, prepare)
 from .spec import PartitionedSettings, Spec
@@ -45,7 +45,7 @@ def workspace(kern, n):
     return allocate(kern, n, len(COEFFS))
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     return composed_step(kern, q, v, mom, t, h, p, settings, ws, COEFFS)

@@ -35,7 +35,7 @@ from numba import njit
 
 from ..status import OK
 from . import newton
-from .base import FAST
+from .base import FAST, inline_step
 from .constrained import SAVED, constraint_rate, record, velocity_projection
 from .spec import NewtonSettings, Spec
 
@@ -98,7 +98,7 @@ def assemble(kern, args, x, F, K):
             K[n + k, n + j] = 0.0
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS

@@ -35,7 +35,7 @@ from numba import njit
 
 from ..status import OK
 from . import newton
-from .base import FAST, momentum_from_velocity
+from .base import FAST, momentum_from_velocity, inline_step
 from .constrained import SAVED, finish_momentum_step
 from .spec import NewtonSettings, Spec
 
@@ -104,7 +104,7 @@ def assemble(kern, args, x, F, K):
         kern.transport(qb, tm, p, F[:n])
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS

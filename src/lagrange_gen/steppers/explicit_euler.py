@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from ..status import OK
-from .base import FAST, accel, inline_where_kernels_are_a_module
+from .base import FAST, accel, inline_step
 from .spec import ExplicitSettings, Spec
 
 #: Scratch of one run: the acceleration a (n,) and the mass matrix H (n, n) it is solved with.
@@ -36,13 +36,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     return OK
 
 
-# Inlined (numba IR) into the run loop of the module's own glue: a call passes the arrays of q,
-# v, mom, p, the workspace and extra as about 50 scalar arguments, which was a third of this
-# method's step time on the cart pendulum (24 -> 16 ns per step, best of 15 runs of 2e5 steps).
-# Not into the portable glue (see the cost model), and not done for methods with more work per
-# step: inlined into the reference-counted run loop, rk4's step went from 90 to 170 ns (every
-# array view of the inlined body is counted there).
-@njit(inline=inline_where_kernels_are_a_module, **FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     a = ws.a

@@ -22,7 +22,7 @@ from numba import njit
 
 from ..status import OK
 from . import newton
-from .base import FAST
+from .base import FAST, inline_step
 from .spec import NewtonSettings, Spec
 
 #: Scratch of one run: the Newton unknown v1 = v+, q1 = q+, dv = v+ - v, rhs, residual R, solver
@@ -63,7 +63,7 @@ def assemble(kern, args, v1, R, A):
         R[i] = s
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]

@@ -32,7 +32,7 @@ from numba import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
-from .base import FAST
+from .base import FAST, inline_step
 from .constrained import SAVED, constraint_rate, record, solve_rows
 from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 from .spec import Spec
@@ -109,7 +109,7 @@ def stage_acceleration(kern, ctx, q, v, t, a):
                   ws.S)
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One rk4 step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     n, m = q.shape[0], kern.N_CONSTRAINTS

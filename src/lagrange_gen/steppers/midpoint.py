@@ -31,7 +31,7 @@ from numba import njit
 
 from ..status import OK
 from . import newton
-from .base import FAST, momentum_from_velocity, velocity_from_momentum
+from .base import FAST, momentum_from_velocity, velocity_from_momentum, inline_step
 from .spec import NewtonSettings, Spec
 
 #: Scratch of one run: the Newton unknown vb and midpoint qb, residual R, momentum rate f,
@@ -78,7 +78,7 @@ def assemble(kern, args, vb, R, A):
         kern.transport(qb, tm, p, R)
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]

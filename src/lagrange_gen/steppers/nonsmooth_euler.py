@@ -47,7 +47,7 @@ from ..linalg import lu_inplace, lu_solve_inplace
 from ..nonsmooth.play import return_map
 from ..status import OK, SINGULAR_NEWTON
 from . import newton
-from .base import FAST, failed_solve_status, max_abs
+from .base import FAST, failed_solve_status, max_abs, inline_step
 from .spec import NewtonSettings, Spec
 
 _PGS_SWEEPS = 200
@@ -206,7 +206,7 @@ def assemble(kern, args, v1, F, A):
     _friction(h, tol, v1, F, A, piv, X, scratch, state, G, coef, Y, W)
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, element states extra (ne,)) at t, in place. Returns (status,
     iterations, residual)."""

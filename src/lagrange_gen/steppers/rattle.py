@@ -45,7 +45,7 @@ from numba import njit
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS
 from . import newton
-from .base import FAST, explicit_path, momentum_from_velocity, subtract_transport
+from .base import FAST, explicit_path, momentum_from_velocity, subtract_transport, inline_step
 from .constrained import SAVED, constraint_rate, finish_momentum_step, project, record, solve_rows
 from .spec import PartitionedSettings, Spec
 
@@ -240,7 +240,7 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
     return status, iters, resid
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
@@ -251,6 +251,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
 # The two Newton systems as modules for newton.solve (see newton.py: modules, not dispatchers).
 _MULTIPLIER = newton.problem(__name__ + "._multiplier", assemble_multiplier)
 _POSITION = newton.problem(__name__ + "._position", assemble_position)
+
 
 SPEC = Spec(
     name="rattle", order=2, family="constrained", implicit=True, symplectic=True,

@@ -108,9 +108,9 @@ GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
 _GLUE = '''import sys as _sys
 
 from lagrange_gen.steppers import {method} as _stepper_{method}
-from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}
+from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}{loop_import}
 
-_THIS_MODULE = _sys.modules[__name__]
+_THIS_MODULE = _sys.modules[__name__]{loop_def}
 
 
 @njit(cache=True, error_model="numpy")
@@ -118,7 +118,7 @@ def run_{method}({wrapped}):
     """Integrate with {method} ({summary}); returns (status, steps_done, n_events).
 
     Argument shapes: see lagrange_gen.steppers.registry; lagrange_gen.simulate wraps this."""
-    return _{loop}(_stepper_{method}, _THIS_MODULE, {n_saved}, {n_events}, {wrapped_call})'''
+    return _{loop}(_stepper_{method}, {loop_arg}_THIS_MODULE, {n_saved}, {n_events}, {wrapped_call})'''
 
 # The portable glue (lagrange_gen.portable): the same loop and method module, with the kernels
 # and constants of any model passed in as ``kern``, a named tuple of first-class functions whose
@@ -130,7 +130,7 @@ import numpy as np
 from numba import njit
 
 from lagrange_gen.steppers import {method} as _stepper_{method}
-from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}
+from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}{loop_import}{loop_def}
 
 
 @njit(cache=True, error_model="numpy")
@@ -138,13 +138,13 @@ def run_{method}(kern, n_saved, {wrapped}):
     """run_{method} of a generated module, on the kernel table ``kern`` (portable.kernel_table)
     of any model without events; n_saved: the method's saved fields on that model
     (SPEC.n_saved). The literal 0 prunes the event code before numba types it."""
-    return _{loop}(_stepper_{method}, kern, n_saved, 0, {wrapped_call})
+    return _{loop}(_stepper_{method}, {loop_arg}kern, n_saved, 0, {wrapped_call})
 
 
 @njit(cache=True, error_model="numpy")
 def run_{method}_events(kern, n_saved, {wrapped}):
     """run_{method} on the kernel table of a model with events (kern.N_EVENTS > 0)."""
-    return _{loop}(_stepper_{method}, kern, n_saved, kern.N_EVENTS, {wrapped_call})
+    return _{loop}(_stepper_{method}, {events_loop_arg}kern, n_saved, kern.N_EVENTS, {wrapped_call})
 '''
 
 
@@ -174,7 +174,7 @@ def _member_{method}({member_args}):
     out_t = np.empty(saves)
     events = np.empty((0, 3 + 2 * n))
     status, steps, n_events = _run_loop(
-        _stepper_{method}, {kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
+        _stepper_{method}, _loop_{method}, {kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
         save_every, p, settings, out_t, q[:saves], v[:saves], stats[:saves], extra[:saves],
         last, events)
     if status == 0 and (steps % save_every != 0 or steps < n_steps):
@@ -230,7 +230,30 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
     wrapped_call = _wrap(args, f"    return _{loop}(")
     return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
                         summary=spec(method).summary, loop_module=loop_module, loop=loop,
-                        n_saved=n_saved, n_events=n_events)
+                        n_saved=n_saved, n_events=n_events,
+                        **_stepping_loop_text(method, "_THIS_MODULE", n_events))
+
+
+def _stepping_loop_text(method, kern, n_events):
+    """The parts of a glue block that bind a fixed-step method's stepping loop
+    (base.stepping_loop) to the kernels ``kern`` ("_THIS_MODULE", or None: the portable glue's
+    kernel table, an argument) and n_events event functions (None in the portable glue: the
+    table's) and pass it to run_loop; empty for an adaptive method (its loop is
+    adaptive.run_adaptive). The portable glue binds two: _loop_<method> for models without
+    events, _loop_<method>_events for the others."""
+    if spec(method).adaptive:
+        return dict(loop_import="", loop_def="", loop_arg="", events_loop_arg="")
+    imports = "\nfrom lagrange_gen.steppers.base import stepping_loop as _stepping_loop"
+    if kern:
+        comment = f"\n\n# run_loop's steps, {method}'s step inlined (base.stepping_loop)"
+        return dict(loop_import=imports, loop_arg=f"_loop_{method}, ",
+                    loop_def=(f"{comment}\n_loop_{method} = _stepping_loop(_stepper_{method}, "
+                              f"{kern}, {n_events})"))
+    comment = "\n\n# run_loop's steps, without and with events (base.stepping_loop)"
+    return dict(loop_import=imports, loop_arg=f"_loop_{method}, ",
+                events_loop_arg=f"_loop_{method}_events, ",
+                loop_def=(f"{comment}\n_loop_{method} = _stepping_loop(_stepper_{method}, None, 0)"
+                          f"\n_loop_{method}_events = _stepping_loop(_stepper_{method})"))
 
 
 def portable_glue_source(method: str, digest: str) -> str:
@@ -243,7 +266,8 @@ def portable_glue_source(method: str, digest: str) -> str:
     wrapped = _wrap(args, f"def run_{method}_events(")
     wrapped_call = _wrap(args, f"    return _{loop}(")
     source = _PORTABLE_GLUE.format(method=method, digest=digest, loop_module=loop_module,
-                                   loop=loop, wrapped=wrapped, wrapped_call=wrapped_call)
+                                   loop=loop, wrapped=wrapped, wrapped_call=wrapped_call,
+                                   **_stepping_loop_text(method, None, None))
     if spec(method).adaptive:
         return source
     # ensemble_<method>(kern, n_saved, ...) for models without events (the literal 0)

@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from ..status import OK
-from .base import FAST, accel
+from .base import FAST, accel, inline_step
 from .explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 from .spec import ExplicitSettings, Spec
 
@@ -50,7 +50,7 @@ def stage_acceleration(kern, ctx, q, v, t, a):
     return accel(kern, q, v, t, p, H, a)
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0)."""
     status = rk_step(_THIS, kern, (p, ws.H), RK4_A, RK4_B, RK4_C, q, v, t, h,

@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from ..status import OK
-from .base import FAST, newton_solve
+from .base import FAST, newton_solve, inline_step
 from .constrained import SAVED, constraint_rate, record
 from .spec import Spec
 
@@ -71,7 +71,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     return OK
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, 0, 0.0): no Newton iterations."""
     n, m = q.shape[0], kern.N_CONSTRAINTS

@@ -21,7 +21,7 @@ from numba import njit
 
 from ..status import OK
 from . import verlet
-from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity
+from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity, inline_step
 from .partitioned import GUESS_DEGREE, begin_step, best_degree, end_step, solve_kick
 from .spec import PartitionedSettings, Spec
 
@@ -51,7 +51,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     return OK
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     n = q.shape[0]

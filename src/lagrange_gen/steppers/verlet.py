@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from ..status import OK
-from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity
+from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity, inline_step
 from .partitioned import (GUESS_DEGREE, begin_step, best_degree, end_step, extrapolate, push,
                           solve_drift, solve_kick)
 from .spec import PartitionedSettings, Spec
@@ -133,7 +133,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     return OK, iters, resid
 
 
-@njit(**FAST)
+@njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
