@@ -75,12 +75,16 @@ N_STATS = 4
 
 def inline_step(expr, caller_ir, callee_ir):
     """numba inline cost model (``@njit(inline=inline_step)``) of every fixed-step method's
-    ``step``: inlined into the stepping loop of a generated module's glue (stepping_loop) and
-    into any other caller (the step API's loop); called from the portable glue's loops. Those
-    are compiled on every first use of a method, and inlined there the step cost more compile
-    time than it saved: cart pendulum, verlet, everything cold 18 -> 22 s for 349 against 435
-    ns per portable step, rk4 5.7 -> 8.3 s for 204 against 228 ns."""
-    return not caller_ir.func_id.func_qualname.startswith("stepping_loop.<locals>.loop_for_table")
+    ``step``: inlined into the loops compiled without reference counting (the stepping loop of
+    a generated module's glue, stepping_loop, and the step API's), called from everywhere else.
+    Inlined into a reference-counted loop (the portable glue's run_loop), rk4's step went from
+    100 to 170 ns on the cart pendulum (every array the step touches is counted there)."""
+    caller = caller_ir.func_id.func_qualname
+    return caller.endswith(_FAST_LOOPS)
+
+
+#: The loops inline_step inlines a step into (qualified names' endings).
+_FAST_LOOPS = ("stepping_loop.<locals>.loop", "_core_class.<locals>._advance")
 
 
 @njit(**FAST)
@@ -321,10 +325,13 @@ def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, s
     """Integrate n_steps steps of size h from (q0, v0) at t0 without returning to Python.
 
     ``method`` is a stepper module (its workspace and prepare are called), ``loop`` its
-    stepping loop for these kernels (stepping_loop: it runs the steps, calling method.step),
+    stepping loop on the generated module ``kern`` (stepping_loop: it runs the steps, the step
+    inlined), or None to run them here (the portable glue: the step is called),
     ``kern`` the generated module, ``settings`` the method's settings record (spec.py),
     n_saved the width of the method's saved fields on this model and n_event_fns its number
-    of event functions (N_EVENTS; the glue passes both as literals).
+    of event functions (N_EVENTS, or 1 for any number of them: only n_event_fns > 0 is read;
+    the glue passes both as literals, which lets numba prune the event code of a model
+    without events).
     Saves row 0 (initial state) and row k after step k * save_every, so the outputs need
     S = n_steps // save_every + 1 rows: out_t (S,), out_q (S, n), out_v (S, n), out_stats
     (S, N_STATS), out_extra (S, n_saved) (the method's saved fields, SPEC.saved), whose row 0
@@ -390,69 +397,55 @@ def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, s
         return status, -1, 0
     _save(0, t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra, out_extra)
     out_stats[0, STAT_WORK] = W
-    # The workspaces of work and events always exist (0-size arrays on a model without them):
-    # the stepping loop takes them as arguments.
+    # The work workspace always exists (0-size arrays on a model without work): numba types the
+    # branches on kern.WORK in any case, and the stepping loop takes it as an argument.
     ww = work.workspace(kern, n)
     P0, D0 = 0.0, 0.0
     if kern.WORK:
         P0, D0 = work.rate(kern, ww, q, v, t0, p)
-    ew = events.workspace(kern, n)
-    iw = hermite.workspace(n)
     if n_event_fns > 0:
+        ew = events.workspace(kern, n)
+        iw = hermite.workspace(n)
         events.start(kern, ew, q, v, t0, p)
+    else:           # (n_event_fns is a literal: numba prunes one branch and every use of these)
+        ew = iw = None
     # (grouped: a call of 30 or more arguments compiles to CALL_FUNCTION_EX, which numba
     # cannot inline)
     outs = (out_t, out_q, out_v, out_stats, out_extra, out_last, out_events)
     aux = (ww, ew, iw, W, P0, D0, bound)
+    if loop is None:        # the portable glue: the steps here, the step called
+        return steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
+                     save_every, p, settings, outs, aux, control, control_data)
     return loop(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps, save_every, p,
                 settings, outs, aux, control, control_data)
 
 
-def stepping_loop(method, kern=None, n_event_fns=None):
-    """The stepping loop run_loop calls (its ``loop``) for the method module ``method``: run_loop's
-    steps after its set-up (steps), compiled without reference counting. ``kern``: the
-    generated module the loop is for (the generated glue binds ``_loop_<method> =
-    stepping_loop(<method module>, <this module>, N_EVENTS)``), or None for a loop that takes
-    its kernels as an argument (the portable glue's kernel table); n_event_fns: the model's
-    number of event functions, or None for a loop that takes it as an argument (the portable
-    glue of models with events). Each given value is a closure constant of the loop, so that
-    numba prunes the event branches of a model without events before it types them (numba
-    prunes a branch on a constant, not on a literal argument).
+def stepping_loop(method, kern, n_event_fns):
+    """The stepping loop run_loop calls (its ``loop``) for the method module ``method`` on the
+    generated module ``kern`` with n_event_fns event functions (the generated glue binds
+    ``_loop_<method> = stepping_loop(<method module>, <this module>, N_EVENTS)``): run_loop's
+    steps after its set-up (steps), with the method's step inlined (inline_step), compiled
+    without reference counting. All three are closure constants of the loop, so that numba
+    inlines the step and prunes the event branches of a model without events before it types
+    them (numba prunes a branch on a constant, not on a literal argument).
 
     Why a function of its own: in run_loop, which allocates and so counts references, a step
     inlined paid for the count of every array it touched (rk4 170 against 100 ns per step on
-    the cart pendulum), and a step called paid for the call. In this loop, which counts
-    nothing, the step of a generated module's loop is inlined (inline_step): cart pendulum,
-    best of 7 runs of 1e5 steps, one process, specialized glue before -> after: rk4 102 -> 81
-    ns, symplectic_euler 183 -> 143, verlet 276 -> 247, explicit_euler 18 -> 18. The portable
-    loops call the step (see inline_step)."""
-    fixed_events = n_event_fns
-    if kern is not None:
-        if fixed_events is None:
-            raise ValueError("stepping_loop: a loop for a generated module needs its N_EVENTS")
-        module = kern
-
-        @njit(**FAST)
-        def loop_for_module(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
-                            save_every, p, settings, outs, aux, control, control_data):
-            return steps(method, module, n_saved, fixed_events, q, v, mom, ws, extra, t0, h,
-                         n_steps, save_every, p, settings, outs, aux, control, control_data)
-        return loop_for_module
-    if fixed_events is not None:
-        @njit(**FAST)
-        def loop_for_table(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
-                           save_every, p, settings, outs, aux, control, control_data):
-            return steps(method, kern, n_saved, fixed_events, q, v, mom, ws, extra, t0, h,
-                         n_steps, save_every, p, settings, outs, aux, control, control_data)
-        return loop_for_table
+    the cart pendulum), and a step called paid for the call. Cart pendulum, best of 7 runs of
+    1e5 steps, one process, the module's glue before -> after: rk4 102 -> 81 ns,
+    symplectic_euler 183 -> 143, verlet 276 -> 247, explicit_euler 18 -> 18; its compile,
+    everything cold, about 1 s longer (an extra layer: rk4 3.6 -> 4.8 s, verlet 11.4 -> 12.2
+    s). The portable glue (loop None in run_loop) keeps the steps inlined in run_loop and calls
+    the step: as a loop of its own there, the first use of a method after an install compiled
+    2 s longer (rk4 5.7 -> 7.8 s, verlet 18.1 -> 20.1 s, fresh numba cache)."""
+    fixed_kern, fixed_events = kern, n_event_fns
 
     @njit(**FAST)
-    def loop_for_table_with_events(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h,
-                                   n_steps, save_every, p, settings, outs, aux, control,
-                                   control_data):
-        return steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps,
-                     save_every, p, settings, outs, aux, control, control_data)
-    return loop_for_table_with_events
+    def loop(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps, save_every, p,
+             settings, outs, aux, control, control_data):
+        return steps(method, fixed_kern, n_saved, fixed_events, q, v, mom, ws, extra, t0, h,
+                     n_steps, save_every, p, settings, outs, aux, control, control_data)
+    return loop
 
 
 @njit(inline="always")

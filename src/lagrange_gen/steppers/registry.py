@@ -144,7 +144,7 @@ def run_{method}(kern, n_saved, {wrapped}):
 @njit(cache=True, error_model="numpy")
 def run_{method}_events(kern, n_saved, {wrapped}):
     """run_{method} on the kernel table of a model with events (kern.N_EVENTS > 0)."""
-    return _{loop}(_stepper_{method}, {events_loop_arg}kern, n_saved, kern.N_EVENTS, {wrapped_call})
+    return _{loop}(_stepper_{method}, {loop_arg}kern, n_saved, {events}, {wrapped_call})
 '''
 
 
@@ -174,7 +174,7 @@ def _member_{method}({member_args}):
     out_t = np.empty(saves)
     events = np.empty((0, 3 + 2 * n))
     status, steps, n_events = _run_loop(
-        _stepper_{method}, _loop_{method}, {kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
+        _stepper_{method}, {loop}{kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
         save_every, p, settings, out_t, q[:saves], v[:saves], stats[:saves], extra[:saves],
         last, events)
     if status == 0 and (steps % save_every != 0 or steps < n_steps):
@@ -236,24 +236,21 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
 
 def _stepping_loop_text(method, kern, n_events):
     """The parts of a glue block that bind a fixed-step method's stepping loop
-    (base.stepping_loop) to the kernels ``kern`` ("_THIS_MODULE", or None: the portable glue's
-    kernel table, an argument) and n_events event functions (None in the portable glue: the
-    table's) and pass it to run_loop; empty for an adaptive method (its loop is
-    adaptive.run_adaptive). The portable glue binds two: _loop_<method> for models without
-    events, _loop_<method>_events for the others."""
+    (base.stepping_loop) to the generated module (kern "_THIS_MODULE") and its n_events event
+    functions and pass it to run_loop; the portable glue (kern None) passes None (run_loop
+    runs the steps itself), an adaptive method nothing (its loop is adaptive.run_adaptive)."""
     if spec(method).adaptive:
-        return dict(loop_import="", loop_def="", loop_arg="", events_loop_arg="")
-    imports = "\nfrom lagrange_gen.steppers.base import stepping_loop as _stepping_loop"
-    if kern:
-        comment = f"\n\n# run_loop's steps, {method}'s step inlined (base.stepping_loop)"
-        return dict(loop_import=imports, loop_arg=f"_loop_{method}, ",
-                    loop_def=(f"{comment}\n_loop_{method} = _stepping_loop(_stepper_{method}, "
-                              f"{kern}, {n_events})"))
-    comment = "\n\n# run_loop's steps, without and with events (base.stepping_loop)"
-    return dict(loop_import=imports, loop_arg=f"_loop_{method}, ",
-                events_loop_arg=f"_loop_{method}_events, ",
-                loop_def=(f"{comment}\n_loop_{method} = _stepping_loop(_stepper_{method}, None, 0)"
-                          f"\n_loop_{method}_events = _stepping_loop(_stepper_{method})"))
+        return dict(loop_import="", loop_def="", loop_arg="", events="kern.N_EVENTS")
+    if not kern:
+        # run_loop reads only n_event_fns > 0; a literal 1 (not kern.N_EVENTS, a run-time
+        # value here) lets numba prune in run_<method>_events too the branch without event
+        # workspaces (ew, iw None), which it could not type
+        return dict(loop_import="", loop_def="", loop_arg="None, ", events="1")
+    return dict(
+        loop_import="\nfrom lagrange_gen.steppers.base import stepping_loop as _stepping_loop",
+        loop_arg=f"_loop_{method}, ",
+        loop_def=(f"\n\n# run_loop's steps, {method}'s step inlined (base.stepping_loop)"
+                  f"\n_loop_{method} = _stepping_loop(_stepper_{method}, {kern}, {n_events})"))
 
 
 def portable_glue_source(method: str, digest: str) -> str:
@@ -287,9 +284,10 @@ def _ensemble_source(method, n_saved, n_events, kern, table):
     portable glue (kern "kern", table "kern, n_saved, ": the kernel table passed in)."""
     wrapped = _wrap(ENSEMBLE_GLUE_ARGS, f"def ensemble_{method}(")
     member_args = table + _wrap(_MEMBER_ARGS, f"def _member_{method}(") if table else _MEMBER_ARGS
+    loop = "None, " if table else f"_loop_{method}, "      # (portable: run_loop runs the steps)
     return _ENSEMBLE_GLUE.format(method=method, wrapped=wrapped, n_saved=n_saved,
                                  n_events=n_events, kern=kern, table=table,
-                                 member_args=member_args)
+                                 member_args=member_args, loop=loop)
 
 
 _MEMBER_ARGS = "q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last"
