@@ -34,10 +34,11 @@ call and ``kern.MASS_IS_CONSTANT`` a constant; likewise the stepping loop holds 
 module as a closure constant and calls ``method.step``. Passing the dispatchers themselves as
 values would make numba embed process-specific addresses ("dynamic globals") and refuse to cache
 the glue; the stepping loop run_loop is given is a global of the glue once run_loop is inlined.
-None of the functions taking ``kern`` is ``cache=True``: they are compiled into, and cached with, each
-generated module's glue. ``run_loop`` is ``inline="always"`` (inlined at numba-IR level into
-the glue): every separately compiled layer re-optimizes everything below it, about 0.5 s of
-compile time per layer, per method and per model.
+None of the functions taking ``kern`` is ``cache=True``: they are compiled into, and cached
+with, each generated module's glue. ``run_loop`` is ``inline="always"`` (inlined at numba-IR
+level into the glue): every separately compiled layer re-optimizes everything below it, about
+0.5 s of compile time per layer, per method and per model (the stepping loop is one such layer,
+paid for its speed: see stepping_loop).
 
 Speed: everything called once or more per step is compiled with ``_nrt=False`` (numba's switch
 for "no reference counting"; none of these functions allocates). With reference counting on,
@@ -432,12 +433,13 @@ def stepping_loop(method, kern, n_event_fns):
     Why a function of its own: in run_loop, which allocates and so counts references, a step
     inlined paid for the count of every array it touched (rk4 170 against 100 ns per step on
     the cart pendulum), and a step called paid for the call. Cart pendulum, best of 7 runs of
-    1e5 steps, one process, the module's glue before -> after: rk4 102 -> 81 ns,
-    symplectic_euler 183 -> 143, verlet 276 -> 247, explicit_euler 18 -> 18; its compile,
-    everything cold, about 1 s longer (an extra layer: rk4 3.6 -> 4.8 s, verlet 11.4 -> 12.2
-    s). The portable glue (loop None in run_loop) keeps the steps inlined in run_loop and calls
-    the step: as a loop of its own there, the first use of a method after an install compiled
-    2 s longer (rk4 5.7 -> 7.8 s, verlet 18.1 -> 20.1 s, fresh numba cache)."""
+    1e5 steps, one process, the module's glue before -> after: rk4 102 -> 78 ns,
+    symplectic_euler 183 -> 138, verlet 276 -> 219, explicit_euler 18 -> 18; its compile (a
+    fresh process, the library's own numba cache warm) about 1 s longer, an extra compiled
+    layer (rk4 3.6 -> 4.8 s, verlet 11.4 -> 12.2 s, composition 14.2 -> 16.1 s). The
+    portable glue (loop None in run_loop) keeps the steps inlined in run_loop and calls the
+    step: as a loop of its own there, the first use of a method after an install compiled 2 s
+    longer (rk4 5.7 -> 7.8 s, verlet 18.1 -> 20.1 s, fresh numba cache)."""
     fixed_kern, fixed_events = kern, n_event_fns
 
     @njit(**FAST)
