@@ -28,7 +28,7 @@ from .errors import SimulationError
 from .failures import raise_for_status
 from .linearization import parameter_vector
 from .steppers import registry
-from .steppers.base import FAST, check_state
+from .steppers.base import check_state, fast_loop
 from .steppers.spec import make_settings
 
 __all__ = ["Stepper"]
@@ -47,7 +47,7 @@ def _core_class(module, method, settings_type, ws_type):
             ("info", typeof(np.zeros(1))), ("settings", settings_type), ("ws", ws_type),
             ("h", typeof(1.0)), ("first", typeof(1))]
 
-    @njit(**FAST)
+    @fast_loop
     def _advance(q, v, mom, p, settings, ws, extra, clock, info, h, k):
         """k steps; clock = [t0, steps done, t]; info = [iterations, residual]. A function
         of its own without reference counting: jitclass methods count references on every

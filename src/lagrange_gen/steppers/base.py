@@ -76,16 +76,19 @@ N_STATS = 4
 
 def inline_step(expr, caller_ir, callee_ir):
     """numba inline cost model (``@njit(inline=inline_step)``) of every fixed-step method's
-    ``step``: inlined into the loops compiled without reference counting (the stepping loop of
-    a generated module's glue, stepping_loop, and the step API's), called from everywhere else.
-    Inlined into a reference-counted loop (the portable glue's run_loop), rk4's step went from
-    100 to 170 ns on the cart pendulum (every array the step touches is counted there)."""
-    caller = caller_ir.func_id.func_qualname
-    return caller.endswith(_FAST_LOOPS)
+    ``step``: inlined into the loops compiled without reference counting (declared with
+    fast_loop: the stepping loop of a generated module's glue, stepping_loop, and the step
+    API's), called from everywhere else. Inlined into a reference-counted loop (the portable
+    glue's run_loop), rk4's step went from 100 to 170 ns on the cart pendulum (every array the
+    step touches is counted there)."""
+    return getattr(caller_ir.func_id.func, "inlines_step", False)
 
 
-#: The loops inline_step inlines a step into (qualified names' endings).
-_FAST_LOOPS = ("stepping_loop.<locals>.loop", "_core_class.<locals>._advance")
+def fast_loop(fn):
+    """``fn`` compiled without reference counting (FAST), marked as a loop that inline_step
+    inlines a method's step into."""
+    fn.inlines_step = True
+    return njit(**FAST)(fn)
 
 
 @njit(**FAST)
@@ -442,7 +445,7 @@ def stepping_loop(method, kern, n_event_fns):
     longer (rk4 5.7 -> 7.8 s, verlet 18.1 -> 20.1 s, fresh numba cache)."""
     fixed_kern, fixed_events = kern, n_event_fns
 
-    @njit(**FAST)
+    @fast_loop
     def loop(kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_steps, save_every, p,
              settings, outs, aux, control, control_data):
         return steps(method, fixed_kern, n_saved, fixed_events, q, v, mom, ws, extra, t0, h,
