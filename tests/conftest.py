@@ -25,6 +25,17 @@ def pytest_addoption(parser):
     group.addoption("--harness-summary", metavar="PATH", help="write the harness counts as JSON here")
 
 
+def glue(module, method):
+    """What the tests call instead of ``module.run_<method>`` (same arguments and returns): the
+    portable glue of ``method`` on ``module``'s kernels (lagrange_gen.portable). It is compiled
+    once per method for every model, where each model's own glue compiles the whole stepper
+    again (several seconds per model and method, the bulk of this suite's time).
+    tests/test_portable.py checks, for every method, that the module's own glue gives the same
+    trajectory bit for bit, and the step API, control and ensemble tests run it."""
+    from lagrange_gen import portable
+    return portable.runner(module, method)
+
+
 @pytest.fixture(scope="session")
 def gen_dir(tmp_path_factory):
     return tmp_path_factory.mktemp("generated")

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from constraint_util import four_bar_state, generated_model, params, pendulum_state
+from conftest import glue
 from lagrange_gen.consistent import initial_multipliers
 from lagrange_gen.steppers.base import N_STATS
 from lagrange_gen.steppers.registry import spec
@@ -19,7 +20,7 @@ def one_step(mod, method, q, v, lam, h, p, t0=0.0):
     out_extra = np.zeros((2, n_saved))
     out_extra[0, :m] = lam
     out_q, out_v = np.empty((2, n)), np.empty((2, n))
-    status, _, _ = getattr(mod, f"run_{method}")(
+    status, _, _ = glue(mod, method)(
         np.array(q, float), np.array(v, float), t0, h, 1, 1, p, make_settings(spec(method), {}),
         np.empty(2), out_q, out_v, np.empty((2, N_STATS)), out_extra,
         np.empty(2 * n + 3 + n_saved), np.empty((0, 3 + 2 * n)))

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from conftest import glue
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.loader import import_generated
 from lagrange_gen.steppers import registry
@@ -53,7 +54,7 @@ class Run:
         self.events = np.full((max_events, 3 + 2 * n), np.nan)
         p = mod.DEFAULT_PARAMS.copy() if params is None else np.asarray(params, dtype=np.float64)
         settings = make_settings(spec, {})
-        self.status, self.steps, self.n_events = getattr(mod, f"run_{method}")(
+        self.status, self.steps, self.n_events = glue(mod, method)(
             np.asarray(q0, dtype=np.float64), np.asarray(v0, dtype=np.float64), float(t0),
             float(h), n_steps, 1, p, settings, self.t, self.q, self.v,
             np.empty((rows, N_STATS)), np.zeros((rows, n_saved)), self.last, self.events)

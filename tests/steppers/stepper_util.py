@@ -1,4 +1,4 @@
-"""Helpers of the stepper tests: generated test models, calls of the run_<method> glue.
+"""Helpers of the stepper tests: generated test models, runs through the glue (conftest.glue).
 
 There is deliberately no conftest.py in this directory: test modules of other directories import
 names from the top-level conftest, and a second conftest module would shadow it. Test modules
@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import glue
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.loader import import_generated
 
@@ -69,7 +70,7 @@ def run(mod, method, q0, v0, h, n_steps, p, t0=0.0, save_every=1, settings=None)
     out_t, out_q, out_v = np.empty(rows), np.empty((rows, n)), np.empty((rows, n))
     out_stats, out_extra, last = np.empty((rows, N_STATS)), np.empty((rows, 0)), np.empty(2 * n + 3)
     record = make_settings(registry.spec(method), settings or {})
-    status, done, _ = getattr(mod, f"run_{method}")(
+    status, done, _ = glue(mod, method)(
         np.asarray(q0, dtype=np.float64), np.asarray(v0, dtype=np.float64), float(t0), float(h),
         n_steps, save_every, p, record, out_t, out_q, out_v, out_stats, out_extra, last,
         np.empty((0, 3 + 2 * n)))

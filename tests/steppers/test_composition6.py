@@ -18,6 +18,7 @@ from lagrange_gen.status import OK
 from lagrange_gen.steppers import registry
 from lagrange_gen.steppers.base import N_STATS
 from lagrange_gen.steppers.spec import make_settings
+from conftest import glue
 from stepper_util import HERE, model, params, run  # model is a fixture
 
 # (model, q0, v0, h, steps, bound on the energy error over the first fifth): the double
@@ -66,7 +67,7 @@ def test_a_failing_substep_leaves_the_state_at_the_start_of_the_step(method):
     out = (np.empty(rows), np.empty((rows, n)), np.empty((rows, n)), np.empty((rows, N_STATS)),
            np.empty((rows, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
     settings = make_settings(registry.spec(method), {"newton_always": True})
-    status, done, _ = getattr(mod, f"run_{method}")(
+    status, done, _ = glue(mod, method)(
         np.array([0.8 * h]), np.array([-1.0]), 0.0, h, 2, 1, np.array([1.0, 1e-6]), settings,
         *out)
     assert status != OK and done == 0, (status, done)
