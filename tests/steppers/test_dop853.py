@@ -8,6 +8,7 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 from scipy.special import ellipk
 
+from conftest import glue
 from stepper_util import generated_model, params
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.needs import method_needs
@@ -34,7 +35,7 @@ def run(mod, q0, v0, t0, t_end, t_eval=(), size=4000, h0=0.0, **settings):
            np.empty((size, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
     counters = np.array([h0, 0.0, 0.0, 0.0])
     record = make_settings(registry.spec("dop853"), settings)
-    status, rows, n_events = mod.run_dop853(
+    status, rows, n_events = glue(mod, "dop853")(
         np.asarray(q0, float), np.asarray(v0, float), float(t0), float(t_end), params(mod),
         record, np.asarray(t_eval, float), *out, counters)
     assert n_events == 0
