@@ -199,7 +199,7 @@ def newton_solve(A, piv, b, scratch):
     return OK
 
 
-@njit(**FAST)
+@njit(inline="always")
 def factor_mass(H, A, piv):
     """A (n, n) <- the factors of the SPD mass matrix H in lu_solve_inplace's layout (Cholesky,
     rewritten by linalg.cholesky_as_lu; piv the identity), H unchanged. One factorization then
@@ -215,7 +215,7 @@ def factor_mass(H, A, piv):
     return True
 
 
-@njit(**FAST)
+@njit(inline="always")
 def velocity_from_factors(kern, q, mom, t, p, A, piv, v, scratch):
     """v = H(q, t)^-1 (mom - b(q, t)) (n,) from H's factors in A, piv (factor_mass)."""
     copy_into(v, mom)
