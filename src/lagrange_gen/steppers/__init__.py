@@ -7,3 +7,9 @@ Nonsmooth elements: nonsmooth_euler. See registry.METHODS and registry.INFO; bas
 run loop; registry.py emits the cached ``run_<method>`` glue into generated modules;
 lagrange_gen.simulate is the Python driver.
 """
+
+from ..numba_inline_copy import install as _install_inline_copy
+
+# numba's inliner copies a callee's scope once per block; the steppers inline large functions
+# (lagrange_gen/numba_inline_copy.py measures it).
+_install_inline_copy()
