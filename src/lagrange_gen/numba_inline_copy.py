@@ -14,8 +14,8 @@ the pass took 4.8 s of a 12.7 s compile.
 consecutive blocks of the same scope, so the copied blocks share one scope again, as the
 blocks they were copied from do. Every other attribute is the real ``copy`` module's. Measured
 the same way: the inlining pass 4.8 -> 1.1 s, run_verlet's compile 12.7 -> 9.8 s. The compiled
-code is the same (tests/test_portable.py and the stepper tests compare trajectories bit for bit
-between separately compiled loops; tests/test_numba_inline_copy.py compares the copies).
+code is the same: tests/test_numba_inline_copy.py compares the copies with numba's own, and a
+stepper compiled in two fresh processes, with and without it, bit for bit.
 
 It is installed by lagrange_gen.steppers (everything that compiles a stepper imports it) only
 when inline_closurecall still makes exactly that call (its source is checked), and not at all

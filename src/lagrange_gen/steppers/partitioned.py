@@ -83,8 +83,9 @@ def jacobian_kick(kern, args, u, A):
 # about a dozen arrays, each as its own pointer, shape and strides. Measured on the cart pendulum
 # (best of 7 runs of 1e5 steps, taskset to one core): symplectic_euler 128 -> 98 ns per step,
 # verlet 248 -> 180, composition 835 -> 663; the 16-link chain's verlet 5580 -> 4996 ns. The
-# price is compile time: the cart pendulum's specialized run_verlet 15.4 -> 18.4 s (numba's
-# inlining pass over the larger step), verlet with every cache cold 20.5 -> 21.7 s.
+# price was compile time: the cart pendulum's specialized run_verlet 15.4 -> 18.4 s, verlet with
+# every cache cold 20.5 -> 21.7 s, most of it numba's inlining pass copying the larger step,
+# which lagrange_gen.numba_inline_copy then took back (run_verlet 14.3 -> 9.7 s).
 @njit(inline="always")
 def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, f, scratch):
     """Solve H(q) u + b(q, t) = mom + hk f(q, u, t) for u (n,); u holds the initial guess on
