@@ -31,7 +31,7 @@ def glue(module, method):
     once per method for every model, where each model's own glue compiles the whole stepper
     again (several seconds per model and method, the bulk of this suite's time).
     tests/test_portable.py checks, for every method, that the module's own glue gives the same
-    trajectory bit for bit, and the step API, control and ensemble tests run it."""
+    trajectory bit for bit; the step API, control and ensemble tests run the module's own glue."""
     from lagrange_gen import portable
     return portable.runner(module, method)
 

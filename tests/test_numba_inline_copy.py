@@ -64,7 +64,6 @@ import json, sys
 import numpy as np
 sys.path.insert(0, sys.argv[1])
 import cart_pendulum as mod
-from lagrange_gen.numba_inline_copy import install
 from numba.core import inline_closurecall
 from lagrange_gen.steppers.base import N_STATS
 from lagrange_gen.steppers import registry
