@@ -99,7 +99,7 @@ def test_cholesky_factors_as_lu_solve_and_reconstruct(n):
     b = rng.normal(size=n)
     F, piv = A.copy(), np.full(n, -1, np.int64)
     assert linalg.cholesky_inplace(F)
-    linalg.cholesky_as_lu(F, piv)
+    linalg.cholesky_as_lu(F, piv, n)
     np.testing.assert_array_equal(piv, np.arange(n))
     L, U = np.tril(F, -1) + np.eye(n), np.triu(F)
     np.testing.assert_allclose(L @ U, A, rtol=1e-13, atol=1e-13 * np.abs(A).max())

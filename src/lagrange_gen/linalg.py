@@ -238,14 +238,15 @@ def _back_substitute(U, x):
             x[k] -= U[k, i] * xi
 
 
-@njit(cache=True, _nrt=False)
-def cholesky_as_lu(A, piv):
+@njit(inline="always")
+def cholesky_as_lu(A, piv, n):
     """Rewrite in place the Cholesky factor L of an SPD matrix (lower triangle of A (n, n), from
     cholesky_inplace) as the LU factors of L L^T in lu_inplace's layout: the unit lower factor
     L D^-1 below the diagonal, U = D L^T on and above it (D = diag(L)), piv (n,) the identity;
     lu_solve_inplace then solves with them (the partitioned methods keep the factors of H this
-    way as the first matrix of their simplified Newton, steppers/partitioned.py)."""
-    n = A.shape[0]
+    way as the first matrix of their simplified Newton, steppers/partitioned.py). Inlined, with
+    n = A.shape[0] passed: base.factor_mass passes kern.N_COORDS, a compile-time constant in a
+    generated module's glue (steppers/base.py, "Loop bounds")."""
     for k in range(n):
         piv[k] = k
         d = A[k, k]

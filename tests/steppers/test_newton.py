@@ -139,7 +139,7 @@ def _solve_simplified(kind, a, x, tol, max_iter, counts):
     F, scratch = np.zeros(n), np.zeros(n)
     J, piv = np.zeros((n, n)), np.zeros(n, dtype=np.int64)
     return newton.solve_simplified(_SIMPLIFIED, None, (kind, a, counts), x, F, J, piv, scratch,
-                                   tol, max_iter, False)
+                                   tol, max_iter, False, n)
 
 
 def test_simplified_newton_reaches_newtons_root_with_fewer_jacobians():

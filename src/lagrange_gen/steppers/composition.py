@@ -90,8 +90,8 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def _substep_newton(kern, q, v, mom, t, h, p, settings, ws, j):
     """verlet's Newton-path step as substep j, with the guesses of substep j's own sequence."""
     vw, mine = ws.verlet, ws.guesses[j]
-    depth = vw.history.shape[0]
-    for i in range(q.shape[0]):
+    depth = GUESS_DEGREE + 1            # the rows of verlet's histories
+    for i in range(kern.N_COORDS):      # (base.py, "Loop bounds")
         vw.u[i] = mine[0, i]
         for k in range(depth):
             vw.history[k, i], vw.drifts[k, i] = mine[1 + k, i], mine[1 + depth + k, i]
@@ -99,7 +99,7 @@ def _substep_newton(kern, q, v, mom, t, h, p, settings, ws, j):
         vw.carried[k] = ws.kept[j, k - 1]
     status, it, res = verlet.step_newton(kern, q, v, mom, t, h, p, settings, vw)
     if status == OK:
-        for i in range(q.shape[0]):
+        for i in range(kern.N_COORDS):
             mine[0, i] = vw.u[i]
             for k in range(depth):
                 mine[1 + k, i], mine[1 + depth + k, i] = vw.history[k, i], vw.drifts[k, i]

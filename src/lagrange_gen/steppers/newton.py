@@ -35,7 +35,7 @@ from numba import njit
 
 from ..linalg import lu_solve_inplace
 from ..status import NEWTON_DIVERGED, NON_FINITE, OK
-from .base import increment_converged, max_abs, newton_converged, newton_solve
+from .base import increment_converged, max_abs, max_abs_of, newton_converged, newton_solve
 
 #: solve_simplified keeps its factored Jacobian while each increment is at most this fraction of
 #: the previous one; a slower contraction re-assembles and re-factors J at the current iterate.
@@ -79,7 +79,7 @@ def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
 
 
 @njit(inline="always")
-def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, factored):
+def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, factored, size):
     """Simplified Newton on F(x) = 0 (Hairer-Wanner, Solving ODEs II, sec. IV.8): J = dF/dx is
     assembled (problem.jacobian) and LU-factored at the initial guess and kept; the following
     iterations evaluate F alone (problem.residual) and reuse the factors. While the iteration
@@ -94,12 +94,15 @@ def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, 
 
     factored: J and piv already hold the LU factors of an approximation of dF/dx (the mass
     matrix H for the kick and the drift, whose Jacobians are H + O(h)): the iteration starts
-    with them, and the first Jacobian is assembled only if they contract slowly."""
+    with them, and the first Jacobian is assembled only if they contract slowly.
+
+    size: N, the length of x (the partitioned steps pass kern.N_COORDS, a compile-time constant
+    in a generated module's glue, so that the loops here unroll: base.py, "Loop bounds")."""
     resid = prev = 0.0
     fresh = not factored
     for it in range(1, max_iter + 1):
         problem.residual(kern, args, x, F)
-        resid = max_abs(F)
+        resid = max_abs_of(F, size)
         if not resid < math.inf:        # NaN or inf in F
             return NON_FINITE, it, resid
         if fresh:
@@ -109,14 +112,14 @@ def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, 
                 return status, it, resid
         else:
             lu_solve_inplace(J, piv, F, scratch)
-        for i in range(x.shape[0]):
+        for i in range(size):
             x[i] -= F[i]
         # Stop on the increment alone: the error left after it is about theta |dx|, far below
         # the tolerance. (newton_converged's bound theta / (1 - theta) |dx| <= tol would stop
         # one iteration earlier with an error up to tol, which over many steps shows above the
         # round-off floor of a 6th-order method: tests/zoo/test_heavy_top.py.)
-        d = max_abs(F)
-        if increment_converged(d, max_abs(x), 0.0, tol):
+        d = max_abs_of(F, size)
+        if increment_converged(d, max_abs_of(x, size), 0.0, tol):
             return OK, it, resid
         fresh = prev > 0.0 and not d <= THETA_REFRESH * prev
         prev = d

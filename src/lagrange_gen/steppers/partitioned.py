@@ -56,7 +56,7 @@ from .base import FAST, factor_mass, velocity_from_factors
 def residual_kick(kern, args, u, R):
     """Residual of solve_kick: R = H(q) u + b(q, t) - mom - hk f(q, u, t)."""
     q, mom, t, hk, p, H, Jq, Jqd, f = args
-    n = q.shape[0]
+    n = kern.N_COORDS
     kern.momentum_rate(q, u, t, p, f)
     for i in range(n):
         s = -mom[i] - hk * f[i]
@@ -71,7 +71,7 @@ def residual_kick(kern, args, u, R):
 def jacobian_kick(kern, args, u, A):
     """Jacobian of residual_kick: A = H(q) - hk df/dv."""
     q, mom, t, hk, p, H, Jq, Jqd, f = args
-    n = q.shape[0]
+    n = kern.N_COORDS
     kern.momentum_rate_jacobian(q, u, t, p, Jq, Jqd)
     for i in range(n):
         for j in range(n):
@@ -96,7 +96,7 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
     return newton.solve_simplified(_KICK, kern, (q, mom, t, hk, p, H, Jq, Jqd, f), u, R, A, piv,
-                                   scratch, tol, max_iter, True)
+                                   scratch, tol, max_iter, True, kern.N_COORDS)
 
 
 @njit(inline="always")
@@ -104,7 +104,7 @@ def residual_drift(kern, args, w, R):
     """Residual of solve_drift: R = H(q_new, td) w + b(q_new, td) - mom at q_new = q + hd (u +
     w); leaves q_new and H(q_new) in args."""
     q, u, mom, hd, td, p, H, dHw, q_new = args
-    n = q.shape[0]
+    n = kern.N_COORDS
     for i in range(n):
         q_new[i] = q[i] + hd * (u[i] + w[i])
     kern.mass_matrix(q_new, td, p, H)
@@ -122,7 +122,7 @@ def jacobian_drift(kern, args, w, A):
     """Jacobian of residual_drift: A = H + hd (d(H w)/dq + db/dq) at the q_new and H(q_new)
     that residual_drift left in args."""
     q, u, mom, hd, td, p, H, dHw, q_new = args
-    n = q.shape[0]
+    n = kern.N_COORDS
     kern.mass_matvec_dq(q_new, w, td, p, dHw)
     if kern.TRANSPORT:
         kern.transport_dq(q_new, td, p, dHw)
@@ -142,9 +142,10 @@ def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R,
     """
     status, iters, resid = newton.solve_simplified(_DRIFT, kern,
                                                    (q, u, mom, hd, td, p, H, dHw, q_new),
-                                                   w, R, A, piv, scratch, tol, max_iter, True)
+                                                   w, R, A, piv, scratch, tol, max_iter, True,
+                                                   kern.N_COORDS)
     if status == OK:
-        for i in range(q.shape[0]):
+        for i in range(kern.N_COORDS):
             q_new[i] = q[i] + hd * (u[i] + w[i])
         kern.mass_matrix(q_new, td, p, H)
     return status, iters, resid
@@ -165,23 +166,24 @@ def begin_step(kern, q, v, t, p, H, A, piv, u, history, carried):
     u_k, u_k-1, ... there were (0 on the first step; end_step stores one more)."""
     if carried[0] == 0:
         kern.mass_matrix(q, t, p, H)
-        if not factor_mass(H, A, piv):
+        if not factor_mass(H, A, piv, kern.N_COORDS):
             return SINGULAR_MASS, 0
     carried[0] = 0
     kept = carried[1]
     carried[1] = 0
-    push(history, u)
+    push(history, u, kern.N_COORDS)
     degree = min(carried[2], kept - 1)
-    for i in range(q.shape[0]):
+    for i in range(kern.N_COORDS):
         u[i] = extrapolate(history, degree, i) if degree >= 1 else v[i]
     return OK, kept
 
 
 @njit(inline="always")
-def push(history, x):
-    """Shift the rows of history (k, n) down by one (the last drops out) and put x (n,) first."""
-    for i in range(x.shape[0]):
-        for j in range(history.shape[0] - 1, 0, -1):
+def push(history, x, n):
+    """Shift the rows of history (GUESS_DEGREE + 1, n) down by one (the last drops out) and put
+    x (n,) first; n passed (kern.N_COORDS: base.py, "Loop bounds")."""
+    for i in range(n):
+        for j in range(GUESS_DEGREE, 0, -1):
             history[j, i] = history[j - 1, i]
         history[0, i] = x[i]
 
@@ -197,19 +199,19 @@ def extrapolate(history, degree, i):
 
 
 @njit(inline="always")
-def best_degree(history, x, kept, base):
+def best_degree(history, x, kept, base, n):
     """The degree whose prediction of x (n,) came closest (max norm): 0 for base (n,) (the
     guess without history), d >= 1 for extrapolate(history, d) from the terms before x
-    (history[0..d], kept of them valid). A sequence that polynomials extrapolate badly (h omega
+    (history (GUESS_DEGREE + 1, n), rows 0..d, kept of them valid; n passed: kern.N_COORDS). A sequence that polynomials extrapolate badly (h omega
     near the stability limit) so falls back to a low degree. About GUESS_DEGREE^2 n / 2
     multiply-adds, against a residual and a triangular solve per Newton iteration saved."""
     best_err = 0.0
-    for i in range(x.shape[0]):
+    for i in range(n):
         best_err = max(best_err, abs(base[i] - x[i]))
     best = 0
-    for d in range(1, min(history.shape[0] - 1, kept - 1) + 1):
+    for d in range(1, min(GUESS_DEGREE, kept - 1) + 1):
         err = 0.0
-        for i in range(x.shape[0]):
+        for i in range(n):
             err = max(err, abs(extrapolate(history, d, i) - x[i]))
         if err < best_err:
             best, best_err = d, err
@@ -222,7 +224,7 @@ def end_step(kern, q_new, mom_new, t_new, p, H, A, piv, v_new, scratch, carried,
     """End of a Newton-path step: H holds H(q_new, t_new); factor it into A, piv (kept for the
     next step's kick, carried[0] = 1) and solve v_new (n,) = H^-1 (mom_new - b); the solutions
     kept grow by one, up to depth (the rows of the histories). Returns OK or SINGULAR_MASS."""
-    if not factor_mass(H, A, piv):
+    if not factor_mass(H, A, piv, kern.N_COORDS):
         return SINGULAR_MASS
     velocity_from_factors(kern, q_new, mom_new, t_new, p, A, piv, v_new, scratch)
     carried[0] = 1

@@ -54,7 +54,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
-    n = q.shape[0]
+    n = kern.N_COORDS       # a compile-time constant in the module's glue (base.py, "Loop bounds")
     if explicit_path(kern, settings):
         a = ws.f
         status = accel(kern, q, v, t, p, ws.H, a)
@@ -73,10 +73,10 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
                                       ws.R, ws.f, ws.s)
     if status != OK:
         return status, iters, resid
-    ws.carried[2] = best_degree(ws.history, u, kept, v)
+    ws.carried[2] = best_degree(ws.history, u, kept, v, n)
     for i in range(n):
         q_new[i] = q[i] + h * u[i]
-    matvec(ws.H, u, p_new)                     # ws.H holds H(q)
+    matvec(ws.H, u, p_new, n)                   # ws.H holds H(q)
     if kern.TRANSPORT:
         kern.transport(q, t, p, p_new)         # the canonical momentum H u + b
     kern.mass_matrix(q_new, t + h, p, ws.H)

@@ -93,7 +93,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     u plus the extrapolation of the earlier differences w - u (on the 16-link chain 5.76 against
     8.90 iterations per step with the last difference alone): ws holds a sequence of steps of
     one size (composition.py gives each of its substeps its own)."""
-    n = q.shape[0]
+    n = kern.N_COORDS       # a compile-time constant in the module's glue (base.py, "Loop bounds")
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
     status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried)
@@ -103,8 +103,8 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
                                    ws.Jq, ws.Jqd, ws.piv, u, ws.R, f, ws.s)
     if status != OK:
         return status, it1, res1
-    ws.carried[2] = best_degree(ws.history, u, kept, v)
-    matvec(ws.H, u, p_half)                    # p* = H(q) u + b (ws.H holds H(q))
+    ws.carried[2] = best_degree(ws.history, u, kept, v, n)
+    matvec(ws.H, u, p_half, n)                  # p* = H(q) u + b (ws.H holds H(q))
     if kern.TRANSPORT:
         kern.transport(q, t, p, p_half)
     drifts, degree = ws.drifts, min(ws.carried[3], kept - 1)
@@ -118,8 +118,8 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     for i in range(n):
         ws.R[i] = w[i] - u[i]
     if kept >= 1:
-        ws.carried[3] = best_degree(drifts, ws.R, kept, drifts[0])
-    push(drifts, ws.R)
+        ws.carried[3] = best_degree(drifts, ws.R, kept, drifts[0], n)
+    push(drifts, ws.R, n)
     kern.momentum_rate(q_new, w, t + h, p, f)
     for i in range(n):
         p_half[i] += 0.5 * h * f[i]            # now p+
