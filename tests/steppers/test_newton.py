@@ -41,7 +41,8 @@ def _solve(kind, a, x, tol, max_iter):
     n = x.shape[0]
     F, scratch = np.zeros(n), np.zeros(n)
     J, piv = np.zeros((n, n)), np.zeros(n, dtype=np.int64)
-    return newton.solve(_PROBLEM, None, (kind, a), x, F, J, piv, scratch, tol, max_iter)
+    return newton.solve(_PROBLEM, None, (kind, a), x, F, J, piv, scratch, tol, max_iter,
+                        x.shape[0])
 
 
 A = np.array([2.0, 3.0, 0.5])

@@ -144,17 +144,18 @@ def increment_converged(d, xmax, prev, tol):
     return False
 
 
-@njit(cache=True, **FAST)
-def newton_converged(dx, x, prev, tol):
-    """Newton stopping test after the update x += dx; returns (converged, max|dx|).
+@njit(inline="always")
+def newton_converged(dx, x, prev, tol, n):
+    """Newton stopping test after the update x += dx (both (n,); n passed, see "Loop bounds");
+    returns (converged, max|dx|).
 
     ``prev`` is max|dx| of the previous iteration (0 on the first). Converged when the increment
     is small relative to the unknown, max|dx| <= tol max(1, max|x|), or when the observed
     contraction theta = |dx| / |prev| < 1 bounds the error left in x by theta / (1 - theta) |dx|
     below that (Hairer-Wanner, Solving ODEs II, sec. IV.8): in the quadratic regime this saves
     the last iteration, which would only confirm convergence."""
-    d = max_abs(dx)
-    return increment_converged(d, max_abs(x), prev, tol), d
+    d = max_abs_of(dx, n)
+    return increment_converged(d, max_abs_of(x, n), prev, tol), d
 
 
 @njit(cache=True, **FAST)

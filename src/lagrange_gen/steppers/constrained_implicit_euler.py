@@ -110,7 +110,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     args = (q, v, t + h, h, p, q1, ws.dv, ws.rhs, ws.H, ws.Jq, ws.Jqd, ws.dHw, ws.DJ, phi, Jb,
             ws.gam, ws.T)
     status, iters, resid = newton.solve(_THIS, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, x.shape[0])
     if status != OK:
         return status, iters, resid
     for i in range(n):

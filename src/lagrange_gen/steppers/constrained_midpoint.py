@@ -117,7 +117,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     args = (q, mom, tm, h, p, qb, q1, f, ws.H, ws.Jq, ws.Jqd, ws.dHw, ws.phi, ws.Ja, ws.Jb,
             ws.gam)
     status, iters, resid = newton.solve(_THIS, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, x.shape[0])
     if status != OK:
         return status, iters, resid
     vb = x[:n]

@@ -303,7 +303,7 @@ def dense(kern, q, v, t, h, p, ws):
     after accept, before advance. DENSE_EVALS evaluations; OK or SINGULAR_MASS."""
     ctx = (p, ws.H)
     for i in range(N_STAGES + 1, N_DENSE):
-        _stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs)
+        _stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, kern.N_COORDS)
         status = stage_acceleration(kern, ctx, ws.qs, ws.kv[i], t + C[i] * h, ws.ka[i])
         if status != OK:
             return status

@@ -43,7 +43,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     status = accel(kern, q, v, t, p, ws.H, a)
     if status != OK:
         return status, 0, 0.0
-    for i in range(q.shape[0]):
+    for i in range(kern.N_COORDS):         # (base.py, "Loop bounds")
         q[i] += h * v[i]
         v[i] += h * a[i]
     return OK, 0, 0.0

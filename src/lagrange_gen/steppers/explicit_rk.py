@@ -49,10 +49,10 @@ HEUN_C = np.array([0.0, 1.0])
 
 
 @njit(inline="always", **FAST)
-def _stage_state(A, i, q, v, h, stage_v, stage_a, qs):
+def _stage_state(A, i, q, v, h, stage_v, stage_a, qs, n):
     """Q_i into qs (n,) and V_i into stage_v[i] (n,) from the stages j < i. Zero entries of A
-    are skipped: no work for them, and a non-finite stage cannot leak through a 0 coefficient."""
-    n = q.shape[0]
+    are skipped: no work for them, and a non-finite stage cannot leak through a 0 coefficient.
+    n passed: kern.N_COORDS (base.py, "Loop bounds")."""
     vi = stage_v[i]
     for k in range(n):
         sq = 0.0
@@ -76,9 +76,9 @@ def rk_step(source, kern, ctx, A, b, c, q, v, t, h, stage_v, stage_a, qs, q_out,
     q_out, v_out (n,) may be q, v themselves (each entry k is written after its last read).
     Returns OK or the first non-OK status of source.stage_acceleration; then q_out, v_out are
     untouched."""
-    n, s = q.shape[0], b.shape[0]
+    n, s = kern.N_COORDS, b.shape[0]       # (n: base.py, "Loop bounds")
     for i in range(s):
-        _stage_state(A, i, q, v, h, stage_v, stage_a, qs)
+        _stage_state(A, i, q, v, h, stage_v, stage_a, qs, n)
         if i == 0 and first_known:
             continue
         status = source.stage_acceleration(kern, ctx, qs, stage_v[i], t + c[i] * h, stage_a[i])

@@ -48,7 +48,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def assemble(kern, args, v1, R, A):
     """Newton system of the step (newton.solve): R (n,) <- R(v+), A (n, n) <- dR/dv+."""
     q, v, t1, h, p, q1, dv, rhs, H, Jq, Jqd, dHw = args
-    n = q.shape[0]
+    n = kern.N_COORDS       # (base.py, "Loop bounds")
     for i in range(n):
         q1[i] = q[i] + h * v1[i]
         dv[i] = v1[i] - v[i]
@@ -66,13 +66,13 @@ def assemble(kern, args, v1, R, A):
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
-    n = q.shape[0]
+    n = kern.N_COORDS       # (base.py, "Loop bounds")
     v1 = ws.v1
     for i in range(n):
         v1[i] = v[i]
     args = (q, v, t + h, h, p, ws.q1, ws.dv, ws.rhs, ws.H, ws.Jq, ws.Jqd, ws.dHw)
     status, iters, resid = newton.solve(_THIS, kern, args, v1, ws.R, ws.A, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, kern.N_COORDS)
     if status == OK:
         for i in range(n):
             q[i] += h * v1[i]

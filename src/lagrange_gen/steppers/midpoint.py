@@ -59,7 +59,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def assemble(kern, args, vb, R, A):
     """Newton system of the step (newton.solve): R (n,) <- R(vb), A (n, n) <- dR/dvb."""
     q, mom, tm, hh, p, qb, f, H, Jq, Jqd, dHw = args
-    n = q.shape[0]
+    n = kern.N_COORDS       # (base.py, "Loop bounds")
     for i in range(n):
         qb[i] = q[i] + hh * vb[i]
     kern.mass_matrix(qb, tm, p, H)
@@ -81,7 +81,7 @@ def assemble(kern, args, vb, R, A):
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
-    n = q.shape[0]
+    n = kern.N_COORDS       # (base.py, "Loop bounds")
     vb, qb, f = ws.vb, ws.qb, ws.f
     q_new, v_new, p_new = ws.q_new, ws.v_new, ws.p_new
     tm = t + 0.5 * h
@@ -89,7 +89,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         vb[i] = v[i]
     args = (q, mom, tm, 0.5 * h, p, qb, f, ws.H, ws.Jq, ws.Jqd, ws.dHw)
     status, iters, resid = newton.solve(_THIS, kern, args, vb, ws.R, ws.A, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, kern.N_COORDS)
     if status != OK:
         return status, iters, resid
     for i in range(n):

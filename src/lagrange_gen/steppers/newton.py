@@ -35,7 +35,7 @@ from numba import njit
 
 from ..linalg import lu_solve_inplace
 from ..status import NEWTON_DIVERGED, NON_FINITE, OK
-from .base import increment_converged, max_abs, max_abs_of, newton_converged, newton_solve
+from .base import increment_converged, max_abs_of, newton_converged, newton_solve
 
 #: solve_simplified keeps its factored Jacobian while each increment is at most this fraction of
 #: the previous one; a slower contraction re-assembles and re-factors J at the current iterate.
@@ -54,9 +54,11 @@ def problem(name, assemble=None, *, residual=None, jacobian=None):
 
 
 @njit(inline="always")
-def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
+def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, size):
     """Newton on problem.assemble's F(x) = 0; x (N,) holds the initial guess and on return the
-    last iterate. F, scratch (N,), J (N, N), piv (N,) int64 are workspace.
+    last iterate. F, scratch (N,), J (N, N), piv (N,) int64 are workspace. size: N (a method
+    whose N is kern.N_COORDS passes that, a compile-time constant in a generated module's glue:
+    base.py, "Loop bounds"; the others x.shape[0]).
 
     Returns (status, iterations, residual): OK when the stopping rule accepted the last update,
     NON_FINITE (F not finite), SINGULAR_NEWTON or NON_FINITE (J could not be factored), or
@@ -64,15 +66,15 @@ def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter):
     resid = prev = 0.0
     for it in range(1, max_iter + 1):
         problem.assemble(kern, args, x, F, J)
-        resid = max_abs(F)
+        resid = max_abs_of(F, size)
         if not resid < math.inf:        # NaN or inf in F
             return NON_FINITE, it, resid
         status = newton_solve(J, piv, F, scratch)        # F <- J^-1 F = -dx
         if status != OK:
             return status, it, resid
-        for i in range(x.shape[0]):
+        for i in range(size):
             x[i] -= F[i]
-        done, prev = newton_converged(F, x, prev, tol)
+        done, prev = newton_converged(F, x, prev, tol, size)
         if done:
             return OK, it, resid
     return NEWTON_DIVERGED, max_iter, resid

@@ -220,7 +220,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
             ws.dHw, ws.Hw, ws.piv, ws.X, ws.s, state, s0, s1, ws.we, ws.u1, G, coef,
             ws.Y, ws.W)
     status, iters, resid = newton.solve(_THIS, kern, args, v1, ws.F, ws.A, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, v1.shape[0])
     if status != OK:
         return status, iters, resid
     for i in range(n):

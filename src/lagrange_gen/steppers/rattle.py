@@ -129,7 +129,7 @@ def _step_explicit(kern, q, v, t, h, p, settings, ws, extra):
         kap[k] = hh * h * extra[k]
     status, iters, resid = newton.solve(_MULTIPLIER, kern, (z, vh, t + h, p, Y, q1, phi, Jb, ws.gam),
                                         kap, ws.Fk, ws.S, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, kap.shape[0])
     if status != OK:
         return status, iters, resid
     for i in range(n):                        # q+ and v_1/2 = v* + h/2 M^-1 J(q)^T lam
@@ -223,7 +223,7 @@ def _step_newton(kern, q, v, mom, t, h, p, settings, ws, extra):
     args = (q, mom, pt, t, h, p, q1, f, H0, ws.H1, ws.Jq, ws.Jqd, ws.D, ws.phi, ws.Ja, ws.Jb,
             ws.gam)
     status, iters, resid = newton.solve(_POSITION, kern, args, x, ws.F, ws.K, ws.piv, ws.s,
-                                        settings.newton_tol, settings.max_iter)
+                                        settings.newton_tol, settings.max_iter, x.shape[0])
     if status != OK:
         return status, iters, resid
     u, w = x[:n], x[n:2 * n]
