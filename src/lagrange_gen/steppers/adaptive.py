@@ -248,6 +248,9 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     branches are pruned before compiling)."""
     n = q0.shape[0]
     size = out_t.shape[0]
+    if n != kern.N_COORDS or v0.shape[0] != n:      # (the steps loop to N_COORDS: base.py)
+        raise ValueError("run_<method>: q0 and v0 need N_COORDS entries (the model's "
+                         "coordinates)")
     if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved or size < 2:
         raise ValueError("run_<method>: out_extra needs n_saved columns, out_last 2 n + 3 + "
                          "n_saved entries and the outputs at least 2 rows")

@@ -384,6 +384,11 @@ def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, s
     most E).
     """
     n = q0.shape[0]
+    # The steps loop to kern.N_COORDS ("Loop bounds") and the kernels read the model's n
+    # entries: a state of another size would be read past its end or partly ignored.
+    if n != kern.N_COORDS or v0.shape[0] != n:
+        raise ValueError("run_<method>: q0 and v0 need N_COORDS entries (the model's "
+                         "coordinates)")
     if out_extra.shape[1] != n_saved or out_last.shape[0] - 2 * n - 3 - n_saved not in (0, 1):
         raise ValueError("run_<method>: out_extra needs n_saved columns and out_last "
                          "2 n + 3 + n_saved entries, or one more for W (n_saved = "
