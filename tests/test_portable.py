@@ -133,6 +133,44 @@ def test_specialized_ready_is_false_before_any_compile(tmp_path):
     assert portable.specialized_ready(mod.run_explicit_euler, args)
 
 
+def test_specialized_ready_remembers_a_miss_until_the_cache_index_changes(tmp_path, monkeypatch):
+    """simulate asks on every call; the on-disk cache is read again only when its index changed
+    (another process may have compiled the glue meanwhile), and a hit is still found then."""
+    mod = import_generated(generate_model(Path(__file__).resolve().parent.parent / "models"
+                                          / "damped_oscillator.py", tmp_path,
+                                          methods=["explicit_euler"]).path)
+    run = mod.run_explicit_euler
+    q = np.zeros(mod.N_COORDS)
+    args = fixed_run.warm_up_args(q, q, 0.0, 1e-3, mod.DEFAULT_PARAMS.copy(),
+                                  make_settings(registry.spec("explicit_euler"), {}),
+                                  np.zeros((1, 0)), np.zeros(2 * mod.N_COORDS + 4),
+                                  np.zeros((0, 3 + 2 * mod.N_COORDS)))
+    probes, stamp = [], [None]
+    load = run._cache.load_overload
+    monkeypatch.setattr(run._cache, "load_overload", lambda *a: probes.append(1) or load(*a))
+    monkeypatch.setattr(portable, "_index_stamp", lambda cache: stamp[0])
+    for _ in range(3):
+        assert not portable.specialized_ready(run, args)
+    assert len(probes) == 1
+    stamp[0] = (1, 2)                        # the index was written
+    assert not portable.specialized_ready(run, args)
+    assert len(probes) == 2
+    run(*args)                               # compiled (and saved) in this process
+    assert portable.specialized_ready(run, args)
+
+
+def test_a_kernel_table_is_typed_once_as_numba_types_any_tuple(generated):
+    """The glue's arguments are typed on every call; a kernel table's type is numba's own tuple
+    type, computed on its first call only."""
+    from numba.core.typing.typeof import Purpose, _TypeofContext, typeof, typeof_impl
+    table = portable.kernel_table(generated("cart_pendulum"), "rk4")
+    first = typeof(table, Purpose.argument)
+    assert portable._TABLE_TYPES[id(table)] == (table, first)      # kept for the next call
+    assert typeof(table, Purpose.argument) is first
+    assert first == typeof_impl.dispatch(tuple)(table, _TypeofContext(Purpose.argument))
+    assert str(first).startswith("Kernels_rk4(")
+
+
 def test_unknown_jit_is_refused(generated):
     with pytest.raises(SimulationError, match="jit='fast'.*auto, specialized, portable"):
         simulate(generated("cart_pendulum"), "rk4", [0.1, 1.0], None, t_end=0.01, h=1e-3,
