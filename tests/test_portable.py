@@ -148,7 +148,7 @@ def test_specialized_ready_remembers_a_miss_until_the_cache_index_changes(tmp_pa
     probes, stamp = [], [None]
     load = run._cache.load_overload
     monkeypatch.setattr(run._cache, "load_overload", lambda *a: probes.append(1) or load(*a))
-    monkeypatch.setattr(portable, "_index_stamp", lambda cache: stamp[0])
+    monkeypatch.setattr(portable, "_index_state", lambda cache: ("index", stamp[0]))
     for _ in range(3):
         assert not portable.specialized_ready(run, args)
     assert len(probes) == 1

@@ -229,11 +229,12 @@ def choose_ensemble(jit, specialized, module, method, args):
     return _bound(module, method, f"ensemble_{method}"), "portable"
 
 
-#: {(id(dispatcher), argument key): numba signature} and {(id(dispatcher), signature): the
-#: stamp of the on-disk cache index that did not hold it}: specialized_ready, which simulate
-#: calls on every run, types its arguments and reads the index once per key and index version.
+#: {argument key: numba signature} and {(cache index file, signature): the index's stamp when it
+#: did not hold that signature}: specialized_ready, which simulate calls on every run, types its
+#: arguments once per kind of arguments and reads a cache index once per version of it.
 _SIGNATURES: dict = {}
 _MISSES: dict = {}
+_UNSEEN = object()
 
 
 def _argument_key(value):
@@ -249,16 +250,19 @@ def _argument_key(value):
     return type(value)
 
 
-def _index_stamp(cache):
-    """(mtime, size) of a numba cache's index file, None when there is none yet (saving an
-    entry writes the index, which changes the stamp)."""
+def _index_state(cache):
+    """(path, stamp) of a numba cache's index file: stamp = (mtime, size), or None while there is
+    no index (saving an entry writes it, which changes the stamp); None when numba's internals
+    moved (then nothing is remembered)."""
     try:
-        info = os.stat(cache._cache_file._index_path)
-    except AttributeError:      # numba internals moved: a stamp that matches nothing
-        return object()
-    except OSError:
+        path = cache._cache_file._index_path
+    except AttributeError:
         return None
-    return (info.st_mtime_ns, info.st_size)
+    try:
+        info = os.stat(path)
+    except OSError:
+        return path, None
+    return path, (info.st_mtime_ns, info.st_size)
 
 
 def specialized_ready(dispatcher, args) -> bool:
@@ -268,7 +272,7 @@ def specialized_ready(dispatcher, args) -> bool:
     process may compile the glue meanwhile). Measured on the cart pole (midpoint, one
     simulate() call per 1 ms step, its glue not compiled): 450 us per call before."""
     try:
-        key = (id(dispatcher), tuple(_argument_key(a) for a in args))
+        key = tuple(_argument_key(a) for a in args)
         sig = _SIGNATURES.get(key)
         if sig is None:
             sig = _SIGNATURES[key] = tuple(dispatcher.typeof_pyval(a) for a in args)
@@ -277,12 +281,13 @@ def specialized_ready(dispatcher, args) -> bool:
         cache = getattr(dispatcher, "_cache", None)
         if cache is None:
             return False
-        stamp = _index_stamp(cache)
-        if (id(dispatcher), sig) in _MISSES and _MISSES[(id(dispatcher), sig)] == stamp:
+        index = _index_state(cache)
+        if index is not None and _MISSES.get((index[0], sig), _UNSEEN) == index[1]:
             return False
         result = cache.load_overload(sig, dispatcher.targetctx)
         if result is None:
-            _MISSES[(id(dispatcher), sig)] = stamp
+            if index is not None:
+                _MISSES[(index[0], sig)] = index[1]
             return False
         # as numba's Dispatcher.compile does with a cache hit
         dispatcher.targetctx.insert_user_function(result.entry_point, result.fndesc,

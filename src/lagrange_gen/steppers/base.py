@@ -49,13 +49,17 @@ the Newton methods (perf: NRT_incref/NRT_decref), and a 2 x 2 LU solve through c
 against 29 ns without. Only ``run_loop`` allocates (once per run) and keeps reference counting;
 the steps run in the stepping loop it calls (stepping_loop), which does not.
 
-Loop bounds: the partitioned methods' per-step loops (partitioned.py, symplectic_euler,
-verlet, composition, and the helpers below that take an ``n``) run to ``kern.N_COORDS``, not to
-an array's shape. In a generated module's glue that is a compile-time constant, so LLVM unrolls
-the loops of a small model into straight-line code (the 2 x 2 cart pendulum) and knows every
-trip count of a larger one; in the portable glue it is a field of the kernel table, a run-time
-value like the shape. Measured on the cart pendulum (best of 7 runs of 1e5 steps, taskset to
-one core, /tmp/port.py in the issue-13 note): symplectic_euler 94 -> 61 ns per step.
+Loop bounds: the fixed-step methods' per-step loops over the coordinates (the steps, the
+Newton loops of newton.py, explicit_rk's stages, and the helpers below that take an ``n``) run
+to ``kern.N_COORDS``, not to an array's shape. In a generated module's glue that is a
+compile-time constant, so LLVM unrolls the loops of a small model into straight-line code (the
+2 x 2 cart pendulum) and knows every trip count of a larger one; in the portable glue it is a
+field of the kernel table, a run-time value like the shape. run_loop refuses a state of another
+length. Measured on the cart pendulum (best of 7 runs of 1e5 steps, taskset to one core,
+/tmp/port.py in the issue-13 note), ns per step: symplectic_euler 97 -> 62, verlet 173 -> 105,
+composition 659 -> 362, midpoint 138 -> 129, implicit_euler 100 -> 84 (explicit_euler and rk4
+unchanged). Methods whose Newton unknowns are not the coordinates (the constrained ones) pass
+x.shape[0].
 
 Shapes: n coordinates; q, v, mom (n,); p (n_params,); extra (n_saved,) the method's saved
 fields (empty for the unconstrained methods).

@@ -202,9 +202,10 @@ def extrapolate(history, degree, i):
 def best_degree(history, x, kept, base, n):
     """The degree whose prediction of x (n,) came closest (max norm): 0 for base (n,) (the
     guess without history), d >= 1 for extrapolate(history, d) from the terms before x
-    (history (GUESS_DEGREE + 1, n), rows 0..d, kept of them valid; n passed: kern.N_COORDS). A sequence that polynomials extrapolate badly (h omega
-    near the stability limit) so falls back to a low degree. About GUESS_DEGREE^2 n / 2
-    multiply-adds, against a residual and a triangular solve per Newton iteration saved."""
+    (history (GUESS_DEGREE + 1, n), rows 0..d, kept of them valid; n passed: kern.N_COORDS). A
+    sequence that polynomials extrapolate badly (h omega near the stability limit) so falls back
+    to a low degree. About GUESS_DEGREE^2 n / 2 multiply-adds, against a residual and a
+    triangular solve per Newton iteration saved."""
     best_err = 0.0
     for i in range(n):
         best_err = max(best_err, abs(base[i] - x[i]))
