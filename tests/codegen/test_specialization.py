@@ -153,6 +153,8 @@ def test_composed_kernels_equal_the_symbolic_ones(tmp_path):
     composed = _generate(tmp_path / "c", n_link_pendulum(3), methods=["verlet", "midpoint"])
     symbolic = _generate(tmp_path / "s", n_link_pendulum(3), methods=[])
     assert "composed from kernels" in composed.__doc__ and "composed" not in symbolic.__doc__
+    for name in ("dynamics", "momentum_rate_jacobian"):     # each of the two, not one of them
+        assert "composed" in getattr(composed, name).py_func.__doc__, name
     rng = np.random.default_rng(21)
     p = composed.DEFAULT_PARAMS * np.array([1.3, 0.8, 1.1])
     out = {m: [np.empty((3, 3)), np.empty(3), np.empty((3, 3)), np.empty((3, 3))] for m in ("c", "s")}
