@@ -3,8 +3,9 @@ emit against a reference written from Lagrange's equations in plain sympy (refer
 every Jacobian kernel against finite differences (fd.py), as printed Python and compiled.
 
 Model classes (CASES) are chosen so that together they emit every kernel kind: H(q) models emit
-the symbolic kernels, constrained ones generated for rattle (the only methods whose dynamics
-callers all use the momentum rate) get the composed dynamics and momentum_rate_jacobian,
+the symbolic kernels, constrained ones generated for rattle (whose callers of the dynamics all
+use the momentum rate, as verlet's and midpoint's do) get the composed dynamics and
+momentum_rate_jacobian,
 constant-H models the rhs kernel and the pre-factored forward dynamics,
 constrained models the constraint kernels, models with elements the element kernels;
 test_every_kernel_kind_was_checked asserts it. Profiles: profiles.py.
