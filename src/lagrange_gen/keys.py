@@ -11,13 +11,14 @@ from importlib import metadata
 from pathlib import Path
 
 from .errors import StaleModuleError
+from .sources import source_hashes
 
 _PACKAGE = Path(__file__).resolve().parent
 # Sources that shape the text generated from a model (equations, kernels, module layout, glue
 # template): a change is seen by re-deriving (--check, load), not by the KEY. Hashed into the
 # record load() keeps next to a module to skip re-deriving (codegen.generate.module_current).
 _GENERATOR_PARTS = ("model.py", "model_file.py", "symbols.py", "loads.py", "model_input.py",
-                    "params.py", "keys.py", "derive", "codegen", "steppers/registry.py")
+                    "params.py", "keys.py", "sources.py", "derive", "codegen", "steppers/registry.py")
 # The header lines that record hashes of the rest of the file (a hash cannot hash itself).
 KEY_PREFIX = "KEY = "
 TEXT_SHA_PREFIX = "TEXT_SHA = "
@@ -45,15 +46,6 @@ def generator_hash() -> str:
 
 def model_hash(source_text: str) -> str:
     return hashlib.sha256(source_text.encode()).hexdigest()
-
-
-def source_hashes(files) -> dict:
-    """{path relative to lagrange_gen: sha256 of its bytes (16 hex digits), or "missing"}."""
-    hashes = {}
-    for name in files:
-        path = _PACKAGE / name
-        hashes[name] = hashlib.sha256(path.read_bytes()).hexdigest()[:16] if path.is_file() else "missing"
-    return hashes
 
 
 def _without_lines(text, prefixes):

@@ -23,7 +23,7 @@ variants were slower at n = 8 to 24 (/tmp/s2/ch.py: 424 against 522 and 672 ns a
 
 import math
 
-from numba import njit
+from .jit import njit
 
 # Relative pivot threshold below which a matrix is reported singular instead of being factored
 # into garbage (e.g. the spherical pendulum's H at sin(q1) = 0).

@@ -3,8 +3,6 @@ decorator and self-registration every generated module uses at import."""
 
 from __future__ import annotations
 
-import functools
-import glob
 import hashlib
 import importlib.util
 import sys
@@ -128,70 +126,6 @@ def register_module(namespace):
         if isinstance(owner, types.ModuleType) and owner.__dict__ is namespace:
             sys.modules[name] = owner
             return
-
-
-def njit(*args, **kwargs):
-    """``numba.njit`` for generated modules: with ``cache=True``, an entry of numba's on-disk cache
-    that cannot be loaded (truncated, garbage, written by something else) is a cache miss: the
-    entry is removed, the function compiled again, and one warning line printed per module."""
-    import numba
-    decorate = numba.njit(**kwargs)
-    if args:                                   # used as @njit without arguments
-        return _guard_cache(decorate(args[0]))
-    return lambda fn: _guard_cache(decorate(fn))
-
-
-_WARNED = set()
-
-
-def _guard_cache(dispatcher):
-    from numba.core.caching import FunctionCache
-    cache = getattr(dispatcher, "_cache", None)
-    if type(cache) is FunctionCache:
-        cache.__class__ = _miss_on_error_cache_class()
-    return dispatcher
-
-
-@functools.lru_cache(maxsize=None)
-def _miss_on_error_cache_class():
-    """numba's FunctionCache whose load/save failures are cache misses (defined on first use:
-    numba is imported only by generated modules)."""
-    from numba.core.caching import FunctionCache
-
-    class MissOnErrorCache(FunctionCache):
-        def load_overload(self, sig, target_context):
-            try:
-                return super().load_overload(sig, target_context)
-            except Exception as exc:      # an unreadable entry: remove it and compile again
-                _discard_entry(self, exc)
-                return None
-
-        def save_overload(self, sig, data):
-            try:
-                super().save_overload(sig, data)
-            except Exception as exc:      # the compiled function works; only the cache failed
-                _discard_entry(self, exc)
-
-    return MissOnErrorCache
-
-
-def _discard_entry(cache, exc):
-    """Delete one function's cache files (index and data; names as numba.core.caching makes
-    them) and warn once per generated module."""
-    directory, base = Path(cache.cache_path), cache._impl.filename_base
-    removed = 0
-    for entry in [directory / f"{base}.nbi", *directory.glob(f"{glob.escape(base)}.*.nbc")]:
-        try:
-            entry.unlink()
-            removed += 1
-        except OSError:
-            pass
-    source = cache._py_func.__code__.co_filename
-    if source not in _WARNED:
-        _WARNED.add(source)
-        what = f"{type(exc).__name__}: {exc}".splitlines()[0]
-        print(f"lagrange-gen: warning: numba cache of {source} unreadable ({what}); removed "
-              f"{removed} file(s) in {directory} and compiling again", file=sys.stderr)
 
 
 def _kernel_args(module):

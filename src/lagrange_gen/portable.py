@@ -153,8 +153,7 @@ def kernel_table(module, method):
 
 def _library_hash(method: str) -> str:
     """sha256 prefix of every package file the portable glue of ``method`` compiles."""
-    from .codegen.needs import source_closure
-    from .keys import source_hashes
+    from .sources import source_closure, source_hashes
     from .steppers.registry import LOOPS, spec
     loop_module = LOOPS[spec(method).adaptive][0]
     files = source_closure([f"steppers.{method}", f"steppers.{loop_module}"])

@@ -15,9 +15,9 @@ import pytest
 
 import lagrange_gen
 from conftest import MODELS_DIR, ROOT
-from lagrange_gen import keys
+from lagrange_gen import keys, sources
 from lagrange_gen.cli import main
-from lagrange_gen.codegen import generate_model, needs
+from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.generate import check_generated
 from lagrange_gen.errors import SimulationError, StaleModuleError
 from lagrange_gen.loader import import_generated
@@ -102,13 +102,13 @@ def test_comment_in_the_model_file_changes_nothing_and_nothing_recompiles(cart):
 @pytest.fixture
 def package_copy(tmp_path, monkeypatch):
     """A copy of the lagrange_gen sources whose files the generator hashes and the import check
-    reads (keys._PACKAGE, needs._PACKAGE point at it); the code that runs stays the installed
+    reads (keys._PACKAGE, sources._PACKAGE point at it); the code that runs stays the installed
     one, so a test can edit a stepper's text without touching the package."""
     copy = tmp_path / "lagrange_gen"
     shutil.copytree(Path(lagrange_gen.__file__).parent, copy,
                     ignore=shutil.ignore_patterns("__pycache__", "*.nb[ic]"))
     monkeypatch.setattr(keys, "_PACKAGE", copy)
-    monkeypatch.setattr(needs, "_PACKAGE", copy)
+    monkeypatch.setattr(sources, "_PACKAGE", copy)
     return copy
 
 

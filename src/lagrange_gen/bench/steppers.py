@@ -27,7 +27,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..steppers import registry
 from ..steppers.base import N_STATS

@@ -21,10 +21,11 @@ from ..derive import derive
 from ..errors import GenerationError
 from ..model_file import load_model
 from ..keys import (derivation_record_path, generator_hash, key_of_text, model_hash, read_header, regeneration_command,
-                    source_hashes, text_hash, why_stale)
+                    text_hash, why_stale)
+from ..sources import source_closure, source_hashes
 from .emit import render_kernel
 from .compose import compositions
-from .needs import methods_needs, select_kernels, source_closure
+from .needs import methods_needs, select_kernels
 from .printer import Inputs
 from .render import COMPILED_IMPORTS, render_module
 from .spec import make_kernels

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import ast
 from functools import lru_cache
-from pathlib import Path
 
-_PACKAGE = Path(__file__).resolve().parent.parent     # src/lagrange_gen
+from ..sources import module_path, relative_module
+
 _KERN = "kern"                                         # the parameter naming the generated module
 
 #: What a loop function reaches besides its own calls: base.run_loop calls the stepping loop it
@@ -97,10 +97,10 @@ class _Module:
         self.names, self.modules = {}, {}   # imported function name -> module; alias -> module
         for node in tree.body:
             if isinstance(node, ast.ImportFrom) and node.level:
-                base = _relative(dotted, node.level, node.module)
+                base = relative_module(dotted, node.level, node.module)
                 for alias in node.names:
                     child = f"{base}.{alias.name}" if base else alias.name
-                    if _path(child) is not None:
+                    if module_path(child) is not None:
                         self.modules[alias.asname or alias.name] = child
                     else:
                         self.names[alias.asname or alias.name] = (base, alias.name)
@@ -117,32 +117,15 @@ class _Module:
         return None
 
 
-def _relative(dotted, level, module):
-    parts = dotted.split(".")[:-level] if level <= dotted.count(".") + 1 else []
-    if module:
-        parts += module.split(".")
-    return ".".join(parts)
-
-
-def _path(dotted):
-    """File of a package module given relative to lagrange_gen (None if not a module file)."""
-    path = _PACKAGE.joinpath(*dotted.split(".")) if dotted else _PACKAGE
-    if path.with_suffix(".py").is_file():
-        return path.with_suffix(".py")
-    if (path / "__init__.py").is_file():
-        return path / "__init__.py"
-    return None
-
-
 @lru_cache(maxsize=None)
 def _parse_cached(dotted, mtime):
-    path = _path(dotted)
+    path = module_path(dotted)
     return _Module(dotted, ast.parse(path.read_text(), str(path)))
 
 
 def _parse(dotted):
     """Parsed module (cached per file modification time: steppers change while we run)."""
-    path = _path(dotted)
+    path = module_path(dotted)
     if path is None:
         return _Module(dotted, ast.Module(body=[], type_ignores=[]))
     return _parse_cached(dotted, path.stat().st_mtime_ns)
@@ -188,41 +171,3 @@ def select_kernels(dyn, methods) -> dict:
                                       f"generate (kernels: {', '.join(table)})")
             why.setdefault(name, []).append(method)
     return {name: why[name] for name in table if name in why}
-
-
-def source_closure(roots) -> tuple:
-    """Package files (paths relative to lagrange_gen, sorted) of the modules ``roots`` (dotted,
-    relative to lagrange_gen: "steppers.rattle", "linalg") and of every package module they
-    import, transitively, at any level of the file (a function-level import counts too).
-
-    This is what compiled code of a generated module is built from, so what its KEY hashes.
-    Package ``__init__`` files are not followed: they run at import, numba compiles nothing
-    from them."""
-    seen, files, todo = set(), [], list(roots)
-    while todo:
-        dotted = todo.pop()
-        path = _path(dotted)
-        if dotted in seen or path is None or path.name == "__init__.py":
-            continue
-        seen.add(dotted)
-        files.append(path.relative_to(_PACKAGE).as_posix())
-        todo += _imported_modules(dotted, ast.parse(path.read_text(), str(path)))
-    return tuple(sorted(files))
-
-
-def _imported_modules(dotted, tree):
-    """Dotted names (relative to lagrange_gen) of the package modules ``tree`` imports."""
-    found = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = _relative(dotted, node.level, node.module)
-            elif (node.module or "").split(".")[0] == _PACKAGE.name:
-                base = node.module.partition(".")[2]
-            else:
-                continue
-            found.append(base)
-            found += [f"{base}.{a.name}" if base else a.name for a in node.names]
-        elif isinstance(node, ast.Import):
-            found += [a.name.partition(".")[2] for a in node.names if a.name.split(".")[0] == _PACKAGE.name]
-    return [name for name in found if name and _path(name) is not None]

@@ -8,7 +8,7 @@ a prescribed strain path this is the play (backlash) operator; the element force
 """
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 
 @njit(cache=True, _nrt=False)

@@ -68,7 +68,7 @@ fields (empty for the unconstrained methods).
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .. import linalg
 from ..status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE

@@ -24,7 +24,7 @@ indefinite and go through newton.solve (LU with partial pivoting, base.newton_so
 velocity projections use the SPD Schur complement J H^-1 J^T (Cholesky).
 """
 
-from numba import njit
+from ..jit import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS

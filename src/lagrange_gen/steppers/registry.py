@@ -7,7 +7,7 @@ dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` l
 generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
 and its compiled code, cores included, is loaded from numba's cache by the next process. The
 KEY of a generated module hashes the sources of the steppers it glues and of the package
-modules they import (codegen.needs.source_closure), so a change there regenerates the module
+modules they import (sources.source_closure), so a change there regenerates the module
 and thereby invalidates that cache.
 
 Glue signature of the fixed-step methods::
@@ -127,8 +127,8 @@ _PORTABLE_GLUE = '''"""Portable glue of {method}, written by lagrange_gen.portab
 
 Library version {digest} (a hash of the package files it compiles)."""
 import numpy as np
-from numba import njit
 
+from lagrange_gen.jit import njit
 from lagrange_gen.steppers import {method} as _stepper_{method}
 from lagrange_gen.steppers.{loop_module} import {loop} as _{loop}{loop_import}{loop_def}
 

@@ -1,0 +1,135 @@
+"""``numba.njit`` with an on-disk cache that is never stale and never fatal.
+
+Every jitted function of the package and of the generated modules is decorated by ``njit``
+here. With ``cache=True`` it changes two things in numba's cache (numba.core.caching):
+
+- **Key.** numba keys an entry on the text of the one file that defines the function. The
+  compiled code also holds every function that function calls, from other files: when
+  linalg.py changed and constrained.py did not, numba served the old constrained.solve_rows with
+  the old Cholesky solve inside, without a word (tests/test_jit_cache.py). For a function defined
+  in the package, the entry's stamp also holds the hashes of the module's source closure
+  (sources.source_closure: every package file it imports, transitively), so a change in any of
+  them compiles it again. Generated modules and the portable glue need no more than numba's own
+  key: their text carries the hashes of the package files they compile (keys.py, portable.py).
+- **Failure.** An entry that cannot be loaded or saved (truncated, garbage, written by something
+  else) is a cache miss: the entry is removed, the function compiled again, and one warning line
+  printed per source file.
+
+numba is imported on first use, so importing this module costs nothing.
+"""
+
+from __future__ import annotations
+
+import functools
+import glob
+import json
+import sys
+from pathlib import Path
+
+from .sources import module_name, source_closure, source_hashes
+
+
+def njit(*args, **kwargs):
+    """``numba.njit(**kwargs)``, usable as ``@njit`` or ``@njit(...)``; with ``cache=True`` the
+    cache is keyed and guarded as the module docstring says."""
+    import numba
+    decorate = numba.njit(**kwargs)
+    if args:                                   # used as @njit without arguments
+        return _guard_cache(decorate(args[0]))
+    return lambda fn: _guard_cache(decorate(fn))
+
+
+def closure_stamp(path) -> str:
+    """JSON {package file: sha256 prefix} of the source closure of the package module at
+    ``path``; what a cache entry of a function defined there is valid for."""
+    return json.dumps(source_hashes(source_closure([module_name(path)])), sort_keys=True)
+
+
+def _guard_cache(dispatcher):
+    from numba.core.caching import FunctionCache
+    cache = getattr(dispatcher, "_cache", None)
+    if type(cache) is not FunctionCache:       # not cached (NullCache), or already guarded
+        return dispatcher
+    source = dispatcher.py_func.__code__.co_filename
+    if module_name(source) is None:
+        cache.__class__ = miss_on_error_cache_class()
+    else:
+        cache.__class__ = closure_keyed_cache_class()
+        cache.closure_source = source
+    return dispatcher
+
+
+@functools.lru_cache(maxsize=None)
+def miss_on_error_cache_class():
+    """numba's FunctionCache whose load/save failures are cache misses (defined on first use, so
+    that numba is imported only when something is jitted)."""
+    from numba.core.caching import FunctionCache
+
+    class MissOnErrorCache(FunctionCache):
+        def load_overload(self, sig, target_context):
+            try:
+                return super().load_overload(sig, target_context)
+            except Exception as exc:      # an unreadable entry: remove it and compile again
+                _discard_entry(self, exc)
+                return None
+
+        def save_overload(self, sig, data):
+            try:
+                super().save_overload(sig, data)
+            except Exception as exc:      # the compiled function works; only the cache failed
+                _discard_entry(self, exc)
+
+    return MissOnErrorCache
+
+
+@functools.lru_cache(maxsize=None)
+def closure_keyed_cache_class():
+    """MissOnErrorCache of a package function, whose stamp also holds closure_stamp of the file
+    that defines it (``closure_source``, set by _guard_cache)."""
+
+    class ClosureKeyedCache(miss_on_error_cache_class()):
+        # The stamp is made on the first load or save, not at decoration: reading the closure
+        # costs milliseconds per module, and most processes load a glue that already holds
+        # these functions without touching their caches.
+        closure_source = None
+
+        def _stamp_closure(self):
+            if self.closure_source is not None:
+                # numba compares this stamp with the one stored in the index file: a mismatch
+                # drops every entry of the function (caching.IndexDataCacheFile._load_index).
+                cache_file = self._cache_file
+                cache_file._source_stamp = (cache_file._source_stamp,
+                                            closure_stamp(self.closure_source))
+                self.closure_source = None
+
+        def load_overload(self, sig, target_context):
+            self._stamp_closure()
+            return super().load_overload(sig, target_context)
+
+        def save_overload(self, sig, data):
+            self._stamp_closure()
+            super().save_overload(sig, data)
+
+    return ClosureKeyedCache
+
+
+_WARNED = set()
+
+
+def _discard_entry(cache, exc):
+    """Delete one function's cache files (index and data; names as numba.core.caching makes
+    them) and warn once per source file."""
+    directory, base = Path(cache.cache_path), cache._impl.filename_base
+    removed = 0
+    for entry in [directory / f"{base}.nbi", *directory.glob(f"{glob.escape(base)}.*.nbc")]:
+        try:
+            entry.unlink()
+            removed += 1
+        except OSError:
+            pass
+    source = cache._py_func.__code__.co_filename
+    if source not in _WARNED:
+        _WARNED.add(source)
+        what = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        print(f"lagrange-gen: warning: numba cache of {source} unreadable ({what}); removed "
+              f"{removed} file(s) in {directory} and compiling again", file=sys.stderr)
