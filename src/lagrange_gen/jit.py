@@ -26,13 +26,16 @@ import json
 import sys
 from pathlib import Path
 
+from .numba_typing_memo import install as install_typing_memo
 from .sources import module_name, source_closure, source_hashes
 
 
 def njit(*args, **kwargs):
     """``numba.njit(**kwargs)``, usable as ``@njit`` or ``@njit(...)``; with ``cache=True`` the
-    cache is keyed and guarded as the module docstring says."""
+    cache is keyed and guarded as the module docstring says. The first call installs
+    numba_typing_memo (faster typing of the kernels' scalar arithmetic)."""
     import numba
+    install_typing_memo()
     decorate = numba.njit(**kwargs)
     if args:                                   # used as @njit without arguments
         return _guard_cache(decorate(args[0]))
