@@ -88,7 +88,7 @@ SUITES = {
     "hard": ("HARD_CASES 3-8 with pass/fail verdicts against their references", _hard),
     "report": ("precision + stability + hard, and the method-choice summary", _report),
     "constraints": ("linkage drift per method, rattle vs verlet cost, breaking stiffness", _constraints),
-    "scale": ("n-link pendulum n = 1..20: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
+    "scale": ("n-link pendulum n = 1..32: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
     "speed": ("the speed goals in one run: vs PyDy at equal error, hand loops, MuJoCo, cold start",
               _speed),
     "ensemble": ("members per second of lagrange_gen.ensemble on 1 and 2 threads vs a simulate loop",
