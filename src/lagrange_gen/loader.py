@@ -1,5 +1,6 @@
-"""Import generated modules by path, generating them first when given a model file; the numba
-decorator and self-registration every generated module uses at import."""
+"""Import generated modules by path, generating them first when given a model file; the
+self-registration every generated module runs at import (its numba decorator is
+lagrange_gen.jit.njit)."""
 
 from __future__ import annotations
 
