@@ -209,3 +209,41 @@ def test_portable_ensemble_refuses_a_model_with_events(event_module):
     mod = event_module("cart_pendulum_events")
     with pytest.raises(SimulationError, match="no event code.*jit='auto' or 'specialized'"):
         lg.ensemble(mod, "verlet", q0=np.array([[0.3, 1.0]]), t_end=0.01, h=1e-3, jit="portable")
+
+
+def test_library_versions_unused_for_long_are_removed_when_a_new_one_is_made(tmp_path):
+    import os
+    import time
+    old = time.time() - (portable.UNUSED_DAYS + 1) * 86400
+    recent = time.time() - (portable.UNUSED_DAYS - 1) * 86400
+    versions = {name: tmp_path / name for name in ("0123456789abcdef", "fedcba9876543210",
+                                                   "00000000000000aa", "not-a-version-dir")}
+    for folder in versions.values():
+        (folder / "__pycache__").mkdir(parents=True)
+        (folder / "run_verlet.py").write_text("# glue\n")
+    os.utime(versions["0123456789abcdef"], (old, old))
+    os.utime(versions["not-a-version-dir"], (old, old))
+    os.utime(versions["fedcba9876543210"], (recent, recent))
+    current = tmp_path / "00000000000000aa"
+    os.utime(current, (old, old))                      # the one being made is never removed
+    removed = portable.remove_unused_versions(current)
+    assert removed == [versions["0123456789abcdef"]]
+    assert not versions["0123456789abcdef"].exists()
+    assert all(versions[name].exists() for name in ("fedcba9876543210", "00000000000000aa",
+                                                      "not-a-version-dir"))
+
+
+def test_using_a_library_version_marks_it_used(tmp_path, monkeypatch):
+    import os
+    monkeypatch.setenv(portable.DIR_ENV, str(tmp_path))
+    portable._glue_module.cache_clear()
+    try:
+        portable._glue_module("explicit_euler")
+        folder = tmp_path / portable._library_hash("explicit_euler")
+        assert (folder / "run_explicit_euler.py").is_file()
+        os.utime(folder, (0, 0))
+        portable._glue_module.cache_clear()
+        portable._glue_module("explicit_euler")
+        assert os.stat(folder).st_mtime > 86400
+    finally:
+        portable._glue_module.cache_clear()

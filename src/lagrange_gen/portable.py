@@ -21,7 +21,8 @@ compile (fixed_run.py).
 Layout: the portable glue sources (registry.portable_glue_source) are written to
 ``portable_dir()/<library hash>/``; the hash covers every package file the glue compiles, so a
 changed library gives new files and numba never loads a stale entry (numba's cache checks only
-the glue file itself).
+the glue file itself). A version directory no process has used for UNUSED_DAYS is removed when
+a new one is made (remove_unused_versions), so upgrades do not pile up compiled glue.
 """
 
 from __future__ import annotations
@@ -39,6 +40,11 @@ from pathlib import Path
 #: Environment variable naming the directory of the portable glue sources (default
 #: ~/.cache/lagrange_gen/portable, or a temporary directory when the home is not writable).
 DIR_ENV = "LAGRANGE_GEN_PORTABLE_DIR"
+
+#: A library version's glue directory (portable_dir()/<library hash>) not used for this many days
+#: is removed when a new version's directory is made: every upgrade of lagrange-gen, and every
+#: edit of a stepper in a checkout, writes a new one (a few MB of compiled glue each).
+UNUSED_DAYS = 30
 
 #: The values of simulate(jit=...).
 JIT_MODES = ("auto", "specialized", "portable")
@@ -170,8 +176,14 @@ def _glue_module(method: str):
     source = portable_glue_source(method, digest)
     folder = portable_dir() / digest
     path = folder / f"run_{method}.py"
-    if not path.exists() or path.read_text() != source:
+    if not folder.is_dir():
         folder.mkdir(parents=True, exist_ok=True)
+        remove_unused_versions(folder)
+    try:
+        os.utime(folder)               # marks the version used now (remove_unused_versions)
+    except OSError:                    # a shared directory we may not touch: it is only a mark
+        pass
+    if not path.exists() or path.read_text() != source:
         fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".run_{method}.", suffix=".tmp")
         with os.fdopen(fd, "w") as f:
             f.write(source)
@@ -184,6 +196,29 @@ def _glue_module(method: str):
         sys.modules[name] = module
         spec.loader.exec_module(module)
     return module
+
+
+def remove_unused_versions(current: Path) -> list:
+    """Remove the sibling library-version directories of ``current`` (16 hex digits, as
+    _library_hash names them; anything else is left alone) whose modification time, refreshed
+    by every process that uses one (_glue_module), is more than UNUSED_DAYS old. A process still
+    loading from one loses only its cache: an unreadable entry is a miss (lagrange_gen.jit).
+    Returns the directories removed."""
+    import shutil
+    import time
+    cutoff = time.time() - UNUSED_DAYS * 86400
+    removed = []
+    for entry in current.parent.iterdir():
+        name = entry.name
+        if entry == current or len(name) != 16 or not all(c in "0123456789abcdef" for c in name):
+            continue
+        try:
+            if entry.is_dir() and entry.stat().st_mtime < cutoff:
+                shutil.rmtree(entry)
+                removed.append(entry)
+        except OSError:                # another process removed or is writing it: leave it
+            pass
+    return removed
 
 
 def _bound(module, method, function):
