@@ -8,8 +8,9 @@ the source closure of a module (source_closure):
 - numba's on-disk cache of the package's own ``cache=True`` functions (lagrange_gen.jit), so a
   changed callee recompiles its cached callers.
 
-Light on purpose (no sympy, no numba): lagrange_gen.jit reads it while the package's jitted
-modules are being imported.
+Light on purpose (no sympy, no numba): lagrange_gen.jit, which every jitted module of the
+package imports, imports it too (the closure itself is read at a function's first cache load or
+save).
 """
 
 from __future__ import annotations
