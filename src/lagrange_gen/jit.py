@@ -15,6 +15,10 @@ here. With ``cache=True`` it changes two things in numba's cache (numba.core.cac
   else) is a cache miss: the entry is removed, the function compiled again, and one warning line
   printed per source file.
 
+An uncached function of the stepper library (CALLEE_MODULES) is compiled without numba's
+CPython and cfunc wrappers, which only a call from Python or a first-class function value would
+use; a call from Python still works, through a twin compiled on first use (jit_callee).
+
 numba is imported on first use, so importing this module costs nothing.
 """
 
@@ -23,6 +27,7 @@ from __future__ import annotations
 import functools
 import glob
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -32,14 +37,41 @@ from .sources import module_name, source_closure, source_hashes
 
 def njit(*args, **kwargs):
     """``numba.njit(**kwargs)``, usable as ``@njit`` or ``@njit(...)``; with ``cache=True`` the
-    cache is keyed and guarded as the module docstring says. The first call installs
-    numba_typing_memo (faster typing of the kernels' scalar arithmetic)."""
+    cache is keyed and guarded as the module docstring says, and an uncached function of the
+    stepper library is compiled for jitted callers only (compiled_for_jitted_callers, jit_callee).
+    The first call installs numba_typing_memo (faster typing of the kernels' scalar arithmetic)."""
     import numba
     install_typing_memo()
-    decorate = numba.njit(**kwargs)
+
+    def decorate(fn):
+        if compiled_for_jitted_callers(fn, kwargs):
+            from .jit_callee import callee_dispatcher
+            return callee_dispatcher(fn, kwargs)
+        return _guard_cache(numba.njit(**kwargs)(fn))
+
     if args:                                   # used as @njit without arguments
-        return _guard_cache(decorate(args[0]))
-    return lambda fn: _guard_cache(decorate(fn))
+        return decorate(args[0])
+    return decorate
+
+
+#: Package modules (relative to lagrange_gen) whose uncached functions only jitted code calls.
+CALLEE_MODULES = ("linalg", "steppers.")
+
+
+def compiled_for_jitted_callers(fn, options) -> bool:
+    """Whether ``fn`` (decorated with numba ``options``) is compiled without numba's wrappers:
+    it is defined in CALLEE_MODULES and not cached (a cached function is loaded through its
+    wrapper). $LAGRANGE_GEN_NUMBA_WRAPPERS=1 keeps the wrappers on every function."""
+    if options.get("cache") or os.environ.get(WRAPPERS_ENV) == "1":
+        return False
+    name = module_name(fn.__code__.co_filename) or ""
+    return any(name == module or (module.endswith(".") and name.startswith(module))
+               for module in CALLEE_MODULES)
+
+
+#: Environment variable: "1" compiles every function with numba's wrappers (the comparison of
+#: tests/test_jit_callee.py, and a way out should a numba release break jit_callee).
+WRAPPERS_ENV = "LAGRANGE_GEN_NUMBA_WRAPPERS"
 
 
 def closure_stamp(path) -> str:

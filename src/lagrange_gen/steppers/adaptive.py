@@ -88,7 +88,7 @@ ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS.
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 from . import events

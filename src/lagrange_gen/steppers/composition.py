@@ -27,7 +27,7 @@ from collections import namedtuple
 from functools import partial
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from . import verlet

@@ -26,7 +26,7 @@ verlet: the method pays off in accuracy (on the cart pendulum over t = 1 at h = 
 
 from functools import partial
 
-from numba import njit
+from ..jit import njit
 
 from .base import FAST, inline_step
 from .composition import (Workspace, allocate, composed_step, linear_radius,  # noqa: F401

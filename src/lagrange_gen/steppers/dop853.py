@@ -27,7 +27,7 @@ from collections import namedtuple
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from .base import FAST, accel

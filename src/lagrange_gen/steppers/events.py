@@ -35,7 +35,7 @@ import warnings
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .base import FAST
 

@@ -20,7 +20,7 @@ index1 the KKT solve of the acceleration-level constrained system.
 """
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from .base import FAST

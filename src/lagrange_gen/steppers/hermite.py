@@ -22,7 +22,7 @@ Shapes: n coordinates; q, v (n,).
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from .base import FAST, accel, copy_into

@@ -18,7 +18,7 @@ import sys
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from . import newton

@@ -28,7 +28,7 @@ from collections import namedtuple
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS

@@ -31,7 +31,7 @@ import math
 import sys
 import types
 
-from numba import njit
+from ..jit import njit
 
 from ..linalg import lu_solve_inplace
 from ..status import NEWTON_DIVERGED, NON_FINITE, OK

@@ -41,7 +41,7 @@ import sys
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..linalg import lu_inplace, lu_solve_inplace
 from ..nonsmooth.play import return_map

@@ -45,7 +45,7 @@ Shapes: q, mom, u, w, R, f, scratch (n,); H, A, Jq, Jqd, dHw (n, n).
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK, SINGULAR_MASS
 from . import newton

@@ -40,7 +40,7 @@ a singular J H^-1 J^T in the velocity projection is SINGULAR_MASS.
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..linalg import cholesky_inplace, cholesky_solve_inplace
 from ..status import OK, SINGULAR_MASS

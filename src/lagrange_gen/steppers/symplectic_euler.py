@@ -17,7 +17,7 @@ explicit kick-drift v+ = v + h a(q, t), q+ = q + h v+: one force evaluation per 
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from . import verlet

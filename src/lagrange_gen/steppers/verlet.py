@@ -25,7 +25,7 @@ import math
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..status import OK
 from .base import FAST, accel, explicit_path, matvec, momentum_from_velocity, inline_step

@@ -28,7 +28,7 @@ call with that generated constant.
 from collections import namedtuple
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .base import FAST
 
