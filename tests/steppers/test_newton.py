@@ -135,12 +135,12 @@ _SIMPLIFIED = newton.problem(__name__ + "._simplified", residual=residual_counte
 
 
 @njit
-def _solve_simplified(kind, a, x, tol, max_iter, counts):
+def _solve_simplified(kind, a, x, tol, max_iter, counts, contraction_stop=False):
     n = x.shape[0]
     F, scratch = np.zeros(n), np.zeros(n)
     J, piv = np.zeros((n, n)), np.zeros(n, dtype=np.int64)
     return newton.solve_simplified(_SIMPLIFIED, None, (kind, a, counts), x, F, J, piv, scratch,
-                                   tol, max_iter, False, n)
+                                   tol, max_iter, False, n, contraction_stop)
 
 
 def test_simplified_newton_reaches_newtons_root_with_fewer_jacobians():
@@ -151,6 +151,23 @@ def test_simplified_newton_reaches_newtons_root_with_fewer_jacobians():
     status, iters, _ = _solve_simplified(ROOTS, A, x, 1e-13, 50, counts)
     assert status == OK and np.max(np.abs(x - root)) < 1e-13
     assert counts[0] == 1 and counts[1] == iters and iters >= 3
+
+
+def test_simplified_newtons_contraction_stop_saves_one_iteration_within_the_tolerance():
+    """With contraction_stop (verlet, symplectic Euler) the iteration stops when the observed
+    contraction bounds the error left below the tolerance: one iteration before the increment
+    itself is that small (the compositions' rule), with an error below tol but above the other
+    rule's."""
+    root, tol = np.sqrt(A), 1e-10
+    runs = {}
+    for contraction_stop in (False, True):
+        x, counts = root * (1 + 1e-3), np.zeros(2)
+        status, iters, _ = _solve_simplified(ROOTS, A, x, tol, 50, counts, contraction_stop)
+        assert status == OK
+        runs[contraction_stop] = iters, np.max(np.abs(x - root))
+    (iters_increment, err_increment), (iters_contraction, err_contraction) = runs[False], runs[True]
+    assert iters_contraction == iters_increment - 1
+    assert err_increment < err_contraction <= tol * np.max(root)
 
 
 def test_simplified_newton_refactors_when_the_contraction_is_slow():

@@ -87,16 +87,19 @@ def jacobian_kick(kern, args, u, A):
 # every cache cold 20.5 -> 21.7 s, most of it numba's inlining pass copying the larger step,
 # which lagrange_gen.numba_inline_copy then took back (run_verlet 14.3 -> 9.7 s).
 @njit(inline="always")
-def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, f, scratch):
+def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, f, scratch,
+               contraction_stop):
     """Solve H(q) u + b(q, t) = mom + hk f(q, u, t) for u (n,); u holds the initial guess on
     entry (b: the T1 = b . v term of T, zero on most models). On entry H holds H(q, t) and A,
-    piv its factors (base.factor_mass), the first Newton matrix.
+    piv its factors (base.factor_mass), the first Newton matrix. contraction_stop: the stopping
+    rule (newton.solve_simplified; False in the compositions).
 
     On return H still holds H(q), A the factors last used, u the solution.
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
     return newton.solve_simplified(_KICK, kern, (q, mom, t, hk, p, H, Jq, Jqd, f), u, R, A, piv,
-                                   scratch, tol, max_iter, True, kern.N_COORDS)
+                                   scratch, tol, max_iter, True, kern.N_COORDS,
+                                   contraction_stop)
 
 
 @njit(inline="always")
@@ -132,10 +135,12 @@ def jacobian_drift(kern, args, w, A):
 
 
 @njit(inline="always")
-def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R, q_new, scratch):
+def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R, q_new, scratch,
+                contraction_stop):
     """Solve H(q_new, td) w + b(q_new, td) = mom with q_new = q + hd (u + w) for w (n,); w holds
     the initial guess on entry (td: the time of the new position), A and piv the factors the
     kick left (of H(q) or of the kick's Jacobian), the drift's first Newton matrix.
+    contraction_stop: as solve_kick's.
 
     On return q_new = q + hd (u + w) and H holds H(q_new) (unfactored).
     Returns (status, iterations, max-norm of the residual at the last iterate).
@@ -143,7 +148,7 @@ def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R,
     status, iters, resid = newton.solve_simplified(_DRIFT, kern,
                                                    (q, u, mom, hd, td, p, H, dHw, q_new),
                                                    w, R, A, piv, scratch, tol, max_iter, True,
-                                                   kern.N_COORDS)
+                                                   kern.N_COORDS, contraction_stop)
     if status == OK:
         for i in range(kern.N_COORDS):
             q_new[i] = q[i] + hd * (u[i] + w[i])

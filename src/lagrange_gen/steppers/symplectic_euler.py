@@ -70,7 +70,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         return status, 0, 0.0
     status, iters, resid = solve_kick(kern, q, mom, t, h, p, settings.newton_tol,
                                       settings.max_iter, ws.H, ws.A, ws.Jq, ws.Jqd, ws.piv, u,
-                                      ws.R, ws.f, ws.s)
+                                      ws.R, ws.f, ws.s, True)
     if status != OK:
         return status, iters, resid
     ws.carried[2] = best_degree(ws.history, u, kept, v, n)

@@ -87,12 +87,13 @@ def step_explicit(kern, q, v, t, h, p, ws):
 
 
 @njit(inline="always")
-def step_newton(kern, q, v, mom, t, h, p, settings, ws):
+def step_newton(kern, q, v, mom, t, h, p, settings, ws, contraction_stop):
     """The Newton path's step; returns (status, Newton iterations, residual). The kick's guess
     is extrapolated from the earlier steps' solutions (partitioned.begin_step), the drift's is
     u plus the extrapolation of the earlier differences w - u (on the 16-link chain 5.76 against
     8.90 iterations per step with the last difference alone): ws holds a sequence of steps of
-    one size (composition.py gives each of its substeps its own)."""
+    one size (composition.py gives each of its substeps its own). contraction_stop: the Newton
+    stopping rule (newton.solve_simplified): True for verlet's own step, False in a composition."""
     n = kern.N_COORDS       # a compile-time constant in the module's glue (base.py, "Loop bounds")
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
@@ -100,7 +101,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     if status != OK:
         return status, 0, 0.0
     status, it1, res1 = solve_kick(kern, q, mom, t, 0.5 * h, p, tol, max_iter, ws.H, ws.A,
-                                   ws.Jq, ws.Jqd, ws.piv, u, ws.R, f, ws.s)
+                                   ws.Jq, ws.Jqd, ws.piv, u, ws.R, f, ws.s, contraction_stop)
     if status != OK:
         return status, it1, res1
     ws.carried[2] = best_degree(ws.history, u, kept, v, n)
@@ -111,7 +112,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws):
     for i in range(n):
         w[i] = u[i] + (extrapolate(drifts, degree, i) if kept >= 1 else 0.0)
     status, it2, res2 = solve_drift(kern, q, u, p_half, 0.5 * h, t + h, p, tol, max_iter, ws.H, ws.A,
-                                    ws.dHw, ws.piv, w, ws.R, q_new, ws.s)
+                                    ws.dHw, ws.piv, w, ws.R, q_new, ws.s, contraction_stop)
     iters, resid = it1 + it2, max(res1, res2)
     if status != OK:
         return status, iters, resid
@@ -138,7 +139,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
     if explicit_path(kern, settings):
         return step_explicit(kern, q, v, t, h, p, ws), 0, 0.0
-    return step_newton(kern, q, v, mom, t, h, p, settings, ws)
+    return step_newton(kern, q, v, mom, t, h, p, settings, ws, True)
 
 
 def linear_step_matrix(tau):
