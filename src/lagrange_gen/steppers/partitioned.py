@@ -142,7 +142,11 @@ def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R,
     kick left (of H(q) or of the kick's Jacobian), the drift's first Newton matrix.
     contraction_stop: as solve_kick's.
 
-    On return q_new = q + hd (u + w) and H holds H(q_new) (unfactored).
+    On return q_new = q + hd (u + w) and H holds H (unfactored) at the last iterate the residual
+    was evaluated at, q + hd (u + w_prev): it differs from q_new by hd times the last Newton
+    increment, within the tolerance (newton.solve_simplified's stopping rule), as everything
+    after a Newton solve does. Evaluating H once more at q_new cost 6 % of a verlet step on the
+    16-link chain (3441 -> 3220 ns, /tmp/s4/chain.py of the issue-13 note).
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
     status, iters, resid = newton.solve_simplified(_DRIFT, kern,
@@ -152,7 +156,6 @@ def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R,
     if status == OK:
         for i in range(kern.N_COORDS):
             q_new[i] = q[i] + hd * (u[i] + w[i])
-        kern.mass_matrix(q_new, td, p, H)
     return status, iters, resid
 
 

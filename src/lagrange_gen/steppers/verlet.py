@@ -124,7 +124,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws, contraction_stop):
     kern.momentum_rate(q_new, w, t + h, p, f)
     for i in range(n):
         p_half[i] += 0.5 * h * f[i]            # now p+
-    # (solve_drift leaves H(q+) in ws.H)
+    # (solve_drift leaves H(q+) in ws.H, at q+ to the Newton tolerance)
     status = end_step(kern, q_new, p_half, t + h, p, ws.H, ws.A, ws.piv, v_new, ws.s, ws.carried,
                       kept, ws.history.shape[0])
     if status != OK:
