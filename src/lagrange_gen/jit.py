@@ -39,9 +39,13 @@ def njit(*args, **kwargs):
     """``numba.njit(**kwargs)``, usable as ``@njit`` or ``@njit(...)``; with ``cache=True`` the
     cache is keyed and guarded as the module docstring says, and an uncached function of the
     stepper library is compiled for jitted callers only (compiled_for_jitted_callers, jit_callee).
-    The first call installs numba_typing_memo (faster typing of the kernels' scalar arithmetic)."""
+    The first call installs numba_typing_memo (faster typing of the kernels' scalar arithmetic)
+    and compile_gc (Python's garbage collector runs rarely while numba compiles)."""
     import numba
+
+    from .compile_gc import install as install_compile_gc
     install_typing_memo()
+    install_compile_gc()
 
     def decorate(fn):
         if compiled_for_jitted_callers(fn, kwargs):
