@@ -3,6 +3,7 @@ CPython and cfunc wrappers. A jitted caller must get the same code, a call from 
 (numba alone would jump to a missing entry point: a segmentation fault), and the cached
 functions, which numba loads through their wrapper, must keep it."""
 
+import functools
 import importlib
 import json
 import os
@@ -75,21 +76,23 @@ def test_a_call_from_python_runs_a_twin_with_wrappers_and_the_same_result():
 
 
 # A first simulate in a fresh process with empty numba and portable caches; prints the class of
-# rk4's step (to show which compile ran) and the final state's bits.
+# midpoint's step (to show which compile ran), the final state's bits, and the signatures
+# base._save was compiled for.
 _RUN = """
 import json, os, sys, tempfile
 os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp()
 os.environ["LAGRANGE_GEN_PORTABLE_DIR"] = tempfile.mkdtemp()
 from lagrange_gen.loader import import_generated
 from lagrange_gen.simulation import simulate
-from lagrange_gen.steppers import midpoint
+from lagrange_gen.steppers import base, midpoint
 mod = import_generated(os.path.join(sys.argv[1], "generated", "cart_pendulum.py"))
 tr = simulate(mod, "midpoint", [0.1, 1.0], [0.3, -0.2], t_end=0.2, h=1e-2)
 print(json.dumps([type(midpoint.step).__name__, [x.hex() for x in tr.q[-1]],
-                  [x.hex() for x in tr.v[-1]]]))
+                  [x.hex() for x in tr.v[-1]], [str(sig) for sig in base._save.signatures]]))
 """
 
 
+@functools.lru_cache(maxsize=None)
 def _run(wrappers):
     env = {k: v for k, v in os.environ.items() if k != "LAGRANGE_GEN_NUMBA_WRAPPERS"}
     if wrappers:
@@ -103,4 +106,11 @@ def _run(wrappers):
 def test_a_stepper_compiled_without_wrappers_gives_the_same_bits():
     without, with_wrappers = _run(False), _run(True)
     assert without[0] == "CalleeDispatcher" and with_wrappers[0] == "CPUDispatcher"
-    assert without[1:] == with_wrappers[1:]
+    assert without[1:3] == with_wrappers[1:3]
+
+
+def test_the_run_loop_compiles_one_save_per_glue():
+    """base._save is compiled separately (cached); run_loop's calls must agree on its argument
+    types, or each first compile of a glue pays for a second one (a literal row 0 did)."""
+    signatures = _run(False)[3]
+    assert len(signatures) == 1, signatures
