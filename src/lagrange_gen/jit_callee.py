@@ -5,9 +5,9 @@ arguments so the function can be called from Python (the "CPython wrapper"), and
 calling convention so it can be passed as a first-class function value (the "cfunc wrapper").
 The functions of the stepper library (lagrange_gen.steppers.*, lagrange_gen.linalg) are called
 by jitted code only: the glue (a generated module's ``run_<method>``, the portable glue, the step
-API's loops) compiles them in, through numba's typing, which compiles each one as a function of
-its own first, even the ``inline="always"`` ones. Their wrappers are never used, and they cost
-compile time in every first compile of a stepper.
+API's loops) compiles them in, each one that is not inlined at numba-IR level as a function of
+its own (numba's typing of a call compiles the callee). Their wrappers are never used, and they
+cost compile time in every first compile of a stepper.
 
 Measured (a new process with an empty NUMBA_CACHE_DIR and portable directory, first simulate of
 10 steps with the portable glue, this 2-core machine), seconds with the wrappers -> without:
