@@ -1,0 +1,154 @@
+"""Kinematic trees as plain data, built into sympy.physics.mechanics bodies and a lagrange_gen Model.
+
+A tree is a list of joints (``TREE`` in models/ur5.py, models/spatial_chain.py,
+models/humanoid.py), each a dict::
+
+    {"name": "elbow", "parent": 1,            # index of the parent joint, -1: the fixed base
+     "type": "revolute",                      # or "prismatic"
+     "axis": (0, 1, 0),                       # joint axis in the parent joint's frame
+     "origin": (0, -0.1197, 0.425),           # the joint in the parent joint's frame
+     "mass": 2.275, "com": (0, 0.0265, 0.11993),     # centre of mass in this body's frame
+     "inertia": (ixx, iyy, izz, ixy, iyz, izx)}      # about the com, in this body's frame
+
+Parents come before their children. Body i's frame is the parent's frame moved to ``origin``
+and turned by q_i about ``axis`` (revolute) or slid by q_i along it (prismatic): at q = 0 every
+frame is parallel to the base frame N, whose z axis points up. That is a URDF with rpy = 0
+everywhere (Pinocchio's joint placement with identity rotation), so a peer builds the same
+model from the same table (lagrange_gen.bench.robots_peers.pinocchio_model).
+
+``tree_bodies`` is what a robotics engineer writes with sympy.physics.mechanics: frames oriented
+with ``orientnew(..., "Axis", ...)``, points placed with ``locatenew``, their velocities by the
+two-point theorem, a RigidBody with its full inertia tensor about its mass centre per joint.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+__all__ = ["tree_bodies", "tree_potential", "model_from_tree", "check_tree", "n_dof", "random_tree"]
+
+KINDS = ("revolute", "prismatic")
+
+
+def check_tree(tree):
+    """ValueError naming the joint when the table is not a tree as described above."""
+    names = set()
+    for i, joint in enumerate(tree):
+        name = joint.get("name", f"joint {i}")
+        if name in names:
+            raise ValueError(f"tree: joint name {name!r} used twice")
+        names.add(name)
+        if joint["type"] not in KINDS:
+            raise ValueError(f"tree: joint {name}: type must be one of {KINDS}, got {joint['type']!r}")
+        if not -1 <= int(joint["parent"]) < i:
+            raise ValueError(f"tree: joint {name}: parent {joint['parent']} must be -1 or an "
+                             f"earlier joint (< {i})")
+        if sum(float(a) ** 2 for a in joint["axis"]) < 1e-24:
+            raise ValueError(f"tree: joint {name}: zero axis")
+        if len(joint["origin"]) != 3 or len(joint["com"]) != 3 or len(joint["inertia"]) != 6:
+            raise ValueError(f"tree: joint {name}: origin and com need 3 numbers, inertia 6")
+        if not float(joint["mass"]) > 0:
+            raise ValueError(f"tree: joint {name}: mass must be positive")
+
+
+def n_dof(tree):
+    return len(tree)
+
+
+def _vector(frame, xyz):
+    x, y, z = (sp.Float(float(c)) if c else 0 for c in xyz)
+    return x * frame.x + y * frame.y + z * frame.z
+
+
+def _unit(axis):
+    """The axis as numbers of norm 1 (exact for the coordinate axes: sympy keeps cos q, sin q)."""
+    values = [float(a) for a in axis]
+    norm = sum(a * a for a in values) ** 0.5
+    if sorted(abs(a) for a in values) == [0.0, 0.0, norm]:
+        return [int(round(a / norm)) for a in values]
+    return [a / norm for a in values]
+
+
+def tree_bodies(tree, q=None):
+    """(N, O, q, bodies): the base frame N (z up), the fixed base point O, the joint coordinates
+    (``me.dynamicsymbols`` named after the joints unless given) and one RigidBody per joint."""
+    import sympy.physics.mechanics as me
+    check_tree(tree)
+    if q is None:
+        q = list(me.dynamicsymbols(" ".join(f"q_{j['name']}" for j in tree), seq=True))
+    N = me.ReferenceFrame("N")
+    O = me.Point("O")
+    O.set_vel(N, 0)
+    frames, origins, bodies = [], [], []
+    for i, joint in enumerate(tree):
+        name, qi = joint["name"], q[i]
+        parent = joint["parent"]
+        P, Po = (N, O) if parent < 0 else (frames[parent], origins[parent])
+        J = Po.locatenew(f"J_{name}", _vector(P, joint["origin"]))    # the joint, fixed in P
+        J.v2pt_theory(Po, N, P)
+        axis = _vector(P, _unit(joint["axis"]))
+        if joint["type"] == "revolute":
+            B = P.orientnew(f"B_{name}", "Axis", [qi, axis])
+            Bo = J
+        else:                                                          # slides along the axis
+            B = P.orientnew(f"B_{name}", "Axis", [0, axis])
+            Bo = J.locatenew(f"Bo_{name}", qi * axis)
+            Bo.set_vel(P, qi.diff() * axis)
+            Bo.v1pt_theory(J, N, P)
+        G = Bo.locatenew(f"G_{name}", _vector(B, joint["com"]))
+        G.v2pt_theory(Bo, N, B)
+        ixx, iyy, izz, ixy, iyz, izx = (float(c) for c in joint["inertia"])
+        inertia = me.inertia(B, ixx, iyy, izz, ixy, iyz, izx)
+        bodies.append(me.RigidBody(name, G, B, float(joint["mass"]), (inertia, G)))
+        frames.append(B)
+        origins.append(Bo)
+    return N, O, q, bodies
+
+
+def tree_potential(N, O, bodies, g):
+    """V of uniform gravity -g N.z: lg.gravity_potential when this lagrange_gen has it, else
+    sum m g z_G (the height of each mass centre above O)."""
+    import lagrange_gen as lg
+    if hasattr(lg, "gravity_potential"):
+        return lg.gravity_potential(N, -g * N.z, bodies)
+    return sum(b.mass * g * b.masscenter.pos_from(O).dot(N.z) for b in bodies)
+
+
+def model_from_tree(name, tree, g=9.81, description=None):
+    """The lagrange_gen Model of a tree: T = lg.kinetic_energy(N, bodies), V = gravity, the one
+    parameter g (default ``g``)."""
+    import lagrange_gen as lg
+    g_sym = lg.parameters("g", defaults=(float(g),))
+    N, O, q, bodies = tree_bodies(tree)
+    T = lg.kinetic_energy(N, bodies)
+    V = tree_potential(N, O, bodies, g_sym)
+    return lg.Model(name, coords=q, T=T, V=V,
+                    description=description or f"{len(tree)}-joint tree, mechanics bodies, gravity -g z")
+
+
+def random_tree(rng, n, prismatic=0.3, aligned=0.0):
+    """A random tree of ``n`` joints for the differential tests: random parents, unit axes
+    (a coordinate axis with probability ``aligned``), offsets, masses and positive definite
+    full inertia tensors (R diag(d) R^T with principal moments obeying the triangle
+    inequality). ``rng`` a numpy Generator."""
+    import numpy as np
+    tree = []
+    for i in range(n):
+        if rng.random() < aligned:
+            axis = np.eye(3)[rng.integers(3)]
+        else:
+            axis = rng.normal(size=3)
+            axis /= np.linalg.norm(axis)
+        d = rng.uniform(0.02, 0.2, size=3)
+        d[2] = rng.uniform(abs(d[0] - d[1]) + 0.005, d[0] + d[1] - 0.005)
+        R, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        I = R @ np.diag(d) @ R.T
+        tree.append({"name": f"j{i}", "parent": int(rng.integers(-1, i)) if i else -1,
+                     "type": "prismatic" if rng.random() < prismatic else "revolute",
+                     "axis": [round(float(a), 12) for a in axis],
+                     "origin": [round(float(c), 12) for c in rng.uniform(-0.5, 0.5, size=3)],
+                     "mass": round(float(rng.uniform(0.5, 3.0)), 12),
+                     "com": [round(float(c), 12) for c in rng.uniform(-0.3, 0.3, size=3)],
+                     "inertia": [round(float(c), 12) for c in
+                                 (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[2, 0])]})
+    return tree
