@@ -64,6 +64,11 @@ def _speed(args):
     print(run_speed_bench(args.models, reports_dir=args.reports, quick=args.quick)["report"])
 
 
+def _robots(args):
+    from .robots import run_robots_bench
+    print(run_robots_bench(args.models, args.reports, quick=args.quick)["report"])
+
+
 def _ensemble(args):
     from .ensemble import run_ensemble_bench
     run_ensemble_bench(Path(args.reports) / "ensemble.md", models_dir=args.models, quick=args.quick)
@@ -91,6 +96,8 @@ SUITES = {
     "scale": ("n-link pendulum n = 1..32: derive/emit/compile/step cost vs sympy LagrangesMethod", _scale),
     "speed": ("the speed goals in one run: vs PyDy at equal error, hand loops, MuJoCo, cold start",
               _speed),
+    "robots": ("UR5, 8/12/24-link spatial chains, 30-DoF tree: pipeline, forward dynamics and its "
+               "derivatives against Pinocchio (pin)", _robots),
     "ensemble": ("members per second of lagrange_gen.ensemble on 1 and 2 threads vs a simulate loop",
                  _ensemble),
     "stepapi": ("us per Stepper.step call on the cart pole vs simulate per step; controller hook cost",
