@@ -3,7 +3,7 @@
 Public API (explicit re-exports)::
 
     from lagrange_gen import Model, coordinates, parameters, t, PointForce, Event, Drawing, load_model
-    from lagrange_gen import kinetic_energy (sympy.physics.mechanics bodies), equations
+    from lagrange_gen import kinetic_energy, gravity_potential (sympy.physics.mechanics bodies), equations
     from lagrange_gen import load, import_generated, simulate
     from lagrange_gen import ensemble, grid, EnsembleResult
 
@@ -20,7 +20,7 @@ from .errors import (BlowUp, EnergyWarning, GenerationError, LagrangeGenError, M
 _LAZY = {
     "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
     "t": "model", "load_model": "model_file", "SaintVenant": "model", "DryFriction": "model",
-    "Event": "model", "Drawing": "model", "kinetic_energy": "mechanics", "equations": "equations", "inputs": "model",
+    "Event": "model", "Drawing": "model", "kinetic_energy": "bodies", "gravity_potential": "bodies", "equations": "equations", "inputs": "model",
     "Signal": "control", "linearize": "linearization", "equilibrium": "linearization",
     "Stepper": "stepper_api", "step_jacobian": "step_derivatives",
     "import_generated": "loader", "load": "loader",

@@ -1,5 +1,5 @@
-"""sympy.physics.mechanics as model input: kinetic energy of Particles and RigidBodies, and loads
-(forces at Points, torques on ReferenceFrames) turned into generalized forces.
+"""sympy.physics.mechanics loads as model input: forces at Points and torques on ReferenceFrames
+turned into generalized forces (the energies of bodies are in bodies.py).
 
 A mechanics model uses ``dynamicsymbols`` as coordinates (Model converts them to Coordinates)
 and one inertial ReferenceFrame N::
@@ -24,35 +24,12 @@ import sympy as sp
 
 from .errors import ModelError
 
-__all__ = ["kinetic_energy", "is_mechanics_load", "generalized_loads"]
+__all__ = ["is_mechanics_load", "generalized_loads"]
 
 
 def _me():
     import sympy.physics.mechanics as me
     return me
-
-
-def kinetic_energy(frame, *bodies):
-    """T = sum of ``body.kinetic_energy(frame)`` over Particles and RigidBodies (a scalar sympy
-    expression in the dynamicsymbols and their time derivatives; give it to Model as T).
-    ModelError when ``frame`` is not a ReferenceFrame or a body is neither."""
-    me = _me()
-    if not isinstance(frame, me.ReferenceFrame):
-        raise ModelError(f"kinetic_energy: the first argument must be the inertial ReferenceFrame, "
-                         f"got {frame!r}")
-    if len(bodies) == 1 and isinstance(bodies[0], (list, tuple)):
-        bodies = tuple(bodies[0])
-    if not bodies:
-        raise ModelError("kinetic_energy: no bodies given (Particles or RigidBodies)")
-    total = sp.S.Zero
-    for body in bodies:
-        if not isinstance(body, (me.Particle, me.RigidBody)):
-            raise ModelError(f"kinetic_energy: {body!r} is not a Particle or RigidBody")
-        try:
-            total += body.kinetic_energy(frame)
-        except ValueError as exc:       # a velocity or angular velocity sympy cannot find
-            raise ModelError(f"kinetic_energy of {body}: {exc}") from None
-    return total
 
 
 def _is_vector(obj):

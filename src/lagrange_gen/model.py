@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from .bodies import expand_intermediates, intermediates_of
 from .drawing import Drawing, check_drawing
 from .errors import ModelError
 from .loads import DryFriction, PointForce, SaintVenant
@@ -94,6 +95,7 @@ class Model:
         self.prescribed = _prescriptions(self.name, prescribed, coords, replace)
         if self.prescribed:
             self._substitute_prescribed()
+        self.intermediates = intermediates_of(*(e for _, e in self._expressions_and_events()))
         self.params = self._collect_params(params)
         self.source_path = None      # set by load_model
         self.source_text = ""
@@ -110,6 +112,10 @@ class Model:
         sub = {}
         for c, expr in self.prescribed.items():
             sub[c], sub[c.d] = expr, sp.diff(expr, t)
+        if intermediates_of(*(e for _, e in self._expressions_and_events())):
+            # a prescribed coordinate inside an Intermediate's definition: substituted in the
+            # expanded expressions (small models; the structured path has no prescriptions)
+            self._expand_intermediates()
         self.T, self.V = self.T.xreplace(sub), self.V.xreplace(sub)
         self.dissipation = self.dissipation.xreplace(sub)
         self.forces = [f.xreplace(sub) for f in self.forces]
@@ -211,15 +217,52 @@ class Model:
             for c in e.coefficients():
                 yield f"coefficient of element {e.name}", c
 
-    def _input_expressions(self):
-        """_all_expressions, the events and the outputs: everything whose symbols must be known.
-        The events stay out of _all_expressions, which chooses the derivation backend
-        (derive/backend.py): an event is evaluated, never differentiated."""
+    def _expressions_and_events(self):
+        """_all_expressions, the events and the outputs, as the user gave them."""
         yield from self._all_expressions()
         for e in self.events:
             yield f"event {e.name}", e.expr
         for name, y in self.outputs.items():
             yield f"output {name}", y
+
+    def _input_expressions(self):
+        """Everything whose symbols must be known: _all_expressions, the events, the outputs
+        and the definitions of the Intermediates they use (bodies.py). The events stay out of
+        _all_expressions, which chooses the derivation backend (derive/backend.py): an event is
+        evaluated, never differentiated."""
+        yield from self._expressions_and_events()
+        for sym in self.intermediates:
+            yield f"intermediate {sym.name} of {sym.definition}", sym.definition
+
+    def symbols_of(self, expr):
+        """The free symbols of ``expr`` seen through its Intermediates' definitions."""
+        out = set()
+        for s in expr.free_symbols:
+            out |= self._intermediate_symbols.get(s, {s})
+        return out
+
+    @property
+    def _intermediate_symbols(self):
+        table = self.__dict__.get("_symbols_table")
+        if table is None or len(table) != len(self.intermediates):
+            table = {}
+            for sym in self.intermediates:       # definitions come after what they use
+                table[sym] = set().union(*(table.get(u, {u}) for u in sym.definition.free_symbols))
+            self.__dict__["_symbols_table"] = table
+        return table
+
+    def _expand_intermediates(self):
+        """Replace every Intermediate by its definition in every expression (exact; large on
+        deep trees)."""
+        self.T, self.V = expand_intermediates(self.T), expand_intermediates(self.V)
+        self.dissipation = expand_intermediates(self.dissipation)
+        self.forces = [expand_intermediates(f) for f in self.forces]
+        self.constraints = [expand_intermediates(c) for c in self.constraints]
+        for e in self.elements:
+            e.strain = expand_intermediates(e.strain)
+        for e in self.events:
+            e.expr = expand_intermediates(e.expr)
+        self.outputs = {k: expand_intermediates(y) for k, y in self.outputs.items()}
 
     def _inputs(self, given):
         """The input symbols (Parameters declared by inputs()), checked."""
@@ -272,7 +315,7 @@ class Model:
         for name in self.outputs:
             _check_name("output", name)
         q, qd = set(self.coords), set(self.velocities)
-        allowed = q | qd | set(self.params) | {t}
+        allowed = q | qd | set(self.params) | {t} | set(self.intermediates)
         for where, expr in self._input_expressions():
             unknown = sorted(str(s) for s in expr.free_symbols - allowed)
             if unknown:
@@ -281,26 +324,26 @@ class Model:
                                  + unknown_symbols_hint(expr.free_symbols - allowed))
             if expr.has(sp.Derivative) or expr.atoms(sp.core.function.AppliedUndef):
                 raise ModelError(f"model {self.name}: {where} contains an undefined function or derivative: {expr}")
-        moving = [f"{v} ({c}.d)" for c, v in zip(self.coords, self.velocities) if v in self.V.free_symbols]
+        moving = [f"{v} ({c}.d)" for c, v in zip(self.coords, self.velocities) if v in self.symbols_of(self.V)]
         if moving:
             raise ModelError(f"model {self.name}: V depends on the velocit{'y' if len(moving) == 1 else 'ies'} "
                              f"{', '.join(moving)}; V is a function of q and t: velocity-dependent "
                              "potentials belong in T or in forces")
-        _check_rayleigh(self.name, self.dissipation, self.velocities)
-        if self.dissipation.free_symbols & {t}:
+        _check_rayleigh(self.name, expand_intermediates(self.dissipation), self.velocities)
+        if self.symbols_of(self.dissipation) & {t}:
             raise ModelError(f"model {self.name}: dissipation depends on t")
         for i, c in enumerate(self.constraints):
-            bad = sorted(str(s) for s in c.free_symbols & qd)
+            bad = sorted(str(s) for s in self.symbols_of(c) & qd)
             if bad:
                 raise ModelError(f"model {self.name}: constraint {i} ({c}) depends on {', '.join(bad)}; "
                                  "only holonomic constraints Phi(q, t) = 0 are supported")
         self._validate_elements(qd)
-        if not (self.T.free_symbols & qd):
+        if not (self.symbols_of(self.T) & qd):
             raise ModelError(f"model {self.name}: T does not depend on any velocity")
 
     def _validate_elements(self, qd):
         for e in self.elements:
-            bad = sorted(str(s) for s in e.strain.free_symbols & (qd | {t}))
+            bad = sorted(str(s) for s in self.symbols_of(e.strain) & (qd | {t}))
             if bad:
                 raise ModelError(f"model {self.name}: element {e.name}: the strain {e.strain} depends on "
                                  f"{', '.join(bad)}; a strain must be a function s(q) of the coordinates")

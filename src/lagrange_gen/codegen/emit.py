@@ -24,8 +24,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import symengine as se
+
 from .cse import cse
-from .printer import KernelPrinter
+from .printer import KernelPrinter, print_native
 from .spec import KernelSpec
 
 #: More structural zeros than this in one output are written by a loop, fewer as statements.
@@ -145,21 +147,27 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
     entries = _entries(spec)
     live = [e for e in entries if e.expr != 0]
     zeros = [e for e in entries if e.expr == 0 and e.out is not None and not e.out.accumulate]
-    temps, reduced = cse([e.expr for e in live], inputs.rename)
-    printer = KernelPrinter()
-    body = [f"    {name} = {printer.doprint(e)}" for name, e in temps]
+    if inputs.graph is None:
+        temps, reduced = cse([e.expr for e in live], inputs.rename)
+        printer = KernelPrinter().doprint
+        used = set()
+        for expr in [e for _, e in temps] + list(reduced):
+            used |= {s.name for s in expr.free_symbols}
+    else:
+        temps, reduced = graph_body(inputs, [e.expr for e in live])
+        printer = print_native
+        used = {s.name for _, e in temps for s in e.free_symbols}
+        used |= {s.name for e in reduced for s in e.free_symbols}
+    body = [f"    {name} = {printer(e)}" for name, e in temps]
     result = "0.0"
     stores = []
     for entry, value in zip(live, reduced):
-        text = printer.doprint(value)
+        text = printer(value)
         if entry.out is None:
             result = text
         else:
             op = "+=" if entry.out.accumulate else "="
             stores.append(f"    {' = '.join(_targets(entry))} {op} {text}")
-    used = set()
-    for expr in [e for _, e in temps] + list(reduced):
-        used |= {s.name for s in expr.free_symbols}
     zero_lines, constants = _zero_lines(spec, zeros)
     views = [f"    {o.name}_f = {o.name}.reshape({o.matrix.shape[0] * o.matrix.shape[1]})"
              for o in spec.outputs if _through_view(o) and not o.local]
@@ -176,6 +184,21 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
     return KernelText(spec.name, constants, "\n".join(lines), n_zero=len(zeros),
                       n_entries=len(entries), n_temps=len(temps),
                       cse_exprs=[e for _, e in temps] + list(reduced))
+
+
+def graph_body(inputs, exprs):
+    """(nodes, reduced) for a model derived through an expression graph (derive/graph.py):
+    nodes [(name, symengine definition over placeholders)] that ``exprs`` use, in evaluation
+    order, and ``exprs`` over placeholders. No CSE: every node is already a short expression
+    shared by name, and the outputs are nodes or short sums of node products."""
+    rename = {se.Symbol(s.name): se.Symbol(new) for s, new in inputs.rename.items()}
+
+    def placeholders(expr):
+        used = {s: rename[s] for s in expr.free_symbols if s in rename}
+        return expr.xreplace(used) if used else expr
+
+    nodes = [(str(sym), placeholders(d)) for sym, d in inputs.graph.used_nodes(exprs)]
+    return nodes, [placeholders(se.sympify(e)) for e in exprs]
 
 
 def _doc(spec, zeros, entries):

@@ -57,6 +57,8 @@ class Inputs:
 
     rename: {model symbol: placeholder name}; loads(args): [(placeholder, load text)] for the
     kernel arguments ``args`` in order, e.g. ("q_0", "q[0]"); ``t`` is a scalar argument.
+    graph: the expression graph of a model derived through one (derive/graph.py), whose nodes
+    the kernels use, else None.
     """
 
     _VECTORS = ("q", "qd", "p", "w", "lam", "we")
@@ -64,6 +66,7 @@ class Inputs:
     def __init__(self, dyn):
         symbols = {"q": dyn.q, "qd": dyn.qd, "p": dyn.params, "w": dyn.aux["w"],
                    "lam": dyn.aux["lam"], "we": dyn.aux.get("we", [])}
+        self.graph = getattr(dyn.ops, "graph", None)
         self.rename = {dyn.t: "t"}
         self._loads = {}
         for arg in self._VECTORS:
@@ -73,3 +76,74 @@ class Inputs:
 
     def loads(self, args):
         return [pair for arg in args for pair in self._loads.get(arg, [])]
+
+
+#: symengine function names -> the Python text of the call (the graph path's printer).
+_NATIVE_CALLS = {name: f"math.{name}" for name in
+                 ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
+                  "asinh", "acosh", "atanh", "exp", "log", "sqrt", "erf", "erfc", "gamma")}
+_NATIVE_CALLS["Abs"] = "abs"
+_ATOMIC = ("Symbol", "Integer", "One", "Zero", "NegativeOne")
+
+
+def print_native(expr) -> str:
+    """Python text of a symengine expression, read directly from its tree (the nodes of an
+    expression graph are many and short: converting each to sympy to print it cost more than
+    the whole derivation). Prints what KernelPrinter prints for the same expression up to
+    term order; anything it does not know goes through sympy and KernelPrinter."""
+    kind = type(expr).__name__
+    if kind == "Symbol":
+        return expr.name
+    if expr.is_Integer:
+        return str(int(expr))
+    if expr.is_Number:
+        return repr(float(expr))
+    if kind == "Add":
+        text = ""
+        for i, arg in enumerate(expr.args):
+            term = print_native(arg)
+            if i == 0:
+                text = term
+            elif term.startswith("-"):
+                text += " - " + term[1:]
+            else:
+                text += " + " + term
+        return text
+    if kind == "Mul":
+        args = list(expr.args)
+        sign = ""
+        if args[0].is_Number and float(args[0]) < 0:
+            sign, args[0] = "-", -args[0]
+            if args[0] == 1:
+                args = args[1:]
+        factors = [_factor(a) for a in args]
+        return sign + "*".join(factors)
+    if kind == "Pow":
+        base, exp = expr.args
+        if type(base).__name__ == "Exp1":
+            return f"math.exp({print_native(exp)})"
+        if exp.is_Integer and 2 <= int(exp) <= 4 and type(base).__name__ == "Symbol":
+            return "(" + "*".join([base.name] * int(exp)) + ")"
+        if exp.is_Integer and int(exp) == -1:
+            return f"1.0/{_factor(base)}"
+        if exp.is_Number and float(exp) == 0.5:
+            return f"math.sqrt({print_native(base)})"
+        return f"{_factor(base)}**{_factor(exp)}"
+    if kind in _NATIVE_CALLS and expr.args:
+        return f"{_NATIVE_CALLS[kind]}({', '.join(print_native(a) for a in expr.args)})"
+    if kind == "Pi":
+        return "math.pi"
+    if kind == "Exp1":
+        return "math.e"
+    return KernelPrinter().doprint(sp.sympify(expr))
+
+
+def _factor(expr) -> str:
+    """An operand of * or **: parenthesized unless it is atomic or a call."""
+    text = print_native(expr)
+    kind = type(expr).__name__
+    if kind in _ATOMIC or kind in _NATIVE_CALLS or (kind == "Pow" and text.startswith(("math.", "("))):
+        return text
+    if expr.is_Number and not text.startswith("-"):
+        return text
+    return f"({text})"

@@ -11,6 +11,8 @@ from .elements import derive_elements
 from .freeze import freeze_model
 from .jacobians import Jacobians
 from .lagrangian import derive_lagrangian
+from .structured import (GraphJacobians, NotScleronomic, derive_lagrangian_graph, graph_model, import_expressions,
+                         uses_graph)
 
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
@@ -34,14 +36,14 @@ class Dynamics:
     ``model`` is the model as derived (frozen parameters substituted; ``frozen`` {name: value}).
     """
 
-    def __init__(self, model, ops_, native, jac_parts, aux, frozen):
+    def __init__(self, model, ops_, native, jac_parts, aux, frozen, jacobians=Jacobians):
         self.model, self.ops, self.native, self.aux, self.frozen = model, ops_, native, aux, frozen
         self.q, self.qd = list(model.coords), list(model.velocities)
         self.params, self.t = list(model.params), time_symbol
         self._names = {s.name: s for s in self.q + self.qd + self.params + [time_symbol]}
         self._names.update({s.name: s for v in aux.values() for s in v})
         o = ops_
-        self.jac = Jacobians(o, jac_parts, o.symbols(self.q), o.symbols(self.qd),
+        self.jac = jacobians(o, jac_parts, o.symbols(self.q), o.symbols(self.qd),
                              o.symbols(aux["w"]), o.symbols(aux["lam"]), self.to_sympy)
         self._sympy = {}
 
@@ -114,8 +116,18 @@ def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
     """
     frozen = dict(freeze or {})
     model = freeze_model(model, frozen) if frozen else model
+    if uses_graph(model):
+        try:
+            return _derive_through_graph(model, frozen, check_samples)
+        except NotScleronomic:
+            model = graph_model(model, expand_all=True)
     o = ops(backend_for(expr for _, expr in model._all_expressions()))
     parts = derive_lagrangian(model, o, check_samples=check_samples)
+    return _finish(model, o, parts, frozen, Jacobians)
+
+
+def _finish(model, o, parts, frozen, jacobians):
+    """Constraints, elements and the Dynamics record around the Lagrangian ``parts``."""
     q = o.symbols(model.coords)
     parts.update(derive_constraints(model, o, q))
     n, m = len(model.coords), len(model.constraints)
@@ -124,4 +136,12 @@ def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
     for key, value in derive_elements(model, aux["we"]).items():
         parts[key] = o.matrix(*value.shape, list(value))
     native = {k: parts[k] for k in FIELDS}
-    return Dynamics(model, o, native, parts, aux, frozen)
+    return Dynamics(model, o, native, parts, aux, frozen, jacobians)
+
+
+def _derive_through_graph(model, frozen, check_samples):
+    """derive() for a model over Intermediates (derive/structured.py)."""
+    model = graph_model(model)
+    o, (T, V, D, *forces) = import_expressions(model, frozen, [model.T, model.V, model.dissipation, *model.forces])
+    parts = derive_lagrangian_graph(model, o, T, V, D, forces, check_samples)
+    return _finish(model, o, parts, frozen, GraphJacobians)
