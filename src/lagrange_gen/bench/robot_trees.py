@@ -17,8 +17,11 @@ everywhere (Pinocchio's joint placement with identity rotation), so a peer build
 model from the same table (lagrange_gen.bench.robots_peers.pinocchio_model).
 
 ``tree_bodies`` is what a robotics engineer writes with sympy.physics.mechanics: frames oriented
-with ``orientnew(..., "Axis", ...)``, points placed with ``locatenew``, their velocities by the
-two-point theorem, a RigidBody with its full inertia tensor about its mass centre per joint.
+with ``orientnew(..., "Axis", ...)``, points placed with ``locatenew`` from the fixed base point O
+(the only velocity set: every other one follows from the positions, as sympy's Point.vel finds
+it; a velocity set on a moving point with v2pt_theory would be taken as given, written out in N,
+by a structured lg.kinetic_energy), a RigidBody with its full inertia tensor about its mass
+centre per joint.
 """
 
 from __future__ import annotations
@@ -85,7 +88,6 @@ def tree_bodies(tree, q=None):
         parent = joint["parent"]
         P, Po = (N, O) if parent < 0 else (frames[parent], origins[parent])
         J = Po.locatenew(f"J_{name}", _vector(P, joint["origin"]))    # the joint, fixed in P
-        J.v2pt_theory(Po, N, P)
         axis = _vector(P, _unit(joint["axis"]))
         if joint["type"] == "revolute":
             B = P.orientnew(f"B_{name}", "Axis", [qi, axis])
@@ -93,10 +95,7 @@ def tree_bodies(tree, q=None):
         else:                                                          # slides along the axis
             B = P.orientnew(f"B_{name}", "Axis", [0, axis])
             Bo = J.locatenew(f"Bo_{name}", qi * axis)
-            Bo.set_vel(P, qi.diff() * axis)
-            Bo.v1pt_theory(J, N, P)
         G = Bo.locatenew(f"G_{name}", _vector(B, joint["com"]))
-        G.v2pt_theory(Bo, N, B)
         ixx, iyy, izz, ixy, iyz, izx = (float(c) for c in joint["inertia"])
         inertia = me.inertia(B, ixx, iyy, izz, ixy, iyz, izx)
         bodies.append(me.RigidBody(name, G, B, float(joint["mass"]), (inertia, G)))
