@@ -120,7 +120,9 @@ def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
         try:
             return _derive_through_graph(model, frozen, check_samples)
         except NotScleronomic:
-            model = graph_model(model, expand_all=True)
+            pass
+    if getattr(model, "intermediates", ()):
+        model = graph_model(model, expand_all=True)
     o = ops(backend_for(expr for _, expr in model._all_expressions()))
     parts = derive_lagrangian(model, o, check_samples=check_samples)
     return _finish(model, o, parts, frozen, Jacobians)

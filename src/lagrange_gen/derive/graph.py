@@ -72,6 +72,12 @@ class Graph:
         found = self._intern.get(expr)
         if found is not None:
             return found
+        calls = {f: self.node(f) for f in expr.atoms(se.Function) if f != expr}
+        if calls:                       # each sin(q_3) computed once, wherever it is used
+            expr = expr.xreplace(calls)
+            found = self._intern.get(expr)
+            if found is not None:
+                return found
         sym = se.Symbol(f"{NODE_PREFIX}{len(self.order)}")
         self.defs[sym] = expr
         self.order.append(sym)

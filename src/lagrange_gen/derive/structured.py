@@ -30,7 +30,7 @@ import sympy as sp
 from ..bodies import Intermediate, expand_intermediates
 from ..errors import ModelError
 from ..symbols import Parameter, t
-from .backend import Mat, Ops
+from .backend import Mat, Ops, backend_for
 from .graph import Graph
 from .jacobians import Jacobians
 
@@ -76,8 +76,13 @@ class GraphOps(Ops):
 
 
 def uses_graph(model) -> bool:
-    """True when the model's T or V are built over Intermediates (bodies.py)."""
-    return bool(getattr(model, "intermediates", ()))
+    """True when the model's expressions use Intermediates (bodies.py) and symengine can
+    differentiate everything in them (backend.backend_for): the graph is symengine's."""
+    used = getattr(model, "intermediates", ())
+    if not used:
+        return False
+    exprs = [e for _, e in model._all_expressions()] + [s.definition for s in used]
+    return backend_for(exprs) == "symengine"
 
 
 def graph_model(model, expand_all=False):
