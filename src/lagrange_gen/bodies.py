@@ -162,33 +162,47 @@ class _Tree:
         return out
 
     def in_N(self, vector):
-        """Components (3, 1) in N of a mechanics Vector, each term through R of its frame, plus
-        the time derivative of those components d/dt_N (the velocity of a position vector)."""
-        position, velocity = sp.zeros(3, 1), sp.zeros(3, 1)
+        """Components (3, 1) in N of a mechanics Vector, each term through R of its frame."""
+        out = sp.zeros(3, 1)
+        for comps, where in vector.args:
+            out += self.R(where) * self._coords(comps)
+        return out
+
+    def rate_in_N(self, vector):
+        """Components (3, 1) in N of d/dt_N of a mechanics Vector (the velocity of a position
+        vector): for each term c in frame F, R(F) (dc/dt + w(F) x c)."""
+        out = sp.zeros(3, 1)
         for comps, where in vector.args:
             c = self._coords(comps)
-            cdot = _time_derivative(c)
-            R = self.R(where)
-            position += R * c
-            velocity += R * (cdot + self.w(where).cross(c))
-        return position, velocity
+            out += self.R(where) * (_time_derivative(c) + self.w(where).cross(c))
+        return out
 
     # -- points ---------------------------------------------------------------------------
-    def position_and_velocity(self, point):
-        """(r, v) (3, 1) each, in N, of ``point``: from the nearest point whose velocity in N
-        is given (a fixed origin, or a point set with set_vel / v2pt_theory), as sympy's
-        Point.vel finds it; r is measured from that point."""
+    def velocity(self, point):
+        """v (3, 1) in N of ``point``: from the nearest point whose velocity in N is given (a
+        fixed origin, or a point set with set_vel / v2pt_theory), as sympy's Point.vel finds
+        it, adding d/dt of each position vector on the way out."""
+        if point not in self._v:
+            root, path = _nearest(point, lambda p: self.N in _records(p, "_vel_dict"), self.N)
+            if root not in self._v:
+                self._v[root] = self._named(self.in_N(root.vel(self.N)))
+            for child, parent in path:
+                if child not in self._v:
+                    self._v[child] = self._named(self._v[parent] + self.rate_in_N(child.pos_from(parent)))
+        return self._v[point]
+
+    def position(self, point):
+        """r (3, 1) in N of ``point`` from the nearest fixed point (velocity given as zero)."""
         if point not in self._r:
-            root, path = _nearest_with_velocity(point, self.N)
-            if root not in self._r:
-                self._r[root] = sp.zeros(3, 1)
-                self._v[root] = self._named(self.in_N(root.vel(self.N))[0])
-            for child, parent in path or ():
+            def fixed(p):
+                given = _records(p, "_vel_dict").get(self.N)
+                return given is not None and given == 0
+            root, path = _nearest(point, fixed, self.N, what="a fixed point (O.set_vel(N, 0))")
+            self._r.setdefault(root, sp.zeros(3, 1))
+            for child, parent in path:
                 if child not in self._r:
-                    dr, dv = self.in_N(child.pos_from(parent))
-                    self._r[child] = self._named(self._r[parent] + dr)
-                    self._v[child] = self._named(self._v[parent] + dv)
-        return self._r[point], self._v[point]
+                    self._r[child] = self._named(self._r[parent] + self.in_N(child.pos_from(parent)))
+        return self._r[point]
 
 
 def _time_derivative(c):
@@ -202,43 +216,44 @@ def _time_derivative(c):
     return out
 
 
-def _neighbours(obj, record):
-    """The frames (or points) ``obj`` is directly related to in sympy's record ``record``."""
+def _records(obj, record):
+    """sympy's table ``record`` of a frame or point ({other: DCM or Vector}); _NoRecords when this
+    sympy keeps it elsewhere (the one place that reads sympy's internals)."""
     table = getattr(obj, record, None)
     if not isinstance(table, dict):
         raise _NoRecords(record)
-    return sorted(table, key=str)
+    return table
+
+
+def _neighbours(obj, record):
+    """The frames (or points) ``obj`` is directly related to in sympy's record ``record``."""
+    return sorted(_records(obj, record), key=str)
 
 
 class _NoRecords(Exception):
     """sympy's orientation or position records are not where this sympy keeps them."""
 
 
-def _nearest_with_velocity(point, frame):
-    """(root, path) where root is the nearest point (breadth first over positions) whose
-    velocity in ``frame`` was given, and path [(child, parent)] from root out to ``point``
-    (None when ``point`` itself has a given velocity)."""
-    velocities = getattr(point, "_vel_dict", None)
-    if not isinstance(velocities, dict):
-        raise _NoRecords("_vel_dict")
-    if frame in velocities:
-        return point, None
+def _nearest(point, wanted, frame, what=None):
+    """(root, path): the nearest point (breadth first over positions) for which ``wanted`` is
+    true, and path [(child, parent)] from root out to ``point`` ([] when ``point`` is the root).
+    ModelError naming ``what`` when there is none."""
     parents, queue = {point: None}, deque([point])
     while queue:
         here = queue.popleft()
+        if wanted(here):
+            path, node = [], here
+            while parents[node] is not None:
+                path.append((parents[node], node))
+                node = parents[node]
+            return here, path
         for other in _neighbours(here, "_pos_dict"):
-            if other in parents:
-                continue
-            parents[other] = here
-            if frame in other._vel_dict:
-                path, node = [], other
-                while parents[node] is not None:
-                    path.append((parents[node], node))
-                    node = parents[node]
-                return other, path
-            queue.append(other)
-    raise ModelError(f"the velocity of point {point} in {frame} cannot be found: no point located "
-                     f"from it has a velocity given in {frame} (set one with O.set_vel({frame}, 0))")
+            if other not in parents:
+                parents[other] = here
+                queue.append(other)
+    what = what or f"a velocity given in {frame}"
+    raise ModelError(f"point {point}: no point located from it has {what}; set one with "
+                     f"O.set_vel({frame}, 0)")
 
 
 def _bodies(bodies, who):
@@ -281,7 +296,7 @@ def kinetic_energy(frame, *bodies):
         tree = _Tree(frame)
         total = sp.S.Zero
         for body in bodies:
-            _, v = tree.position_and_velocity(body.masscenter)
+            v = tree.velocity(body.masscenter)
             total += body.mass * v.dot(v) / 2
             if isinstance(body, me.RigidBody):
                 w = tree.w(body.frame)
@@ -303,8 +318,8 @@ def kinetic_energy(frame, *bodies):
 
 def gravity_potential(frame, gravity, *bodies):
     """V = -sum m gravity . r of the bodies' mass centres (``gravity`` a constant Vector in
-    ``frame``, e.g. -g*N.z), positions measured from the fixed point they are located from;
-    over Intermediates like kinetic_energy."""
+    ``frame``, e.g. -g*N.z), positions measured from the nearest fixed point (velocity set to
+    zero) they are located from; over Intermediates like kinetic_energy."""
     _check_frame(frame, "gravity_potential")
     bodies = _bodies(bodies, "gravity_potential")
     me = _me()
@@ -315,13 +330,10 @@ def gravity_potential(frame, gravity, *bodies):
         g = tree.components(gravity, frame)
         total = sp.S.Zero
         for body in bodies:
-            root, _ = _nearest_with_velocity(body.masscenter, frame)
-            if root.vel(frame) != 0:
-                raise ModelError(f"gravity_potential: {body} is located from {root}, which moves: "
-                                 f"locate the mass centres from a fixed point (O.set_vel({frame}, 0))")
-            r, _ = tree.position_and_velocity(body.masscenter)
-            total -= body.mass * g.dot(r)
+            total -= body.mass * g.dot(tree.position(body.masscenter))
         return total
     except _NoRecords as exc:
         raise ModelError(f"gravity_potential: sympy's point records were not found ({exc}): "
                          "write V from the positions instead") from None
+    except ValueError as exc:
+        raise ModelError(f"gravity_potential: {exc}") from None
