@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..model import Model, t as time_symbol
 from .backend import backend_for, ops
 from .constraints import derive_constraints
 from .elements import derive_elements
 from .freeze import freeze_model
 from .jacobians import Jacobians
 from .lagrangian import derive_lagrangian
+from ..model.model import Model, t as time_symbol
 
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
@@ -75,7 +75,7 @@ class Dynamics:
     def has_work(self):
         """True when E = T2 - T0 + V is not conserved: non-conservative forces, dissipation or
         an explicit t in L (P = qd . Q_nc - dL/dt nonzero), or nonsmooth elements (which
-        dissipate; steppers/work.py)."""
+        dissipate; steppers/core/work.py)."""
         return self.native["power"][0, 0] != 0 or self.n_elements > 0
 
     @property
