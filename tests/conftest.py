@@ -8,7 +8,7 @@ import pytest
 from lagrange_gen import load_model
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.derive import derive
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 ROOT = Path(__file__).resolve().parent.parent
 MODELS_DIR = ROOT / "models"
@@ -27,12 +27,12 @@ def pytest_addoption(parser):
 
 def glue(module, method):
     """What the tests call instead of ``module.run_<method>`` (same arguments and returns): the
-    portable glue of ``method`` on ``module``'s kernels (lagrange_gen.portable). It is compiled
+    portable glue of ``method`` on ``module``'s kernels (lagrange_gen.jit.portable). It is compiled
     once per method for every model, where each model's own glue compiles the whole stepper
     again (several seconds per model and method, the bulk of this suite's time).
     tests/test_portable.py checks, for every method, that the module's own glue gives the same
     trajectory bit for bit; the step API, control and ensemble tests run the module's own glue."""
-    from lagrange_gen import portable
+    from lagrange_gen.jit import portable
     return portable.runner(module, method)
 
 

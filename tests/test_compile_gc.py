@@ -1,4 +1,4 @@
-"""lagrange_gen.compile_gc: while numba compiles, the young GC threshold is raised; after the
+"""lagrange_gen.jit.compile_gc: while numba compiles, the young GC threshold is raised; after the
 outermost compile, failed ones included, the thresholds are what they were."""
 
 import gc
@@ -6,8 +6,8 @@ import gc
 import pytest
 from numba.core import event
 
-from lagrange_gen import compile_gc
-from lagrange_gen.jit import njit
+from lagrange_gen.jit import compile_gc
+from lagrange_gen.jit.cache import njit
 
 
 class _Seen(event.Listener):

@@ -8,9 +8,9 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from lagrange_gen import compile_notice
-from lagrange_gen.adaptive_run import _warm_up
-from lagrange_gen.fixed_run import warm_up, warm_up_args
+from lagrange_gen.jit import compile_notice
+from lagrange_gen.run.adaptive_driver import _warm_up
+from lagrange_gen.run.fixed_driver import warm_up, warm_up_args
 
 LINE = re.compile(r"^lagrange-gen: compiling (\S+) for (\S+) \(first use\) \.\.\. "
                   r"(done in|failed after) (\d+\.\d) s\n$")

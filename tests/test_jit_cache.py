@@ -2,7 +2,7 @@
 
 numba keys a cache entry on the text of the file that defines the function, but the compiled
 code also holds every function it calls, from other files. constrained.solve_rows (cache=True)
-calls linalg.cholesky_solve_inplace: when linalg.py changed and constrained.py did not, numba
+calls linalg.cholesky_solve_inplace: when steppers/core/linalg.py changed and constrained.py did not, numba
 loaded the old solve_rows, with the old solve inside, without a word. That is how the portable
 glue compiled on one checkout and the specialized glue compiled on a clean clone came to differ
 in the last bit (CI of 2026-11-26). lagrange_gen.jit keys these entries on every package file
@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 
 import lagrange_gen
-from lagrange_gen import jit
+from lagrange_gen.jit import cache as jit
 
 PACKAGE = Path(lagrange_gen.__file__).resolve().parent
 
@@ -30,7 +30,7 @@ sys.path.insert(0, sys.argv[1])
 import numpy as np
 import lagrange_gen
 assert lagrange_gen.__file__.startswith(sys.argv[1]), lagrange_gen.__file__
-from lagrange_gen.steppers.constrained import solve_rows
+from lagrange_gen.steppers.core.constrained import solve_rows
 L = np.array([[2.0, 0.0], [0.0, 3.0]])
 J = np.array([[1.0, 1.0]])
 Y = np.zeros((1, 2))
@@ -39,8 +39,8 @@ print(json.dumps({"Y": Y.tolist(), "hits": sum(solve_rows.stats.cache_hits.value
                   "misses": sum(solve_rows.stats.cache_misses.values())}))
 """
 
-# Appended to the copy's linalg.py: a cholesky_solve_inplace that gives another answer, as an
-# edit of linalg.py (and of no other file) would.
+# Appended to the copy's steppers/core/linalg.py: a cholesky_solve_inplace that gives another answer, as an
+# edit of steppers/core/linalg.py (and of no other file) would.
 _CHANGED_SOLVE = """
 
 @njit(cache=True, _nrt=False)
@@ -65,10 +65,10 @@ def test_a_change_in_a_callee_file_recompiles_the_cached_caller(tmp_path):
     assert first["Y"] == [[0.25, 1.0 / 9.0]] and first["misses"] == 1
     again = _probe(tmp_path)                 # nothing changed: the entry serves a new process
     assert again == {"Y": first["Y"], "hits": 1, "misses": 0}
-    linalg = tmp_path / "lagrange_gen" / "linalg.py"
+    linalg = tmp_path / "lagrange_gen" / "steppers" / "core" / "linalg.py"
     linalg.write_text(linalg.read_text() + _CHANGED_SOLVE)
     changed = _probe(tmp_path)
-    assert changed["Y"] == [[-1.0, -1.0]], "solve_rows came from the cache of the old linalg.py"
+    assert changed["Y"] == [[-1.0, -1.0]], "solve_rows came from the cache of the old steppers/core/linalg.py"
     assert changed["misses"] == 1
 
 
@@ -90,6 +90,7 @@ def test_every_cached_package_function_uses_the_closure_key():
 
 
 def test_the_key_covers_the_imports_of_the_module():
-    stamp = jit.closure_stamp(PACKAGE / "steppers" / "constrained.py")
-    assert {"steppers/constrained.py", "linalg.py", "steppers/base.py"} <= set(json.loads(stamp))
-    assert jit.closure_stamp(PACKAGE / "linalg.py") != stamp
+    stamp = jit.closure_stamp(PACKAGE / "steppers" / "core" / "constrained.py")
+    assert {"steppers/core/constrained.py", "steppers/core/linalg.py",
+            "steppers/core/base.py"} <= set(json.loads(stamp))
+    assert jit.closure_stamp(PACKAGE / "steppers" / "core" / "linalg.py") != stamp

@@ -1,4 +1,4 @@
-"""lagrange_gen.jit_callee: the stepper library's uncached functions are compiled without numba's
+"""lagrange_gen.jit.callee: the stepper library's uncached functions are compiled without numba's
 CPython and cfunc wrappers. A jitted caller must get the same code, a call from Python must work
 (numba alone would jump to a missing entry point: a segmentation fault), and the cached
 functions, which numba loads through their wrapper, must keep it."""
@@ -15,15 +15,17 @@ import numpy as np
 from numba.core.registry import CPUDispatcher
 
 from conftest import ROOT
-from lagrange_gen import linalg, steppers
-from lagrange_gen.jit import njit
-from lagrange_gen.jit_callee import CalleeDispatcher
+from lagrange_gen import steppers
+from lagrange_gen.jit.cache import njit
+from lagrange_gen.jit.callee import CalleeDispatcher
+from lagrange_gen.steppers.core import linalg
 
 
 def _library_dispatchers():
-    """Every numba dispatcher defined in lagrange_gen.linalg and lagrange_gen.steppers.*."""
-    modules = [linalg] + [importlib.import_module(info.name) for info in
-                          pkgutil.iter_modules(steppers.__path__, "lagrange_gen.steppers.")]
+    """Every numba dispatcher defined in lagrange_gen.steppers.* (linalg included)."""
+    modules = [importlib.import_module(info.name) for info in
+               pkgutil.walk_packages(steppers.__path__, "lagrange_gen.steppers.")]
+    assert linalg in modules
     for module in modules:
         for value in vars(module).values():
             if isinstance(value, CPUDispatcher) and value.py_func.__module__ == module.__name__:
@@ -82,9 +84,10 @@ _RUN = """
 import json, os, sys, tempfile
 os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp()
 os.environ["LAGRANGE_GEN_PORTABLE_DIR"] = tempfile.mkdtemp()
-from lagrange_gen.loader import import_generated
-from lagrange_gen.simulation import simulate
-from lagrange_gen.steppers import base, midpoint
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.run.simulate import simulate
+from lagrange_gen.steppers.core import base
+from lagrange_gen.steppers.methods import midpoint
 mod = import_generated(os.path.join(sys.argv[1], "generated", "cart_pendulum.py"))
 tr = simulate(mod, "midpoint", [0.1, 1.0], [0.3, -0.2], t_end=0.2, h=1e-2)
 print(json.dumps([type(midpoint.step).__name__, [x.hex() for x in tr.q[-1]],

@@ -1,4 +1,4 @@
-"""lagrange_gen.linalg, the factorizations every stepper's solves go through, against numpy and
+"""lagrange_gen.steppers.core.linalg, the factorizations every stepper's solves go through, against numpy and
 by their defining identities (P A = L U, L L^T = A), including the singular and non-finite
 matrices the steppers must report instead of dividing by."""
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from lagrange_gen import linalg
+from lagrange_gen.steppers.core import linalg
 
 
 def _matrices(seed=0):

@@ -1,4 +1,4 @@
-"""lagrange_gen.numba_inline_copy: numba's inliner copying a callee's scope once per IR, not once
+"""lagrange_gen.jit.inline_copy: numba's inliner copying a callee's scope once per IR, not once
 per block. The copies must be what numba's own block-by-block deepcopy gives, and a stepper
 compiled with and without it must run the same floating-point operations."""
 
@@ -13,7 +13,7 @@ from numba.core import inline_closurecall, ir
 from numba.core.compiler import run_frontend
 
 import lagrange_gen.steppers  # noqa: F401  (installs the copier)
-from lagrange_gen import numba_inline_copy
+from lagrange_gen.jit import inline_copy as numba_inline_copy
 from conftest import ROOT
 
 
@@ -65,9 +65,9 @@ import numpy as np
 sys.path.insert(0, sys.argv[1])
 import cart_pendulum as mod
 from numba.core import inline_closurecall
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.method_spec import make_settings
 n, rows = 2, 2
 out = (np.empty(rows), np.empty((rows, n)), np.empty((rows, n)), np.empty((rows, N_STATS)),
        np.empty((rows, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))

@@ -1,4 +1,4 @@
-"""lagrange_gen.numba_typing_memo: numba's typing of scalar calls remembered within a process.
+"""lagrange_gen.jit.typing_memo: numba's typing of scalar calls remembered within a process.
 It must give the same machine code as numba's own typing, and must not answer for calls whose
 types it does not cover."""
 
@@ -10,8 +10,8 @@ import sys
 from numba import types
 
 from conftest import ROOT
-from lagrange_gen import numba_typing_memo
-from lagrange_gen.jit import njit
+from lagrange_gen.jit import typing_memo as numba_typing_memo
+from lagrange_gen.jit.cache import njit
 
 
 @njit
@@ -51,8 +51,8 @@ def test_calls_on_arrays_or_literals_go_to_numba_unchanged():
 # generated/) in a fresh process with an empty numba cache and prints a hash of their assembly.
 _ASM = """
 import hashlib, json, os, sys
-from lagrange_gen import numba_typing_memo
-from lagrange_gen.loader import _kernel_args, import_generated
+from lagrange_gen.jit import typing_memo as numba_typing_memo
+from lagrange_gen.run.loader import _kernel_args, import_generated
 h = hashlib.sha256()
 for stem in ("cart_pendulum", "double_pendulum"):
     mod = import_generated(os.path.join(sys.argv[1], "generated", stem + ".py"))

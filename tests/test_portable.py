@@ -1,4 +1,4 @@
-"""The portable glue (lagrange_gen.portable): one compiled stepper for every model.
+"""The portable glue (lagrange_gen.jit.portable): one compiled stepper for every model.
 
 A portable run is the specialized run's floating-point operations in the same order, with the
 kernels called through pointers instead of inlined: its trajectory must equal the specialized
@@ -11,13 +11,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lagrange_gen import fixed_run, portable
 from lagrange_gen.codegen import generate_model
+from lagrange_gen.codegen import glue
 from lagrange_gen.errors import SimulationError
-from lagrange_gen.loader import import_generated
-from lagrange_gen.simulation import simulate
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.jit import portable
+from lagrange_gen.run import fixed_driver as fixed_run
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.run.simulate import simulate
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.method_spec import make_settings
 
 EVENT_MODELS = Path(__file__).resolve().parent / "events" / "models"
 
@@ -178,8 +180,8 @@ def test_unknown_jit_is_refused(generated):
 
 
 def test_glue_source_is_deterministic_and_names_its_library_version():
-    a = registry.portable_glue_source("rattle", "0123456789abcdef")
-    assert a == registry.portable_glue_source("rattle", "0123456789abcdef")
+    a = glue.portable_glue_source("rattle", "0123456789abcdef")
+    assert a == glue.portable_glue_source("rattle", "0123456789abcdef")
     assert "0123456789abcdef" in a and "def run_rattle(kern, n_saved, q0, v0" in a
 
 

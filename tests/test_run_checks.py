@@ -13,12 +13,12 @@ import pytest
 import scipy.linalg
 
 from lagrange_gen import simulate
-from lagrange_gen import run_checks
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.energy_check import ENERGY_FRACTION, is_conservative
 from lagrange_gen.errors import EnergyWarning, SimulationError
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run import checks as run_checks
+from lagrange_gen.run.energy_check import ENERGY_FRACTION, is_conservative
+from lagrange_gen.run.loader import import_generated
 
 MODELS = Path(__file__).resolve().parent.parent / "models"
 Q0, V0 = [0.1, 0.5], [0.0, 0.0]
@@ -241,7 +241,7 @@ def test_cli_passes_only_the_settings_given_and_refuses_one_the_method_lacks(car
 
 
 def test_cli_has_an_option_for_every_setting_of_every_method(capsys):
-    from lagrange_gen.steppers import registry
+    from lagrange_gen.steppers.core import registry
     with pytest.raises(SystemExit):
         main(["simulate", "--help"])
     text = capsys.readouterr().out

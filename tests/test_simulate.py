@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import lagrange_gen.simulation as simulate_module
-from lagrange_gen.cli import main
-from lagrange_gen.cli_simulate import add_parser, run as run_cli
-from lagrange_gen.simulation import simulate
+import lagrange_gen.run.simulate as simulate_module
+from lagrange_gen.cli.main import main
+from lagrange_gen.cli.simulate import add_parser, run as run_cli
+from lagrange_gen.run.simulate import simulate
 
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
@@ -45,7 +45,7 @@ def test_t_end_not_a_multiple_of_h_is_rounded_up_to_a_whole_step(cart):
 def test_chunked_run_equals_one_call(cart, monkeypatch):
     whole = {m: simulate(cart, m, Q0, V0, t_end=1.0, h=0.01, save_every=3)
              for m in ("rk4", "midpoint")}
-    import lagrange_gen.fixed_run as fixed_run      # where the chunk size lives
+    import lagrange_gen.run.fixed_driver as fixed_run      # where the chunk size lives
     monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 9)
     for method, ref in whole.items():
         chunked = simulate(cart, method, Q0, V0, t_end=1.0, h=0.01, save_every=3)

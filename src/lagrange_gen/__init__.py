@@ -18,14 +18,16 @@ from .errors import (BlowUp, EnergyWarning, GenerationError, LagrangeGenError, M
                      StaleModuleError)
 
 _LAZY = {
-    "Model": "model", "PointForce": "model", "coordinates": "model", "parameters": "model",
-    "t": "model", "load_model": "model_file", "SaintVenant": "model", "DryFriction": "model",
-    "Event": "model", "Drawing": "model", "kinetic_energy": "bodies", "gravity_potential": "bodies", "equations": "equations", "inputs": "model",
-    "Signal": "control", "linearize": "linearization", "equilibrium": "linearization",
-    "Stepper": "stepper_api", "step_jacobian": "step_derivatives",
-    "import_generated": "loader", "load": "loader",
-    "simulate": "simulation", "Trajectory": "trajectory",
-    "ensemble": "ensemble_run", "grid": "ensemble_inputs", "EnsembleResult": "ensemble_run",
+    "Model": "model.model", "PointForce": "model.model", "coordinates": "model.model",
+    "parameters": "model.model", "t": "model.model", "SaintVenant": "model.model",
+    "DryFriction": "model.model", "Event": "model.model", "Drawing": "model.model",
+    "inputs": "model.model", "load_model": "model.model_file", "kinetic_energy": "model.bodies", "gravity_potential": "model.bodies",
+    "equations": "derive.equations",
+    "Signal": "run.control", "linearize": "linear.linearize", "equilibrium": "linear.linearize",
+    "Stepper": "run.stepper", "step_jacobian": "linear.step_derivatives",
+    "import_generated": "run.loader", "load": "run.loader",
+    "simulate": "run.simulate", "Trajectory": "run.trajectory",
+    "ensemble": "run.ensemble", "grid": "run.ensemble_inputs", "EnsembleResult": "run.ensemble",
 }
 
 __all__ = sorted(_LAZY) + [

@@ -52,4 +52,4 @@ class SingularNewtonMatrix(NewtonDivergence):
 
 class EnergyWarning(UserWarning):
     """A run on a conservative model lost (or gained) energy far beyond what its step allows
-    (lagrange_gen.energy_check); the trajectory is kept, with the line in Trajectory.warnings."""
+    (lagrange_gen.run.energy_check); the trajectory is kept, with the line in Trajectory.warnings."""

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen.analysis import hard_cases, stability
-from lagrange_gen.steppers.verlet import linear_step_matrix
+from lagrange_gen.steppers.methods.verlet import linear_step_matrix
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ import matplotlib.image as mpimg
 import numpy as np
 
 from conftest import MODELS_DIR
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 
 
 def png_has_pixels(path, min_bytes=2000):

@@ -6,7 +6,7 @@ import textwrap
 import pytest
 
 from conftest import MODELS_DIR
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 
 HEADER = "import sympy as sp\nfrom lagrange_gen import Model, coordinates, parameters, t\n"
 GOOD = HEADER + textwrap.dedent("""
@@ -90,7 +90,7 @@ def test_check_reports_missing_and_stale(workspace, tmp_path, capsys):
 def test_parameter_without_value(tmp_path):
     from lagrange_gen import SimulationError
     from lagrange_gen.codegen import generate_model
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.run.loader import import_generated
     model = tmp_path / "spring.py"
     model.write_text(GOOD.replace("defaults=(1.0, 2.0)", "defaults={'m': 1.0}"))
     mod = import_generated(generate_model(model, tmp_path / "out").path)
@@ -111,7 +111,7 @@ def test_several_models_and_dynamicsymbols(tmp_path, capsys):
     """))
     shutil.copy(MODELS_DIR / "cart_pendulum.py", tmp_path / "cart_pendulum.py")
     assert main([str(ds), str(tmp_path / "cart_pendulum.py"), "-o", str(tmp_path / "out")]) == 0
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.run.loader import import_generated
     mod = import_generated(tmp_path / "out" / "ds_pendulum.py")
     assert mod.COORDS == ("q",)
     assert mod.accelerations([0.5], [0.0])[0] == pytest.approx(-9.81 / 2.0 * __import__("math").sin(0.5))

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lagrange_gen.cli import main
-from lagrange_gen.simulation import simulate
+from lagrange_gen.cli.main import main
+from lagrange_gen.run.simulate import simulate
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"

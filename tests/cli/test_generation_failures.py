@@ -15,7 +15,7 @@ import textwrap
 import pytest
 
 from conftest import MODELS_DIR, ROOT
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 
 CLI = str(ROOT / ".venv" / "bin" / "lagrange-gen")
 PYTHON = str(ROOT / ".venv" / "bin" / "python")
@@ -162,7 +162,7 @@ def test_import_after_regeneration_in_the_same_process_gives_the_new_module(tmp_
     """import_generated caches modules by path: after the file is regenerated (here with another
     method), the same process must get the new text, not the module object imported before."""
     from lagrange_gen.codegen import generate_model
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.run.loader import import_generated
     model = ROOT / "models" / "damped_oscillator.py"
     first = import_generated(generate_model(model, tmp_path, methods=["rk4"]).path)
     assert not hasattr(first, "run_verlet")

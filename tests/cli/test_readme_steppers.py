@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lagrange_gen.simulation import simulate
-from lagrange_gen.steppers import registry
+from lagrange_gen.run.simulate import simulate
+from lagrange_gen.steppers.core import registry
 
 README = (Path(__file__).resolve().parents[2] / "README.md").read_text()
 

@@ -15,7 +15,7 @@ import textwrap
 import pytest
 
 from conftest import MODELS_DIR, ROOT
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 from lagrange_gen.errors import GenerationError, StaleModuleError
 
 CLI = str(ROOT / ".venv" / "bin" / "lagrange-gen")
@@ -45,7 +45,7 @@ def test_hand_edited_kernel_fails_import_and_check(tmp_path, capsys):
     text = target.read_text()
     body_line = next(line for line in text.splitlines() if line.startswith("    out[0] = "))
     target.write_text(text.replace(body_line, body_line + " * 2.0", 1))   # KEY line untouched
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.run.loader import import_generated
     with pytest.raises(StaleModuleError, match=r"damped_oscillator\.py.*edited.*lagrange-gen .*damped_oscillator\.py"):
         import_generated(target)
     capsys.readouterr()
@@ -185,8 +185,8 @@ def test_hints_quote_paths_and_keep_the_output_directory(tmp_path, capsys):
 def test_regeneration_command_of_a_module(tmp_path):
     """keys.regeneration_command_for: the command that regenerates a generated module with more
     methods, with -o and quoted paths (what the simulate hint prints)."""
-    from lagrange_gen.keys import regeneration_command_for
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.codegen.keys import regeneration_command_for
+    from lagrange_gen.run.loader import import_generated
     model = shutil.copy(MODELS_DIR / "damped_oscillator.py", tmp_path / "damped oscillator.py")
     out = tmp_path / "gen out"
     assert main([str(model), "-o", str(out), "--freeze", "c=2", *ONE_METHOD]) == 0

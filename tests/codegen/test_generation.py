@@ -10,8 +10,8 @@ import pytest
 from conftest import MODELS_DIR, ROOT
 from lagrange_gen import StaleModuleError
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.keys import read_key
-from lagrange_gen.loader import import_generated
+from lagrange_gen.codegen.keys import read_key
+from lagrange_gen.run.loader import import_generated
 
 
 def test_second_run_is_byte_identical_even_with_another_hash_seed(tmp_path):

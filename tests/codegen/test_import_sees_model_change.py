@@ -9,9 +9,9 @@ import pytest
 
 from conftest import MODELS_DIR
 from lagrange_gen import StaleModuleError
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 
 @pytest.fixture

@@ -15,13 +15,13 @@ import pytest
 
 import lagrange_gen
 from conftest import MODELS_DIR, ROOT
-from lagrange_gen import keys, sources
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
+from lagrange_gen.codegen import keys, sources
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.generate import check_generated
 from lagrange_gen.errors import SimulationError, StaleModuleError
-from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, METHODS
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, METHODS
 
 # nonsmooth_euler is implicit Euler on a model without elements: simulate accepts it there.
 UNCONSTRAINED = [m for m in METHODS if m not in CONSTRAINED_METHODS]
@@ -121,7 +121,7 @@ def test_comment_in_an_unrelated_stepper_changes_nothing(cart, package_copy):
     before, stamp = target.read_bytes(), target.stat().st_mtime_ns
     generate_model(model, out)                 # same text from the copy: hashes are of bytes
     assert target.read_bytes() == before
-    _add_comment(package_copy / "steppers" / "rattle.py")          # glued by four_bar, not here
+    _add_comment(package_copy / "steppers" / "methods" / "rattle.py")          # glued by four_bar, not here
     generate_model(model, out)
     assert target.read_bytes() == before and target.stat().st_mtime_ns == stamp
     keys.check_current(target, *(import_generated(target).__dict__[k] for k in
@@ -134,10 +134,10 @@ def test_comment_in_a_glued_stepper_makes_the_module_stale(cart, package_copy, t
     first = generate_model(model, out)
     mod = import_generated(first.path)
     fields = [mod.KEY, mod.SOURCES, mod.MODEL_PATH, mod.OPTIONS, mod.TEXT_SHA]
-    _add_comment(package_copy / "steppers" / "base.py")            # shared by every stepper
-    with pytest.raises(StaleModuleError, match=r"steppers/base\.py changed since generation.*lagrange-gen"):
+    _add_comment(package_copy / "steppers" / "core" / "base.py")          # shared by every stepper
+    with pytest.raises(StaleModuleError, match=r"steppers/core/base\.py changed since generation.*lagrange-gen"):
         keys.check_current(first.path, *fields)
-    assert "stepper sources changed: steppers/base.py" in check_generated(model, out)[1]
+    assert "stepper sources changed: steppers/core/base.py" in check_generated(model, out)[1]
     second = generate_model(model, out)
     assert second.written and second.key != first.key
 

@@ -11,14 +11,14 @@ import sympy as sp
 
 from conftest import MODELS_DIR
 from lagrange_gen import SimulationError, load_model, simulate
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model, generate_text
 from lagrange_gen.codegen.needs import MODULE_FUNCTIONS, method_needs
 from lagrange_gen.codegen.spec import kernel_table
 from lagrange_gen.derive import derive
-from lagrange_gen.loader import compile_all, import_generated
-from lagrange_gen.params import resolve_params
-from lagrange_gen.steppers.registry import METHODS
+from lagrange_gen.run.loader import compile_all, import_generated
+from lagrange_gen.run.params import resolve_params
+from lagrange_gen.steppers.core.registry import METHODS
 
 sys.path.insert(0, str(MODELS_DIR))
 from n_link_pendulum import n_link_pendulum  # noqa: E402
@@ -35,7 +35,7 @@ def _generate(tmp_path, model, **kwargs):
 
 
 def test_method_needs_are_read_from_the_stepper_sources():
-    # (N_COORDS: the loop bound of every step, steppers/base.py "Loop bounds")
+    # (N_COORDS: the loop bound of every step, steppers/core/base.py "Loop bounds")
     assert method_needs("explicit_euler", with_loop=False) == {"forward_dynamics", "N_COORDS"}
     # the run loop adds the energy of saved states and the event functions (and, to
     # interpolate a step with events, the forward dynamics and the model's counts)

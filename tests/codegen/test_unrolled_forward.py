@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from lagrange_gen import linalg
 from lagrange_gen.codegen.forward import UNROLL_MAX, unrolled_solve_lines
-from lagrange_gen.status import OK, SINGULAR_MASS
+from lagrange_gen.steppers.core import linalg
+from lagrange_gen.steppers.core.status import OK, SINGULAR_MASS
 
 
 def _run_unrolled(H, b):

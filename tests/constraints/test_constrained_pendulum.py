@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from constraint_util import generated_model, one_angle_pendulum, pendulum_state
-from lagrange_gen.consistent import initial_multipliers
-from lagrange_gen.simulation import simulate
-from lagrange_gen.steppers.registry import INFO
+from lagrange_gen.run.consistent import initial_multipliers
+from lagrange_gen.run.simulate import simulate
+from lagrange_gen.steppers.core.registry import INFO
 
 THETA0, OMEGA0, T_END = 1.0, 0.5, 1.0
 STEPS = {1: (100, 200, 400, 800, 1600), 2: (25, 50, 100, 200, 400)}

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from constraint_util import generated_model, pendulum_state
-from lagrange_gen.consistent import ConstraintError, consistent_initial_state
 from lagrange_gen.errors import NewtonDivergence, SimulationError
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.consistent import ConstraintError, consistent_initial_state
+from lagrange_gen.run.simulate import simulate
 
 
 def test_unconstrained_method_on_constrained_model_is_refused():
@@ -87,7 +87,7 @@ def test_spook_settings_are_checked():
 def test_trajectory_outputs(tmp_path):
     """Multipliers (S, m), |Phi| and |J v| per saved row, also in the npz file; chunked runs
     carry the multiplier across chunk boundaries (same result as one chunk)."""
-    import lagrange_gen.fixed_run as sim       # where the chunk size lives
+    import lagrange_gen.run.fixed_driver as sim       # where the chunk size lives
     mod = generated_model("cartesian_double_pendulum")
     q0 = np.array([0.0, -1.0, 0.0, -2.0])
     v0 = np.array([1.0, 0.0, 2.5, 0.0])
@@ -114,7 +114,7 @@ def test_trajectory_outputs(tmp_path):
 def test_singular_newton_matrix_is_diagnosed_by_constraint():
     """What simulate appends to a SingularMass raised by a constrained method: the dependent
     constraints at the failing state, by index and equation."""
-    from lagrange_gen.consistent import diagnose_singular
+    from lagrange_gen.run.consistent import diagnose_singular
     mod = generated_model("redundant_pendulum")
     text = diagnose_singular(mod, np.array([0.0, -1.0]), np.array(mod.DEFAULTS))
     assert "linearly dependent" in text and "constraint 0 (" in text and "constraint 1 (" in text

@@ -7,10 +7,10 @@ import pytest
 
 from constraint_util import four_bar_state, generated_model, params, pendulum_state
 from conftest import glue
-from lagrange_gen.consistent import initial_multipliers
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.registry import spec
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.run.consistent import initial_multipliers
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.method_spec import make_settings
+from lagrange_gen.steppers.core.registry import spec
 
 
 def one_step(mod, method, q, v, lam, h, p, t0=0.0):

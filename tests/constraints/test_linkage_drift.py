@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from constraint_util import four_bar_state, generated_model
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 
 N_STEPS, H = 100_000, 1e-3
 TOL = 1e-12     # simulate's default newton_tol

@@ -8,7 +8,7 @@ import pytest
 
 from constraint_util import generated_model, pendulum_state
 from lagrange_gen.errors import BlowUp
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 
 H, T_END, THETA0, G = 1e-3, 2.0, 1.0, 9.81
 STIFFNESS = (1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8)

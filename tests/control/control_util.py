@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 HERE = Path(__file__).resolve().parent
 

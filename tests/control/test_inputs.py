@@ -6,8 +6,8 @@ import pytest
 
 import lagrange_gen as lg
 from control_util import torque_pendulum  # noqa: F401  (a fixture)
-from lagrange_gen.control import Signal
-from lagrange_gen.model import Model, coordinates, parameters
+from lagrange_gen.model.model import Model, coordinates, parameters
+from lagrange_gen.run.control import Signal
 
 
 @pytest.fixture(scope="module")
@@ -98,7 +98,7 @@ def test_frozen_input_is_a_constant(gen_dir):
     from pathlib import Path
 
     from lagrange_gen.codegen import generate_model
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.run.loader import import_generated
     root = Path(__file__).resolve().parents[2]
     out = gen_dir / "frozen_u"
     mod = import_generated(generate_model(root / "models" / "cart_pole.py", out, methods=["rk4"],
@@ -120,7 +120,7 @@ def test_input_change_restarts_cached_state(gen_dir, method):
     from pathlib import Path
 
     from lagrange_gen.codegen import generate_model
-    from lagrange_gen.loader import import_generated
+    from lagrange_gen.run.loader import import_generated
     mod = import_generated(generate_model(Path(__file__).resolve().parent / "forced_oscillator.py",
                                           gen_dir).path)
     assert mod.MASS_IS_CONSTANT and mod.FORCES_VELOCITY_FREE

@@ -8,7 +8,7 @@ import scipy.linalg
 
 import lagrange_gen as lg
 from control_util import torque_pendulum  # noqa: F401  (a fixture)
-from lagrange_gen.linearization import parameter_vector
+from lagrange_gen.linear.linearize import parameter_vector
 
 
 def test_cart_pole_linearization_matches_hand_derived(generated):
@@ -117,7 +117,7 @@ def test_constrained_acceleration_derivatives_off_rest(generated):
     """The KKT derivatives (d(qdd)/dq, d(qdd)/dqd of H qdd = rhs + J^T lam, J qdd = gamma) at a
     moving state of the four-bar linkage (trigonometric constraints: d gamma/dq != 0), against
     central differences of the KKT solve of the generated kernels."""
-    from lagrange_gen.linearization import _accel_jacobians
+    from lagrange_gen.linear.linearize import _accel_jacobians
     mod = generated("four_bar")
     n, m, p = mod.N_COORDS, mod.N_CONSTRAINTS, mod.DEFAULT_PARAMS.copy()
     q, qd = np.array([0.7, 0.4, 1.9]), np.array([1.1, -0.6, 0.8])

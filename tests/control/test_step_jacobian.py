@@ -8,8 +8,8 @@ import pytest
 
 import lagrange_gen as lg
 from control_util import modulated_pendulum, torque_pendulum  # noqa: F401  (fixtures)
-from lagrange_gen.step_derivatives import METHODS
-from lagrange_gen.steppers.registry import INFO
+from lagrange_gen.linear.step_derivatives import METHODS
+from lagrange_gen.steppers.core.registry import INFO
 
 def _check_against_differences(module, method, t):
     """Newton at 1e-15 (on the methods that have the setting) so the differences of the steps

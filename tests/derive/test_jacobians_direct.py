@@ -14,7 +14,7 @@ from conftest import MODELS_DIR
 from lagrange_gen import load_model
 from lagrange_gen.codegen import generate_text
 from lagrange_gen.derive import derive
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 
 def _direct(dyn):

@@ -15,7 +15,7 @@ from sympy.physics import mechanics as me
 
 from conftest import MODELS_DIR
 from lagrange_gen.codegen import generate_text
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 sys.path.insert(0, str(MODELS_DIR))
 from n_link_pendulum import n_link_pendulum  # noqa: E402

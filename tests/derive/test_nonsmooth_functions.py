@@ -7,7 +7,7 @@ import sympy as sp
 from lagrange_gen import Model, coordinates, parameters
 from lagrange_gen.codegen import generate_text
 from lagrange_gen.derive.backend import backend_for
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 
 def test_quadratic_drag_with_abs_is_differentiated_exactly(tmp_path):

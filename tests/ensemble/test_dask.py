@@ -10,8 +10,8 @@ import pytest
 
 import lagrange_gen as lg
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.ensemble_dask import chunk_size, import_on_worker
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.ensemble_dask import chunk_size, import_on_worker
+from lagrange_gen.run.loader import import_generated
 
 distributed = pytest.importorskip("distributed")
 MODELS = Path(__file__).resolve().parents[2] / "models"

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 import lagrange_gen as lg
-from lagrange_gen import run_checks, status
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.errors import LagrangeGenError, SimulationError
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run import checks as run_checks
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import status
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import lagrange_gen as lg
-from lagrange_gen.cli import main
-from lagrange_gen.cli_sweep import parse_axis
+from lagrange_gen.cli.main import main
+from lagrange_gen.cli.sweep import parse_axis
 
 MODEL = Path(__file__).resolve().parents[2] / "models" / "cart_pendulum.py"
 

@@ -13,10 +13,10 @@ import numpy as np
 
 from conftest import glue
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.method_spec import make_settings
 
 MODELS = Path(__file__).resolve().parent / "models"
 #: The methods the tests run (their glue only, to keep compile time down).

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 from test_event_reference import scipy_events
 
 MODELS = __import__("events_util").MODELS
@@ -22,7 +22,7 @@ def test_dop853_event_times_match_scipy_to_1e9(gen_dir):
     q0, v0, t_end = np.array([0.1, 0.5]), np.zeros(2), 3.0
     traj = simulate(MODELS / "cart_pendulum_events.py", "dop853", q0, v0, t_end=t_end,
                     out_dir=gen_dir, rtol=1e-12, atol=1e-12)
-    from lagrange_gen.simulation import load_module
+    from lagrange_gen.run.simulate import load_module
     reference = scipy_events(load_module(MODELS / "cart_pendulum_events.py", gen_dir), q0, v0,
                              t_end)
     for name, times in reference.items():

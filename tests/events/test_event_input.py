@@ -11,8 +11,8 @@ import pytest
 from events_util import MODELS
 from lagrange_gen import Event, ModelError, load_model
 from lagrange_gen.codegen import generate_text
-from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers import hermite
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import hermite
 
 HEADER = textwrap.dedent("""\
     import sympy as sp

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from events_util import Run, generated
-from lagrange_gen.status import OK
-from lagrange_gen.steppers.events import events_table
+from lagrange_gen.steppers.core.events import events_table
+from lagrange_gen.steppers.core.status import OK
 
 OMEGA = 2.0
 T_END = 3.0

@@ -6,7 +6,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from events_util import Run, generated
-from lagrange_gen.status import OK
+from lagrange_gen.steppers.core.status import OK
 
 
 def scipy_events(mod, q0, v0, t_end):

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from lagrange_gen.codegen import generate_text
-from lagrange_gen.loader import import_generated
-from lagrange_gen.status import OK
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core.status import OK
 
 from .strategies import sample_state
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 
 LAGRANGE_GEN = Path(sys.executable).parent / "lagrange-gen"
 

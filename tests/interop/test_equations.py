@@ -11,7 +11,7 @@ from pathlib import Path
 import sympy as sp
 
 import lagrange_gen as lg
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 N = sp.Symbol
@@ -73,7 +73,7 @@ def test_cli_equations_of_a_family_and_a_bad_file(tmp_path, capsys):
 def test_simplify_size_guard():
     """Entries above SIMPLIFY_MAX_OPS are left as derived; small ones are simplified; simplify=
     False leaves every entry alone."""
-    from lagrange_gen.equations import SIMPLIFY_MAX_OPS, _simplifier
+    from lagrange_gen.derive.equations import SIMPLIFY_MAX_OPS, _simplifier
     x = sp.Symbol("x")
     small = sp.sin(x)**2 + sp.cos(x)**2
     big = small + sum(sp.Symbol(f"a{i}") * x**i for i in range(SIMPLIFY_MAX_OPS))

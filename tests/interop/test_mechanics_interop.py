@@ -15,10 +15,10 @@ import sympy.physics.mechanics as me
 
 import lagrange_gen as lg
 from lagrange_gen import Model, ModelError, PointForce, parameters
-from lagrange_gen.bodies import expand_intermediates
+from lagrange_gen.model.bodies import expand_intermediates
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.derive import derive
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 ROOT = Path(__file__).resolve().parents[2]
 HAND = ROOT / "models" / "heavy_top.py"

@@ -26,7 +26,7 @@ import sympy as sp
 
 from lagrange_gen.bench.robot_trees import random_tree
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 pin = pytest.importorskip("pinocchio")
 

@@ -7,7 +7,7 @@ import pytest
 
 from lagrange_gen import simulate
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 # {placeholder in TEMPLATE: (internal-looking name, plain name)}. Coordinates first, then
 # parameters; every name the generated code uses for its own purposes appears.

@@ -63,7 +63,7 @@ def test_keyboard_interrupt_while_loading_stays_an_interrupt(tmp_path, monkeypat
     """Ctrl-C (or a file raising KeyboardInterrupt, which looks the same) is not turned into a
     model error that a loop over files would skip: the CLI reports "interrupted", exit 130, and
     the directory the file changed to is left again."""
-    from lagrange_gen.cli import main
+    from lagrange_gen.cli.main import main
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     path = tmp_path / "interrupted.py"

@@ -9,7 +9,7 @@ import pytest
 import sympy as sp
 
 from lagrange_gen import Model, ModelError, PointForce, SaintVenant, coordinates, parameters
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 
 
 def _refusal(build):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 _cache = {}

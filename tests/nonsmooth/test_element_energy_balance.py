@@ -10,7 +10,7 @@ of the method) on the forced Prandtl and viscoelastoplastic models."""
 import numpy as np
 import pytest
 
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 from nonsmooth_util import ns_model  # noqa: F401  (fixture)
 
 

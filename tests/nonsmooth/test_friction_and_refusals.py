@@ -7,7 +7,7 @@ import pytest
 
 from lagrange_gen import ModelError, SimulationError, load_model
 from lagrange_gen.errors import SingularNewtonMatrix
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 from nonsmooth_util import ns_model  # noqa: F401  (fixture)
 
 

@@ -6,7 +6,7 @@ import pytest
 
 from lagrange_gen.identify import identify_prandtl
 from lagrange_gen.nonsmooth import experiments
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 from nonsmooth_util import forcing, ns_model  # noqa: F401  (fixture)
 
 

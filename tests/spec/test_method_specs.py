@@ -1,4 +1,4 @@
-"""The stepper specs (steppers/spec.py) are the one place that knows a method.
+"""The stepper specs (steppers/core/method_spec.py) are the one place that knows a method.
 
 - each SPEC's declared kernels are what its code reaches (codegen.needs reads the source);
 - no source file outside steppers/ compares anything with a method's name (the CLI, simulate,
@@ -14,8 +14,8 @@ import pytest
 
 from lagrange_gen.codegen.needs import method_needs
 from lagrange_gen.errors import SimulationError
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.spec import FAMILIES, make_settings
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.method_spec import FAMILIES, make_settings
 
 SRC = Path(__file__).resolve().parents[2] / "src" / "lagrange_gen"
 

@@ -15,12 +15,12 @@ import pytest
 
 from conftest import glue
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
+from lagrange_gen.run.loader import import_generated
 
-from lagrange_gen.status import OK
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.method_spec import make_settings
+from lagrange_gen.steppers.core.status import OK
 
 HERE = Path(__file__).resolve().parent
 MODEL_FILES = {

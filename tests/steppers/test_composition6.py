@@ -1,4 +1,4 @@
-"""The sixth-order composition of verlet (steppers/composition6.py) over long runs: its energy
+"""The sixth-order composition of verlet (steppers/methods/composition6.py) over long runs: its energy
 error stays bounded (no drift) and is of its order's size; a failing substep of a composition
 restores the state the step started from. Its fitted order is in
 test_stepper_convergence.py, symmetry and symplecticity in test_stepper_geometry.py, its
@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
-from lagrange_gen.status import OK
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.method_spec import make_settings
+from lagrange_gen.steppers.core.status import OK
 from conftest import glue
 from stepper_util import HERE, model, params, run  # model is a fixture
 

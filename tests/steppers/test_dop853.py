@@ -12,12 +12,12 @@ from conftest import glue
 from stepper_util import generated_model, params
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.needs import method_needs
-from lagrange_gen.loader import import_generated
-from lagrange_gen.status import NON_FINITE, OK, UNSTABLE
-from lagrange_gen.steppers import registry
-from lagrange_gen.status import STEP_TOO_SMALL, TOO_MANY_STEPS
-from lagrange_gen.steppers.base import N_STATS, STAT_ITERS, STAT_RESIDUAL
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.base import N_STATS, STAT_ITERS, STAT_RESIDUAL
+from lagrange_gen.steppers.core.method_spec import make_settings
+from lagrange_gen.steppers.core.status import NON_FINITE, OK, UNSTABLE
+from lagrange_gen.steppers.core.status import STEP_TOO_SMALL, TOO_MANY_STEPS
 
 Q0, V0 = np.array([0.7, -0.4]), np.array([0.2, 0.9])
 T_END = 5.0

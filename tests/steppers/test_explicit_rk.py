@@ -7,10 +7,10 @@ import pytest
 from numba import njit
 
 from stepper_util import model, one_step, params  # model is a fixture
-from lagrange_gen.status import OK
-from lagrange_gen.steppers import rk4
-from lagrange_gen.steppers.explicit_rk import (HEUN_A, HEUN_B, HEUN_C, RK4_A, RK4_B, RK4_C,
+from lagrange_gen.steppers.core.explicit_rk import (HEUN_A, HEUN_B, HEUN_C, RK4_A, RK4_B, RK4_C,
                                                RULE38_A, RULE38_B, RULE38_C, rk_step)
+from lagrange_gen.steppers.core.status import OK
+from lagrange_gen.steppers.methods import rk4
 
 STATES = [([0.3, 0.8], [0.2, -0.5]), ([-1.2, 2.9], [1.5, 3.0]), ([0.0, 0.0], [0.0, 0.0])]
 

@@ -1,4 +1,4 @@
-"""The one Newton of the implicit steppers (steppers/newton.py), alone on small systems with
+"""The one Newton of the implicit steppers (steppers/core/newton.py), alone on small systems with
 known solutions: F(x) = x_i^2 - a_i (root sqrt(a), Jacobian diag(2 x)); a singular Jacobian; a
 non-finite residual; the iteration cap."""
 
@@ -7,9 +7,9 @@ import math
 import numpy as np
 from numba import njit
 
-from lagrange_gen.status import NEWTON_DIVERGED, NON_FINITE, OK, SINGULAR_NEWTON
-from lagrange_gen.steppers import newton
-from lagrange_gen.steppers.base import FAST
+from lagrange_gen.steppers.core import newton
+from lagrange_gen.steppers.core.base import FAST
+from lagrange_gen.steppers.core.status import NEWTON_DIVERGED, NON_FINITE, OK, SINGULAR_NEWTON
 
 ROOTS, SINGULAR, NAN_RESIDUAL, INF_JACOBIAN = 0, 1, 2, 3
 

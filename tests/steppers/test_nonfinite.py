@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.errors import BlowUp, NewtonDivergence, SingularMass
-from lagrange_gen.loader import import_generated
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.run.simulate import simulate
 
 from stepper_util import HERE, model  # noqa: F401  (model is a fixture)
 
@@ -95,8 +95,8 @@ def test_check_state_sorts_every_entry_and_bound(bound):
     """base.check_state, run after every step: NaN and +-inf in any entry of q or v are
     NON_FINITE, also under an infinite blow-up bound (its fast path compares |x| <= bound, which
     inf passes when bound is inf); a finite entry past a finite bound is UNSTABLE."""
-    from lagrange_gen.status import NON_FINITE, OK, UNSTABLE
-    from lagrange_gen.steppers.base import check_state
+    from lagrange_gen.steppers.core.base import check_state
+    from lagrange_gen.steppers.core.status import NON_FINITE, OK, UNSTABLE
     for bad, expected in ((math.nan, NON_FINITE), (math.inf, NON_FINITE),
                           (-math.inf, NON_FINITE),
                           (1e200, UNSTABLE if bound < math.inf else OK)):

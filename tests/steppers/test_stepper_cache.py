@@ -1,5 +1,5 @@
 """The run_<method> glue is cached on disk: a second process loads it instead of recompiling
-(DESIGN.md section 5; the reason the glue exists, see steppers/registry.py)."""
+(DESIGN.md section 5; the reason the glue exists, see steppers/core/registry.py)."""
 
 import json
 import subprocess
@@ -9,17 +9,17 @@ from lagrange_gen.codegen import generate_model
 
 from stepper_util import MODEL_FILES
 
-#: Explicit ones and each Newton path (the shared steppers/newton.py): a glue that numba cannot
+#: Explicit ones and each Newton path (the shared steppers/core/newton.py): a glue that numba cannot
 #: cache ("dynamic globals") would recompile in every process.
 METHODS = ("rk4", "verlet", "midpoint", "implicit_euler", "symplectic_euler")
 
 SCRIPT = """
 import json, sys
 import numpy as np
-from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.method_spec import make_settings
 mod = import_generated(sys.argv[1])
 out = dict()
 for method in sys.argv[2].split(","):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from stepper_util import model, params, reference_solution, run  # model is a fixture
-from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, INFO, METHODS
+from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, INFO, METHODS
 
 T_END = 1.0
 # Step counts per order: small enough steps to be in the asymptotic regime, errors still far

@@ -8,11 +8,11 @@ import shlex
 import numpy as np
 import pytest
 
-from lagrange_gen.cli import main
+from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.errors import BlowUp, NewtonDivergence, SimulationError, SingularMass
-from lagrange_gen.loader import import_generated
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.run.simulate import simulate
 
 from stepper_util import MODEL_FILES, model  # model is a fixture
 

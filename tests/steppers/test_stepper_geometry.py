@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from stepper_util import mass_matrix, model, one_step, params  # model is a fixture
-from lagrange_gen.steppers.registry import INFO, METHODS
+from lagrange_gen.steppers.core.registry import INFO, METHODS
 
 # The fixed-step methods for smooth unconstrained models whose SPEC claims the property.
 FIXED = [m for m in METHODS

@@ -12,7 +12,7 @@ import pytest
 
 from stepper_util import model, one_step, params  # model is a fixture
 from lagrange_gen.analysis.stability import CLOSED_FORMS, spectral_radius  # closed forms of case 3
-from lagrange_gen.steppers import registry
+from lagrange_gen.steppers.core import registry
 
 TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)
 OMEGA = 3.0        # not 1, so that h and tau differ and a wrong scaling shows

@@ -1,4 +1,4 @@
-"""The energy balance E - E0 - W = 0 (steppers/work.py): W, the work of non-conservative forces,
+"""The energy balance E - E0 - W = 0 (steppers/core/work.py): W, the work of non-conservative forces,
 dissipation and explicit time, integrated by the run loop with the corrected trapezoid rule.
 
 On a damped, forced model the balance error max |E - E0 - W| over the run converges at the
@@ -12,8 +12,9 @@ import sys
 import numpy as np
 import pytest
 
-from lagrange_gen import fixed_run, simulate
-from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
+from lagrange_gen import simulate
+from lagrange_gen.run import fixed_driver as fixed_run
+from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
 from time_util import ROOT
 
 UNCONSTRAINED = [m for m in METHODS if not INFO[m].adaptive and m not in NONSMOOTH_METHODS

@@ -19,7 +19,7 @@ import pytest
 import sympy as sp
 
 from lagrange_gen import simulate
-from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
+from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
 from time_util import dop853, generated_rhs
 
 T_END = 1.0

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.loader import import_generated
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.run.simulate import simulate
 
 EVENTS_MODEL = Path(__file__).resolve().parent.parent / "events" / "models" / "cart_pendulum_events.py"
 

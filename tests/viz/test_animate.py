@@ -8,9 +8,9 @@ import pytest
 from PIL import Image, ImageChops
 
 from lagrange_gen import LagrangeGenError, ModelError, Trajectory
-from lagrange_gen.animate import _scene, default_frames, frame_states, point_positions
-from lagrange_gen.cli import main
-from lagrange_gen.model_file import load_model
+from lagrange_gen.cli.main import main
+from lagrange_gen.model.model_file import load_model
+from lagrange_gen.viz.animate import _scene, default_frames, frame_states, point_positions
 from tests.conftest import MODELS_DIR
 
 
@@ -152,7 +152,7 @@ def test_frozen_parameters_and_build_options_come_from_the_source(run):
                           "source": {**source, "frozen": {}}})
     _, xyz = point_positions(chain, load_model(MODELS_DIR / "n_link_pendulum.py", n=2), 3)
     assert xyz.shape == (3, 3, 2)
-    from lagrange_gen.animate import drawing_model
+    from lagrange_gen.viz.animate import drawing_model
     assert drawing_model(chain).name == "n_link_pendulum_2"
     frozen = Trajectory(**{**traj.__dict__, "params": params,
                            "source": {**traj.source, "frozen": {"l2": 0.5}}})
@@ -164,7 +164,7 @@ def test_frozen_parameters_and_build_options_come_from_the_source(run):
 
 def test_simulate_records_where_the_module_came_from(tmp_path):
     from types import SimpleNamespace
-    from lagrange_gen.simulation import _source
+    from lagrange_gen.run.simulate import _source
     module = SimpleNamespace(__file__=str(tmp_path / "gen" / "m.py"), MODEL_PATH="../models/m.py",
                              OPTIONS={"build": {"n": 4}, "methods": ["rk4"]}, FROZEN={"g": 9.81})
     assert _source(module) == {"model_file": str(tmp_path / "models" / "m.py"),

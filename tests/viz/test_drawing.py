@@ -9,8 +9,8 @@ import sympy as sp
 
 from lagrange_gen import Drawing, Model, ModelError, coordinates, parameters
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.drawing import positions_function
-from lagrange_gen.model_file import load_model
+from lagrange_gen.model.drawing import positions_function
+from lagrange_gen.model.model_file import load_model
 from tests.conftest import MODELS_DIR
 
 rng = np.random.default_rng(7)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen import Trajectory
-from lagrange_gen.plot import MAX_ROWS
+from lagrange_gen.viz.plot import MAX_ROWS
 
 
 def by_label(fig):

@@ -13,7 +13,7 @@ a method keeps to roundoff are bounded by roundoff_bound, one rounding of the qu
 import numpy as np
 
 from lagrange_gen import simulate
-from lagrange_gen.steppers.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
+from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, INFO, METHODS, NONSMOOTH_METHODS
 
 # Fixed-step methods (order fits at given step counts); dop853 chooses its own steps and is
 # checked in tests/steppers/test_dop853.py and tests/events.

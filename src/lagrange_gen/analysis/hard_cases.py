@@ -13,10 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..steppers import registry
 from . import reference, scenes, stability
 from .runs import fmt, guarded_run, load_module, params_of, short_error, \
     unconstrained_methods
+from ..steppers.core import registry
 
 PASS, FAIL = "PASS", "FAIL"
 

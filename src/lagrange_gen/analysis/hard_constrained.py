@@ -9,11 +9,11 @@ import math
 
 import numpy as np
 
-from ..steppers import registry
 from . import reference, scenes
+from .hard_cases import FAIL, PASS, CaseResult, _methods, _verdict
 from .runs import NOT_AVAILABLE, constrained_methods, guarded_run, has_method, load_module, \
     model_available, params_of, short_error
-from .hard_cases import FAIL, PASS, CaseResult, _methods, _verdict
+from ..steppers.core import registry
 
 STIFFNESSES = (1e2, 1e4, 1e6, 1e8)
 THETA0 = 0.5           # start angle of the pendulums, rad from the downward vertical

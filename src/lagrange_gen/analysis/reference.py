@@ -22,7 +22,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.special import ellipj
 
-from ..status import OK
+from ..steppers.core.status import OK
 
 REF_TOL = 1e-13
 FPU_OMEGA = 50.0
@@ -183,7 +183,7 @@ def mechanics_equations(model_file):
     symbols in the model's order). Raises ValueError for a model this peer does not cover."""
     from sympy.physics import mechanics as me
 
-    from ..model_file import load_model
+    from ..model.model_file import load_model
     model = load_model(model_file)
     if model.constraints or model.elements or any(f != 0 for f in model.forces) \
             or model.dissipation != 0:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import EnergyWarning, SimulationError
-from ..steppers import registry
+from ..steppers.core import registry
 
 NOT_AVAILABLE = "not available in this build"
 
@@ -45,7 +45,7 @@ def has_method(name):
 
 def load_module(models_dir, stem, gen_dir, **options):
     """Generated module of models_dir/<stem>.py (generated into gen_dir when missing or stale)."""
-    from ..loader import load
+    from ..run.loader import load
     return load(Path(models_dir) / f"{stem}.py", out_dir=gen_dir, options=options or None)
 
 
@@ -82,7 +82,7 @@ class Run:
 def guarded_run(mod, method, q0, v0, h, t_end, p, save_every=1, repeats=1, **kwargs):
     """simulate(...) repeated ``repeats`` times, keeping the fastest wall_time; a SimulationError
     becomes a failed Run."""
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     best, traj = np.inf, None
     for _ in range(max(1, repeats)):
         start = time.perf_counter()

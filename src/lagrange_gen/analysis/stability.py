@@ -15,9 +15,9 @@ import warnings
 
 import numpy as np
 
-from ..errors import EnergyWarning
-from ..steppers import registry
 from . import runs
+from ..errors import EnergyWarning
+from ..steppers.core import registry
 
 OMEGA = 3.0        # not 1, so that h and tau differ and a wrong scaling would show
 TAUS = (0.1, 1.0, 1.9, 1.99, 2.01, 10.0, 1000.0)       # HARD_CASES case 3
@@ -31,7 +31,7 @@ def oscillator(models_dir="models", gen_dir="generated"):
 def step_matrix(mod, method, tau, omega=OMEGA):
     """A (2, 2): columns are one step of ``method`` from (x, v) = (1, 0) and (0, 1) on
     x'' = -omega^2 x with h = tau / omega. Raises SimulationError when the step fails."""
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     p = runs.params_of(mod, m=1.0, c=1.0 / omega**2, b=0.0)
     h = tau / omega
     cols = []

@@ -122,7 +122,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     import os
-    from ..portable import JIT_ENV
+    from ..jit.portable import JIT_ENV
     # The suites time the specialized loops (the production speed of a model run more than once)
     # unless the environment asks otherwise; bench speed's first-use rows pass jit themselves.
     os.environ.setdefault(JIT_ENV, "specialized")

@@ -2,7 +2,7 @@
 processes, a progress bar and markdown/figure output. Loading models, the guarded run and
 the markdown table are lagrange_gen.analysis.runs.
 
-Every run goes through :func:`lagrange_gen.simulation.simulate`, the path a user takes: its
+Every run goes through :func:`lagrange_gen.run.simulate.simulate`, the path a user takes: its
 ``wall_time`` is the integration only (the glue is compiled or loaded from numba's cache before
 the clock starts), and its exceptions are what a failed run looks like to a user.
 """
@@ -25,7 +25,7 @@ BAD_EXAMPLES = ("explicit_euler", "index1")
 _COMPILE_CHILD = r"""
 import json, sys
 from lagrange_gen.errors import SimulationError
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.simulate import simulate
 for path, methods, q0 in json.loads(sys.argv[1]):
     for method in methods:
         try:

@@ -23,15 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..consistent import consistent_initial_state
-from ..errors import EnergyWarning, SimulationError
-from ..simulation import simulate
-from ..steppers.base import N_STATS
-from ..steppers.registry import spec
-from ..steppers.spec import make_settings
 from ..analysis.runs import fmt, md_table
 from .common import ROOT, new_figure, save_figure, write_report
+from ..errors import EnergyWarning, SimulationError
+from ..run.consistent import consistent_initial_state
+from ..run.simulate import simulate
 from .steppers import _best_of
+from ..steppers.core.base import N_STATS
+from ..steppers.core.method_spec import make_settings
+from ..steppers.core.registry import spec
 
 LINKAGE_H = 1e-3
 STIFF_H, STIFF_T, STIFF_THETA0 = 1e-3, 2.0, 1.0
@@ -53,7 +53,7 @@ STIFF_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "composition", 
 
 
 def _load(models_dir, stem, gen_dir):
-    from ..loader import load
+    from ..run.loader import load
     return load(Path(models_dir) / f"{stem}.py", out_dir=gen_dir)
 
 
@@ -64,9 +64,9 @@ def _free_twin(models_dir, stem):
     import tempfile
     from ..codegen.generate import generate_text
     from ..codegen.write import write_if_changed
-    from ..loader import import_generated
-    from ..model import Model
-    from ..model_file import load_model
+    from ..model.model import Model
+    from ..model.model_file import load_model
+    from ..run.loader import import_generated
     rigid = load_model(Path(models_dir) / f"{stem}.py")
     free = Model(f"{rigid.name}_free", rigid.coords, rigid.T, rigid.V, forces=rigid.forces,
                  dissipation=rigid.dissipation, params=rigid.params)

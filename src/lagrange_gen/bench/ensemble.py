@@ -59,7 +59,7 @@ def _time_ensembles(module, q0, v0, k, threads):
     falls on both alike. CPU / wall is how many cores the run actually got."""
     import numba
 
-    from ..ensemble_run import ensemble
+    from ..run.ensemble import ensemble
     before = numba.get_num_threads()
     timed = {t: (float("inf"), 0.0, None) for t in threads}
     split = {}
@@ -89,7 +89,7 @@ def _time_ensembles(module, q0, v0, k, threads):
 def _time_simulate_loop(module, q0, v0, k, result):
     """(best seconds per member of a Python loop of simulate over the subset, cores obtained
     in that run, all members bitwise equal to the ensemble's)."""
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     best, cores, equal = float("inf"), 0.0, True
     for _ in range(REPEATS):
         start, cpu = time.perf_counter(), time.process_time()
@@ -111,8 +111,8 @@ def _time_dask(module, q0, v0, k, local):
         import distributed
     except ImportError:
         return None
-    from ..ensemble_dask import chunk_size
-    from ..ensemble_run import ensemble
+    from ..run.ensemble import ensemble
+    from ..run.ensemble_dask import chunk_size
     kwargs = dict(q0=q0, v0=v0, params={"k": k}, t_end=T_END, h=H_STEP, save_every=SAVE_EVERY)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
@@ -132,7 +132,7 @@ def run_ensemble_bench(report_path, models_dir="models", quick=False):
     import numba
 
     from ..codegen import generate_model
-    from ..loader import import_generated
+    from ..run.loader import import_generated
     M, subset = (1_000, 20) if quick else (10_000, 100)
     with tempfile.TemporaryDirectory() as tmp:
         result = generate_model(Path(models_dir) / "cart_pendulum.py", tmp, methods=["rk4"])

@@ -92,7 +92,7 @@ def ns_per_step(n, h, integrator, params, th0, thd0, steps=20_000, repeats=3):
 def equivalence(mod, params, th0, h=1e-3, steps=1000):
     """Max abs difference of the final absolute angles and rates between MuJoCo's RK4 and our
     rk4 (same h, same start at rest): small when the MJCF chain is the model's chain."""
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     n = mod.N_COORDS
     ours = simulate(mod, "rk4", th0, np.zeros(n), t_end=steps * h, h=h, save_every=steps)
     th, thd = run_steps(n, h, "RK4", params, np.asarray(th0), np.zeros(n), steps)

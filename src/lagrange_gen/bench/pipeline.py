@@ -19,7 +19,7 @@ import json, sys, time
 t0 = time.perf_counter()
 import numba, numpy  # noqa: F401  (imports are timed separately from the module)
 t1 = time.perf_counter()
-from lagrange_gen.loader import import_generated, compile_all
+from lagrange_gen.run.loader import import_generated, compile_all
 mod = import_generated(sys.argv[1])
 t2 = time.perf_counter()
 compile_all(mod)

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
+from . import common, peers
 from ..analysis import reference as ref
 from ..analysis import runs
-from ..steppers import registry
-from . import common, peers
+from ..steppers.core import registry
 
 TARGET = 1e-8          # the headline's final-state error
 

@@ -19,9 +19,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..analysis import hard_constrained, runs
-from ..steppers import registry
 from . import common, hard, precision, precision_report, stability
+from ..analysis import hard_constrained, runs
+from ..steppers.core import registry
 
 ENERGY_TARGET = 1e-6
 

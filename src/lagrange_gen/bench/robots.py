@@ -224,7 +224,7 @@ def _derivatives_jit(mod):
 
 def _child(args):
     import numpy as np
-    from ..model_file import load_model
+    from ..model.model_file import load_model
     from ..codegen.generate import generate_parts
     from ..codegen.write import write_if_changed
     Progress = _progress_class()
@@ -244,14 +244,14 @@ def _child(args):
             kernels=[t.name for t in parts.texts])
 
     _event(stage="kernel compile")
-    from ..loader import compile_all, import_generated
+    from ..run.loader import compile_all, import_generated
     start = time.perf_counter()
     mod = import_generated(parts.target)
     compile_all(mod)
     _result(kernel_compile=time.perf_counter() - start)
 
     _event(stage="first step")
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     n = mod.N_COORDS
     rng = np.random.default_rng(0)
     q, v, tau = rng.uniform(-1, 1, n), rng.normal(size=n), np.zeros(n)

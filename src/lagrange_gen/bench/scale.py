@@ -37,7 +37,7 @@ def measure_generation(model_file, n, out_dir, methods=METHODS):
     import sympy as sp
     from ..codegen.generate import generate_parts
     from ..codegen.write import write_if_changed
-    from ..model_file import load_model
+    from ..model.model_file import load_model
     model = load_model(model_file, n=n)
     parts = generate_parts(model, out_dir, methods=list(methods) if methods else None)
     write_if_changed(parts.target, parts.text)
@@ -137,8 +137,8 @@ def _child_imports():
     start = time.perf_counter()
     import numba  # noqa: F401
     import numpy  # noqa: F401
-    from ..loader import compile_all, import_generated  # noqa: F401
-    from ..simulation import simulate  # noqa: F401
+    from ..run.loader import compile_all, import_generated  # noqa: F401
+    from ..run.simulate import simulate  # noqa: F401
     return time.perf_counter() - start
 
 
@@ -150,7 +150,7 @@ def _state(n):
 def _child_cold(path):
     """First compile in a fresh cache: kernels, then each method's glue, then the loops."""
     out = {"imports": _child_imports()}
-    from ..loader import compile_all, import_generated
+    from ..run.loader import compile_all, import_generated
     start = time.perf_counter()
     mod = import_generated(path)
     out["module_import"] = time.perf_counter() - start
@@ -168,7 +168,7 @@ def _child_cold(path):
 
 def _step_cost(mod, method, h=1e-3, target_s=0.3):
     """(glue compile seconds, ns per step inside the jitted loop) of one method."""
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     q0, v0 = _state(mod.N_COORDS)
     probe = simulate(mod, method, q0, v0, t_end=20 * h, h=h, save_every=20)
     steps = int(min(200_000, max(50, target_s / max(probe.wall_time / 20, 1e-9))))
@@ -209,8 +209,8 @@ def _forward_cost(mod, target_s=0.3):
 def _child_warm(path):
     """A second process with a warm cache: import, load the kernels, take one verlet step."""
     out = {"warm_imports": _child_imports()}
-    from ..loader import compile_all, import_generated
-    from ..simulation import simulate
+    from ..run.loader import compile_all, import_generated
+    from ..run.simulate import simulate
     start = time.perf_counter()
     mod = import_generated(path)
     q0, v0 = _state(mod.N_COORDS)
@@ -225,7 +225,7 @@ def _child_warm(path):
 def _child_kernels(path):
     """First compile of the kernels only, and the forward-dynamics cost of that module."""
     _child_imports()
-    from ..loader import compile_all, import_generated
+    from ..run.loader import compile_all, import_generated
     start = time.perf_counter()
     mod = import_generated(path)
     compile_all(mod)

@@ -28,11 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
+from . import common, mujoco_chain, peers, precision
 from ..analysis import reference as ref
 from ..analysis import runs
-from ..steppers import registry
-from . import common, mujoco_chain, peers, precision
 from .steppers import HAND_CLOSED_FORM, measure_new_process, measure_step_times
+from ..steppers.core import registry
 
 CASE = precision.Case("cart_pendulum", (0.1, 1.0), (0.0, 0.0), 10.0, 100, 100)
 CHAIN_N, CHAIN_H = 16, 1e-3
@@ -72,9 +72,9 @@ def measure_precision(models_dir, gen_dir, quick, progress):
 
 
 def portable_step_ns(mod, method, steps, repeats):
-    """ns per step of the portable glue (lagrange_gen.portable) of ``method`` on ``mod``, timed
+    """ns per step of the portable glue (lagrange_gen.jit.portable) of ``method`` on ``mod``, timed
     as bench/steppers.py times the module's own run_<method>."""
-    from .. import portable
+    from ..jit import portable
     from .steppers import _best_of, _library_runner
     go = _library_runner(mod, method, steps, portable.runner(mod, method))
     go()                                                  # compile or load
@@ -86,15 +86,15 @@ def chain_dir():
     numba's cache of it serves the next run), not in the repository's generated/, which holds
     each model file's default build (generated/n_link_pendulum_16.py was left there untracked
     after every run)."""
-    from .. import portable
+    from ..jit import portable
     return portable.portable_dir().parent / "bench"
 
 
 def measure_chain(models_dir, gen_dir, quick):
     """ns per step on the 16-link chain: {"ours": {method: ns}, "mujoco": {integrator: {c_loop,
     python_loop}} or None, "equivalence": max abs state difference of the two rk4 runs}."""
-    from ..loader import load
-    from ..simulation import simulate
+    from ..run.loader import load
+    from ..run.simulate import simulate
     mod = load(Path(models_dir) / "n_link_pendulum.py", out_dir=gen_dir,
                methods=list(CHAIN_METHODS), options={"n": CHAIN_N})
     th0, v0 = 0.3 * np.sin(np.arange(1, CHAIN_N + 1)), np.zeros(CHAIN_N)
@@ -120,8 +120,8 @@ _COLD_CHILD = r"""
 import json, sys, time
 t0 = time.perf_counter()
 import numba, numpy  # noqa: F401
-from lagrange_gen.loader import load
-from lagrange_gen.simulation import simulate
+from lagrange_gen.run.loader import load
+from lagrange_gen.run.simulate import simulate
 t1 = time.perf_counter()
 path, out_dir, method, options, q0, jit = sys.argv[1], sys.argv[2], sys.argv[3], \
     json.loads(sys.argv[4]), json.loads(sys.argv[5]), sys.argv[6]

@@ -117,7 +117,7 @@ def _step_details(steps):
               f"{r['ours_ns'] / r['hand_ns']:.2f} | {r['iters']:.2f} | "
               f"{r['portable_ns']:.0f} ({r['portable_ns'] / r['ours_ns']:.2f}x) |" for r in steps]
     return lines + ["", "The library column is the specialized loop (the generated module's "
-                        "run_<method>); the portable loop (lagrange_gen.portable, what a model "
+                        "run_<method>); the portable loop (lagrange_gen.jit.portable, what a model "
                         "just written runs first) is timed the same way.", ""]
 
 
@@ -137,7 +137,7 @@ def _chain_details(chain):
 def _cold_details(cold, warm):
     lines = ["## First simulate of a model just written (seconds)", "",
              "New process, model generated into a fresh directory, 10 steps of 1 ms, "
-             "simulate's default jit=\"auto\" (lagrange_gen.portable). \"Model just written\": "
+             "simulate's default jit=\"auto\" (lagrange_gen.jit.portable). \"Model just written\": "
              "a numba cache in which another model (bench/speed.py WARMUP_STEM) already ran the "
              "method, so the portable stepper is cached and nothing of this model is; what "
              "every new model but the first after an install costs. \"Everything cold\": a "

@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
+from . import common
 from ..analysis import runs, scenes
 from ..analysis.stability import (OMEGA, TAUS, oscillator, phase_per_step, spectral_radius,
                                   stability_limit, step_matrix, tau_table)
-from ..steppers import registry
-from . import common
+from ..steppers.core import registry
 
 
 def radius_curves(mod, methods, taus, progress):

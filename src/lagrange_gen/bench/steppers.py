@@ -27,12 +27,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from ..jit import njit
+from ..jit.cache import njit
 
-from ..steppers import registry
-from ..steppers.base import N_STATS
-from ..steppers.spec import make_settings
 from ..analysis.runs import unconstrained_methods
+from ..steppers.core import registry
+from ..steppers.core.base import N_STATS
+from ..steppers.core.method_spec import make_settings
 
 ROOT = Path(__file__).resolve().parents[3]
 Q0, V0, H_STEP = (0.1, 0.5), (0.0, 0.0), 1e-3
@@ -253,7 +253,7 @@ def _best_of(fn, repeats):
 
 def _library_runner(mod, method, n_steps, run=None):
     """A zero-argument call of ``run`` (default: the module's run_<method>; the portable glue's
-    runner, lagrange_gen.portable, takes the same arguments) for n_steps steps from (Q0, V0),
+    runner, lagrange_gen.jit.portable, takes the same arguments) for n_steps steps from (Q0, V0),
     returning (final state, Newton iterations per step)."""
     run = run or getattr(mod, f"run_{method}")
     n = mod.N_COORDS
@@ -312,10 +312,10 @@ t0 = time.perf_counter()
 import numpy as np
 import numba  # noqa: F401
 t1 = time.perf_counter()
-from lagrange_gen.loader import import_generated
-from lagrange_gen.steppers import registry
-from lagrange_gen.steppers.base import N_STATS
-from lagrange_gen.steppers.spec import make_settings
+from lagrange_gen.run.loader import import_generated
+from lagrange_gen.steppers.core import registry
+from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.method_spec import make_settings
 mod = import_generated(sys.argv[1])
 t2 = time.perf_counter()
 run = getattr(mod, "run_" + sys.argv[2])
@@ -360,7 +360,7 @@ def run_steppers_bench(report_path=ROOT / "reports" / "steppers.md",
                        model_file=ROOT / "models" / "cart_pendulum.py", quick=False):
     """Measure, write the markdown report, return the numbers."""
     from ..codegen import generate_model
-    from ..loader import import_generated
+    from ..run.loader import import_generated
     n_steps, repeats = (20_000, 2) if quick else (100_000, 5)
     with tempfile.TemporaryDirectory() as tmp:
         path = generate_model(model_file, Path(tmp) / "gen").path

@@ -17,17 +17,17 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..derive import derive
-from ..errors import GenerationError
-from ..model_file import load_model
-from ..keys import (derivation_record_path, generator_hash, key_of_text, model_hash, read_header, regeneration_command,
-                    text_hash, why_stale)
-from ..sources import source_closure, source_hashes
-from .emit import render_kernel
 from .compose import compositions
+from ..derive import derive
+from .emit import render_kernel
+from ..errors import GenerationError
+from .keys import (derivation_record_path, generator_hash, key_of_text, model_hash, read_header, regeneration_command,
+                    text_hash, why_stale)
+from ..model.model_file import load_model
 from .needs import methods_needs, select_kernels
 from .printer import Inputs
 from .render import COMPILED_IMPORTS, render_module
+from .sources import source_closure, source_hashes
 from .spec import make_kernels
 from .write import write_if_changed
 
@@ -103,7 +103,7 @@ def resolve_methods(requested, model, drop_inapplicable=False):
     nonsmooth_euler on a model with elements as in simulate. GenerationError for an unknown
     method, and for one that does not apply (one line naming it and why) unless
     ``drop_inapplicable`` (load(): simulate then refuses it with its own message)."""
-    from ..steppers.registry import METHODS, applicable_methods, inapplicable, runs_as
+    from ..steppers.core.registry import METHODS, applicable_methods, inapplicable, runs_as
     n_constraints, n_elements = model_counts(model)
     if requested is None:
         return list(applicable_methods(n_constraints, n_elements))
@@ -167,7 +167,8 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None, progre
 
 def _glue(methods, dyn):
     """The glue of every method: run_<method>, then (fixed-step methods) ensemble_<method>."""
-    from ..steppers.registry import ensemble_glue_source, glue_source, spec
+    from .glue import ensemble_glue_source, glue_source
+    from ..steppers.core.registry import spec
     blocks = []
     for m in methods:
         counts = (_n_saved(m, dyn), len(dyn.model.events))
@@ -178,14 +179,14 @@ def _glue(methods, dyn):
 
 
 def _n_saved(method, dyn):
-    from ..steppers.registry import spec
+    from ..steppers.core.registry import spec
     return spec(method).n_saved(dyn.n, dyn.m, dyn.n_elements)
 
 
 def module_sources(methods) -> dict:
     """{package file: hash} of what a module gluing ``methods`` compiles: the stepper modules,
     the package modules they import and the compiled imports of every module (linalg, status)."""
-    return source_hashes(source_closure([f"steppers.{m}" for m in methods] + list(COMPILED_IMPORTS)))
+    return source_hashes(source_closure([f"steppers.methods.{m}" for m in methods] + list(COMPILED_IMPORTS)))
 
 
 def generate_text(model, out_dir="generated", methods=None, freeze=None):

@@ -1,8 +1,8 @@
 """Which generated kernels a stepper method needs, read from the steppers' source (AST).
 
-A stepper core reaches the generated module only as ``kern`` (see steppers/base.py), so the
+A stepper core reaches the generated module only as ``kern`` (see steppers/core/base.py), so the
 kernels a method needs are the attributes ``kern.<name>`` accessed by the functions of
-``steppers/<method>.py`` and, transitively, by every function of the package they call
+``steppers/methods/<method>.py`` and, transitively, by every function of the package they call
 (``from .base import accel``, ``verlet.step`` through ``from . import verlet``, ...). Reading
 the source instead of keeping a table means a newly added method (rattle, spook, ...) is
 specialized correctly without touching the generator. The analysis is conservative: a kernel
@@ -14,25 +14,25 @@ from __future__ import annotations
 import ast
 from functools import lru_cache
 
-from ..sources import module_path, relative_module
+from .sources import module_path, relative_module
 
 _KERN = "kern"                                         # the parameter naming the generated module
 
 #: What a loop function reaches besides its own calls: base.run_loop calls the stepping loop it
 #: is passed (base.stepping_loop, a closure the glue binds), whose body is base.steps.
-_PASSED_IN = {("steppers.base", "run_loop"): [("steppers.base", "steps")]}
+_PASSED_IN = {("steppers.core.base", "run_loop"): [("steppers.core.base", "steps")]}
 
 
 def method_needs(method: str, with_loop: bool = True) -> frozenset:
-    """Names ``kern.<name>`` used by ``steppers/<method>.py`` and everything it calls, and
+    """Names ``kern.<name>`` used by ``steppers/methods/<method>.py`` and everything it calls, and
     (with_loop) by the run loop its glue calls (base.run_loop or adaptive.run_adaptive: the
     energy, events, ...). SPEC.kernels declares the method's own (with_loop=False)."""
-    from ..steppers.registry import LOOPS, spec
-    module = f"steppers.{method}"
+    from ..steppers.core.registry import LOOPS, spec
+    module = f"steppers.methods.{method}"
     roots = [(module, name) for name in _parse(module).functions]
     if with_loop:
         loop_module, loop = LOOPS[spec(method).adaptive]
-        roots.append((f"steppers.{loop_module}", loop))
+        roots.append((f"steppers.core.{loop_module}", loop))
         roots += _PASSED_IN.get(roots[-1], [])
     return _reached(roots)
 
@@ -157,7 +157,7 @@ def select_kernels(dyn, methods) -> dict:
         why.setdefault("constraint_rate", []).append("constrained model (consistent initial velocities)")
     if dyn.n_elements:
         why.setdefault("elements", []).append("model with nonsmooth elements (element energy)")
-    if {"input_jacobian", "outputs"} & set(table):   # inputs or outputs: control.py, linearize
+    if {"input_jacobian", "outputs"} & set(table):   # inputs or outputs: run/control.py, linearize
         for name in ("input_jacobian", "outputs", "output_jacobian", "rhs_jacobian",
                      "mass_matvec_dq") + (("constraint_dq",) if dyn.m else ()):
             if name in table:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import sympy as sp
 
 from ..derive.elements import KIND_CODES
-from ..keys import KEY_PREFIX, TEXT_SHA_PREFIX, key_of_text, text_hash
 from .forward import factor_at_import, forward_source
+from .keys import KEY_PREFIX, TEXT_SHA_PREFIX, key_of_text, text_hash
 from .spec import default_kernels, event_functions, live_inputs
 
 
@@ -69,17 +69,17 @@ _IMPORTS = [
     "",
     "import numpy as np",
     "",
-    "from lagrange_gen.keys import check_current",
+    "from lagrange_gen.codegen.keys import check_current",
     "from lagrange_gen.jit import njit  # numba.njit; a bad cache entry is a miss",
-    "from lagrange_gen.loader import register_module",
+    "from lagrange_gen.run.loader import register_module",
     "from lagrange_gen.errors import SingularMass",
-    "from lagrange_gen.linalg import SINGULAR_RTOL, cholesky_inplace, cholesky_solve_inplace",
-    "from lagrange_gen.params import resolve_params",
-    "from lagrange_gen.status import OK, SINGULAR_MASS",
+    "from lagrange_gen.steppers.core.linalg import SINGULAR_RTOL, cholesky_inplace, cholesky_solve_inplace",
+    "from lagrange_gen.run.params import resolve_params",
+    "from lagrange_gen.steppers.core.status import OK, SINGULAR_MASS",
 ]
 #: The modules of _IMPORTS whose functions or constants numba compiles into the kernels (the
 #: others run in Python): with the glued steppers, the roots of the module's SOURCES.
-COMPILED_IMPORTS = ("linalg", "status")
+COMPILED_IMPORTS = ("steppers.core.linalg", "steppers.core.status")
 
 
 def _model_constants(dyn, methods, texts):

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..symbols import Parameter
+from ..model.symbols import Parameter
 
 
 @dataclass
@@ -124,7 +124,7 @@ def kernel_table(dyn) -> dict:
         "events": lambda: KernelSpec(
             "events", ["q", "qd", "t", "p"], [Output("out", _column(event_functions(dyn)))],
             doc="event functions g (n_events,) in EVENT_NAMES order, whose zero crossings "
-                "steppers/events.py locates"),
+                "steppers/core/events.py locates"),
     }
     table.update(io_kernels(dyn))
     return table

@@ -3,8 +3,8 @@ acceleration-level right-hand side, in native objects."""
 
 from __future__ import annotations
 
-from ..symbols import t
 from .lagrangian import _dot, _quadratic
+from ..model.symbols import t
 
 
 def derive_constraints(model, o, q):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..model import Model, t as time_symbol
 from .backend import backend_for, ops
 from .constraints import derive_constraints
 from .elements import derive_elements
@@ -13,6 +12,7 @@ from .jacobians import Jacobians
 from .lagrangian import derive_lagrangian
 from .structured import (GraphJacobians, NotScleronomic, derive_lagrangian_graph, graph_model, import_expressions,
                          uses_graph)
+from ..model.model import Model, t as time_symbol
 
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
@@ -77,7 +77,7 @@ class Dynamics:
     def has_work(self):
         """True when E = T2 - T0 + V is not conserved: non-conservative forces, dissipation or
         an explicit t in L (P = qd . Q_nc - dL/dt nonzero), or nonsmooth elements (which
-        dissipate; steppers/work.py)."""
+        dissipate; steppers/core/work.py)."""
         return self.native["power"][0, 0] != 0 or self.n_elements > 0
 
     @property

@@ -2,7 +2,7 @@
 
 A frozen parameter disappears from the generated module's PARAMS (its value is folded into the
 kernels as a constant, so products like m * g * l shrink to one number) and is recorded in
-FROZEN; passing it at run time is an error (lagrange_gen.params.resolve_params).
+FROZEN; passing it at run time is an error (lagrange_gen.run.params.resolve_params).
 """
 
 from __future__ import annotations

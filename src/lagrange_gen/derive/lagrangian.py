@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
-from ..symbols import t
 from .backend import Mat
+from ..errors import ModelError
+from ..model.symbols import t
 
 
 def derive_lagrangian(model, o, check_samples=8):

@@ -27,9 +27,9 @@ import copy
 import numpy as np
 import sympy as sp
 
-from ..bodies import Intermediate, expand_intermediates
+from ..model.bodies import Intermediate, expand_intermediates
 from ..errors import ModelError
-from ..symbols import Parameter, t
+from ..model.symbols import Parameter, t
 from .backend import Mat, Ops, backend_for
 from .graph import Graph
 from .jacobians import Jacobians

@@ -1,7 +1,7 @@
 """Nonsmooth elements: the Saint-Venant return map, the play operator, and the lecture's experiments.
 
 The model elements themselves (SaintVenant, DryFriction) are declared in lagrange_gen.model; the
-time stepper that treats them is steppers/nonsmooth_euler.py.
+time stepper that treats them is steppers/methods/nonsmooth_euler.py.
 """
 
 from .play import loop_area, play_operator, return_map

@@ -99,7 +99,7 @@ def _figure(path, case9, case10):
 
 def run_nonsmooth_report(report_dir="reports", models_dir="models"):
     """Run the experiments and write reports/nonsmooth.md and reports/nonsmooth_cycles.png."""
-    from ..simulation import simulate
+    from ..run.simulate import simulate
     models = Path(models_dir)
     report_dir = Path(report_dir)
     report_dir.mkdir(parents=True, exist_ok=True)

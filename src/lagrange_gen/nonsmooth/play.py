@@ -8,7 +8,7 @@ a prescribed strain path this is the play (backlash) operator; the element force
 """
 
 import numpy as np
-from ..jit import njit
+from ..jit.cache import njit
 
 
 @njit(cache=True, _nrt=False)

@@ -1,0 +1,78 @@
+"""What every subcommand parses alike: NAME=VALUE lists (--param, --freeze, --set), velocity
+names (--keep), and warnings turned into one ``lagrange-gen: warning: ...`` line each."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import sys
+import warnings
+
+from ..errors import LagrangeGenError
+
+#: How each option converts its values: numbers are finite floats; build options int, float or
+#: the text itself (a build() may take a name).
+NUMBER, BUILD = "number", "build"
+
+
+def parse_assignments(values, option, kind=NUMBER, error=LagrangeGenError):
+    """``['a=1,b=2', 'c=3']`` (an append option; a single string too) -> {'a': 1.0, 'b': 2.0,
+    'c': 3.0}. ``kind`` NUMBER: finite floats; BUILD: int, else float, else the text. A malformed
+    item is ``error`` naming ``option`` and the item."""
+    if values is None:
+        return {}
+    if isinstance(values, str):
+        values = [values]
+    out = {}
+    for text in values:
+        for item in text.split(","):
+            if not item.strip():
+                continue
+            name, sep, value = item.partition("=")
+            name = name.strip()
+            if not sep or not name.isidentifier():
+                raise error(f"{option} {item.strip()}: expected NAME=VALUE, e.g. {option} a=1,b=2")
+            out[name] = _convert(name, value.strip(), kind, option, item.strip(), error)
+    return out
+
+
+def _convert(name, value, kind, option, item, error):
+    if kind == BUILD:
+        for convert in (int, float):
+            try:
+                return convert(value)
+            except ValueError:
+                continue
+        return value
+    try:
+        number = float(value)
+    except ValueError:
+        raise error(f"{option} {item}: {value!r} is not a number (expected NAME=NUMBER)") from None
+    if not math.isfinite(number):
+        # Worded as the run checks word a non-finite parameter given through the Python API.
+        raise error(f"{option} {item}: parameter {name!r} = {value} is not finite")
+    return number
+
+
+def velocity_names(values):
+    """``['th_dot,x_dot']`` or ``['th_dot', 'x_dot']`` (--keep) -> ('th_dot', 'x_dot')."""
+    return tuple(name.strip() for text in values or () for name in text.split(",") if name.strip())
+
+
+@contextlib.contextmanager
+def one_line_warnings(stream=None):
+    """Warnings raised inside the block are printed as they come, as one
+    ``lagrange-gen: warning: MESSAGE`` line each on stderr (no source line; a repeated message
+    once)."""
+    seen = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = str(message).strip().replace("\n", " ")
+        if text not in seen:
+            seen.add(text)
+            print(f"lagrange-gen: warning: {text}", file=stream or sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = show
+        yield

@@ -1,0 +1,242 @@
+"""The glue each stepper method emits into a generated module, and the portable glue.
+
+Why glue: numba caches a compiled function on disk only when it takes no function arguments.
+The cores in ``steppers/methods/<method>.py`` are generic over the kernels: they receive the generated
+module itself as their first argument (``kern``; see base.py for why a module and not the
+dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` lives in the
+generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
+and its compiled code, cores included, is loaded from numba's cache by the next process. The
+KEY of a generated module hashes the sources of the steppers it glues and of the package
+modules they import (sources.source_closure), so a change there regenerates the module
+and thereby invalidates that cache.
+
+Glue signature of the fixed-step methods::
+
+    run_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
+                 out_t, out_q, out_v, out_stats, out_extra, out_last) -> (status, steps_done)
+
+    q0, v0     (n,) float64      initial state at time t0
+    h          float             step (may be negative: steps backwards in time)
+    n_steps, save_every  int     saves after every save_every-th step, plus row 0
+    p          (n_params,)       parameter values in PARAMS order
+    settings   the method's settings record (SPEC.settings, built by spec.make_settings)
+    out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_saved)
+               S = n_steps // save_every + 1; n_saved = SPEC.n_saved(n, m, ne), the method's
+               saved fields (multipliers and residuals, element states; none for most)
+    out_last   (2 n + 3 + n_saved,)  [t, q, v, Newton iterations since the last save, Newton
+                                 residual, saved fields] at the end, or at the failure
+    status     lagrange_gen.steppers.core.status code; steps_done = index of the failing step on failure, -1
+               when the initial state is refused (see base.run_loop)
+
+Fixed-step methods also get ``ensemble_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
+out_q, out_v, out_stats, out_extra, out_last, out_status)``: the same loop for M members at once
+(a numba prange over members; member arrays with a leading M axis, see ensemble_glue_source and
+lagrange_gen.ensemble).
+
+The glue is compiled with error_model="numpy", like the kernels and the cores: non-finite
+arithmetic gives inf/NaN, which the run loop reports as NON_FINITE, never a Python exception.
+"""
+
+from __future__ import annotations
+
+from ..steppers.core.registry import LOOPS, spec
+
+
+#: Glue arguments of the adaptive methods (see adaptive.run_adaptive).
+ADAPTIVE_GLUE_ARGS = ("q0, v0, t0, t_end, p, settings, t_eval, "
+                      "out_t, out_q, out_v, out_stats, out_extra, out_last, out_events, counters")
+
+GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
+             "out_t, out_q, out_v, out_stats, out_extra, out_last, out_events")
+
+
+# _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
+# cores call kernels through; assigning it in every glue block keeps each block self-contained.
+_GLUE = '''import sys as _sys
+
+from lagrange_gen.steppers.methods import {method} as _stepper_{method}
+from lagrange_gen.steppers.core.{loop_module} import {loop} as _{loop}{loop_import}
+
+_THIS_MODULE = _sys.modules[__name__]{loop_def}
+
+
+@njit(cache=True, error_model="numpy")
+def run_{method}({wrapped}):
+    """Integrate with {method} ({summary}); returns (status, steps_done, n_events).
+
+    Argument shapes: see lagrange_gen.codegen.glue; lagrange_gen.simulate wraps this."""
+    return _{loop}(_stepper_{method}, {loop_arg}_THIS_MODULE, {n_saved}, {n_events}, {wrapped_call})'''
+
+# The portable glue (lagrange_gen.jit.portable): the same loop and method module, with the kernels
+# and constants of any model passed in as ``kern``, a named tuple of first-class functions whose
+# numba type is the same for every model, so that the method compiles once for all models.
+_PORTABLE_GLUE = '''"""Portable glue of {method}, written by lagrange_gen.jit.portable; DO NOT EDIT.
+
+Library version {digest} (a hash of the package files it compiles)."""
+import numpy as np
+
+from lagrange_gen.jit import njit
+from lagrange_gen.steppers.methods import {method} as _stepper_{method}
+from lagrange_gen.steppers.core.{loop_module} import {loop} as _{loop}{loop_import}{loop_def}
+
+
+@njit(cache=True, error_model="numpy")
+def run_{method}(kern, n_saved, {wrapped}):
+    """run_{method} of a generated module, on the kernel table ``kern`` (portable.kernel_table)
+    of any model without events; n_saved: the method's saved fields on that model
+    (SPEC.n_saved). The literal 0 prunes the event code before numba types it."""
+    return _{loop}(_stepper_{method}, {loop_arg}kern, n_saved, 0, {wrapped_call})
+
+
+@njit(cache=True, error_model="numpy")
+def run_{method}_events(kern, n_saved, {wrapped}):
+    """run_{method} on the kernel table of a model with events (kern.N_EVENTS > 0)."""
+    return _{loop}(_stepper_{method}, {loop_arg}kern, n_saved, {events}, {wrapped_call})
+'''
+
+
+#: Arguments of the ensemble glue of a fixed-step method (lagrange_gen.ensemble wraps it).
+ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
+                      "out_q, out_v, out_stats, out_extra, out_last, out_status")
+
+# ensemble_<method> runs member i in _member_<method>: base.run_loop as run_<method> runs it, on
+# the member's rows of the (M, S, ...) outputs. The member is a separate (cached) function
+# because numba parallelizes a prange loop only when its body has one exit, and run_loop, once
+# inlined, has several (early returns, a raise). S = saved_rows: the final state gets a row when
+# n_steps is not a multiple of save_every or a terminal event stopped the member, written as
+# simulate's _trajectory writes it, so a member equals simulate's Trajectory. Time rows and
+# events are per-member scratch (the times are the same for every member; events are counted).
+_ENSEMBLE_GLUE = '''import math as _math
+
+from numba import prange as _prange
+
+from lagrange_gen.steppers.core.status import NON_FINITE as _NON_FINITE
+
+
+@njit(cache=True, error_model="numpy")
+def _member_{method}({member_args}):
+    """One member of ensemble_{method}: (status, steps_done, n_events) as run_{method}."""
+    n = q0.shape[0]
+    saves = n_steps // save_every + 1
+    out_t = np.empty(saves)
+    events = np.empty((0, 3 + 2 * n))
+    status, steps, n_events = _run_loop(
+        _stepper_{method}, {loop}{kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
+        save_every, p, settings, out_t, q[:saves], v[:saves], stats[:saves], extra[:saves],
+        last, events)
+    if status == 0 and (steps % save_every != 0 or steps < n_steps):
+        row = steps // save_every + 1
+        for k in range(n):
+            q[row, k] = last[1 + k]
+            v[row, k] = last[1 + n + k]
+        energy = {kern}.energy(q[row], v[row], last[0], p)
+        stats[row, 0] = energy
+        stats[row, 1] = last[1 + 2 * n]
+        stats[row, 2] = last[2 + 2 * n]
+        for k in range(extra.shape[1]):
+            extra[row, k] = last[3 + 2 * n + k]
+        if not _math.isfinite(energy):
+            status, steps = _NON_FINITE, steps - 1
+    return status, steps, n_events
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def ensemble_{method}({table}{wrapped}):
+    """Integrate members i = 0..M-1 with {method} in one parallel loop; nothing returned.
+
+    q0, v0 (M, n); p (M, n_params); out_q, out_v (M, S, n); out_stats (M, S, N_STATS);
+    out_extra (M, S, n_saved) (row 0: the initial saved fields); out_last (M, 2 n + 3 +
+    n_saved); out_status (M, 3) int64 receives (status, steps_done, n_events) per member.
+    See lagrange_gen.codegen.glue; lagrange_gen.ensemble wraps this."""
+    for i in _prange(q0.shape[0]):
+        status, steps, n_events = _member_{method}(
+            {table}q0[i], v0[i], t0, h, n_steps, save_every, p[i], settings, out_q[i], out_v[i],
+            out_stats[i], out_extra[i], out_last[i])
+        out_status[i, 0] = status
+        out_status[i, 1] = steps
+        out_status[i, 2] = n_events'''
+
+
+def glue_args(method: str) -> str:
+    """The argument list of ``run_<method>`` (fixed-step or adaptive)."""
+    return ADAPTIVE_GLUE_ARGS if spec(method).adaptive else GLUE_ARGS
+
+
+def glue_source(method: str, n_saved: int, n_events: int) -> str:
+    """Source text of ``run_<method>`` to append to a generated module whose model gives the
+    method n_saved saved fields (SPEC.n_saved) and has n_events event functions; deterministic.
+    Both are passed to the loop as literals: numba prunes the event branches of a model without
+    events before compiling them (a module constant would only be folded later, by LLVM)."""
+    loop_module, loop = LOOPS[spec(method).adaptive]
+    args = glue_args(method)
+    wrapped = _wrap(args, f"def run_{method}(")
+    wrapped_call = _wrap(args, f"    return _{loop}(")
+    return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
+                        summary=spec(method).summary, loop_module=loop_module, loop=loop,
+                        n_saved=n_saved, n_events=n_events,
+                        **_stepping_loop_text(method, "_THIS_MODULE", n_events))
+
+
+def _stepping_loop_text(method, kern, n_events):
+    """The parts of a glue block that bind a fixed-step method's stepping loop
+    (base.stepping_loop) to the generated module (kern "_THIS_MODULE") and its n_events event
+    functions and pass it to run_loop; the portable glue (kern None) passes None (run_loop
+    runs the steps itself), an adaptive method nothing (its loop is adaptive.run_adaptive)."""
+    if spec(method).adaptive:
+        return dict(loop_import="", loop_def="", loop_arg="", events="kern.N_EVENTS")
+    if not kern:
+        # run_loop reads only n_event_fns > 0; a literal 1 (not kern.N_EVENTS, a run-time
+        # value here) lets numba prune in run_<method>_events too the branch without event
+        # workspaces (ew, iw None), which it could not type
+        return dict(loop_import="", loop_def="", loop_arg="None, ", events="1")
+    return dict(
+        loop_import="\nfrom lagrange_gen.steppers.core.base import stepping_loop as _stepping_loop",
+        loop_arg=f"_loop_{method}, ",
+        loop_def=(f"\n\n# run_loop's steps, {method}'s step inlined (base.stepping_loop)"
+                  f"\n_loop_{method} = _stepping_loop(_stepper_{method}, {kern}, {n_events})"))
+
+
+def portable_glue_source(method: str, digest: str) -> str:
+    """Source text of the portable ``run_<method>(kern, n_saved, ...)``,
+    ``run_<method>_events`` and, for a fixed-step method, ``ensemble_<method>(kern, n_saved,
+    ...)`` (models without events) (lagrange_gen.jit.portable) for the library version ``digest``;
+    deterministic."""
+    loop_module, loop = LOOPS[spec(method).adaptive]
+    args = glue_args(method)
+    wrapped = _wrap(args, f"def run_{method}_events(")
+    wrapped_call = _wrap(args, f"    return _{loop}(")
+    source = _PORTABLE_GLUE.format(method=method, digest=digest, loop_module=loop_module,
+                                   loop=loop, wrapped=wrapped, wrapped_call=wrapped_call,
+                                   **_stepping_loop_text(method, None, None))
+    if spec(method).adaptive:
+        return source
+    # ensemble_<method>(kern, n_saved, ...) for models without events (the literal 0)
+    return source + "\n\n" + _ensemble_source(method, "n_saved", 0, "kern", "kern, n_saved, ")
+
+
+def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:
+    """Source text of ``ensemble_<method>`` (fixed-step methods only), appended after
+    ``run_<method>`` (whose block imports the stepper and run_loop); deterministic."""
+    if spec(method).adaptive:
+        raise ValueError(f"{method} chooses its own steps: no ensemble glue (fixed-step only)")
+    return _ensemble_source(method, n_saved, n_events, "_THIS_MODULE", "")
+
+
+def _ensemble_source(method, n_saved, n_events, kern, table):
+    """_ENSEMBLE_GLUE for the generated module (kern "_THIS_MODULE", no table argument) or the
+    portable glue (kern "kern", table "kern, n_saved, ": the kernel table passed in)."""
+    wrapped = _wrap(ENSEMBLE_GLUE_ARGS, f"def ensemble_{method}(")
+    member_args = table + _wrap(_MEMBER_ARGS, f"def _member_{method}(") if table else _MEMBER_ARGS
+    loop = "None, " if table else f"_loop_{method}, "      # (portable: run_loop runs the steps)
+    return _ENSEMBLE_GLUE.format(method=method, wrapped=wrapped, n_saved=n_saved,
+                                 n_events=n_events, kern=kern, table=table,
+                                 member_args=member_args, loop=loop)
+
+
+_MEMBER_ARGS = "q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last"
+
+
+def _wrap(args, opening):
+    """The argument list ``args`` broken after "settings, " and aligned under ``opening``
+    (the text before the first argument: "def run_verlet(", "    return _run_loop(")."""
+    return args.replace("settings, ", "settings,\n" + " " * len(opening))

@@ -1,0 +1,174 @@
+"""``numba.njit`` with an on-disk cache that is never stale and never fatal.
+
+Every jitted function of the package and of the generated modules is decorated by ``njit``
+here. With ``cache=True`` it changes two things in numba's cache (numba.core.caching):
+
+- **Key.** numba keys an entry on the text of the one file that defines the function. The
+  compiled code also holds every function that function calls, from other files: when
+  steppers/core/linalg.py changed and constrained.py did not, numba served the old constrained.solve_rows with
+  the old Cholesky solve inside, without a word (tests/test_jit_cache.py). For a function defined
+  in the package, the entry's stamp also holds the hashes of the module's source closure
+  (sources.source_closure: every package file it imports, transitively), so a change in any of
+  them compiles it again. Generated modules and the portable glue need no more than numba's own
+  key: their text carries the hashes of the package files they compile (codegen/keys.py, jit/portable.py).
+- **Failure.** An entry that cannot be loaded or saved (truncated, garbage, written by something
+  else) is a cache miss: the entry is removed, the function compiled again, and one warning line
+  printed per source file.
+
+An uncached function of the stepper library (CALLEE_MODULES) is compiled without numba's
+CPython and cfunc wrappers, which only a call from Python or a first-class function value would
+use; a call from Python still works, through a twin compiled on first use (jit_callee).
+
+numba is imported on first use, so importing this module costs nothing.
+"""
+
+from __future__ import annotations
+
+import functools
+import glob
+import json
+import os
+import sys
+from pathlib import Path
+
+from ..codegen.sources import module_name, source_closure, source_hashes
+from .typing_memo import install as install_typing_memo
+
+
+def njit(*args, **kwargs):
+    """``numba.njit(**kwargs)``, usable as ``@njit`` or ``@njit(...)``; with ``cache=True`` the
+    cache is keyed and guarded as the module docstring says, and an uncached function of the
+    stepper library is compiled for jitted callers only (compiled_for_jitted_callers, jit_callee).
+    The first call installs numba_typing_memo (faster typing of the kernels' scalar arithmetic)
+    and compile_gc (Python's garbage collector runs rarely while numba compiles)."""
+    import numba
+
+    from .compile_gc import install as install_compile_gc
+    install_typing_memo()
+    install_compile_gc()
+
+    def decorate(fn):
+        if compiled_for_jitted_callers(fn, kwargs):
+            from .callee import callee_dispatcher
+            return callee_dispatcher(fn, kwargs)
+        return _guard_cache(numba.njit(**kwargs)(fn))
+
+    if args:                                   # used as @njit without arguments
+        return decorate(args[0])
+    return decorate
+
+
+#: Package modules (relative to lagrange_gen) whose uncached functions only jitted code calls.
+CALLEE_MODULES = ("steppers.",)
+
+
+def compiled_for_jitted_callers(fn, options) -> bool:
+    """Whether ``fn`` (decorated with numba ``options``) is compiled without numba's wrappers:
+    it is defined in CALLEE_MODULES and not cached (a cached function is loaded through its
+    wrapper). $LAGRANGE_GEN_NUMBA_WRAPPERS=1 keeps the wrappers on every function."""
+    if options.get("cache") or os.environ.get(WRAPPERS_ENV) == "1":
+        return False
+    name = module_name(fn.__code__.co_filename) or ""
+    return any(name == module or (module.endswith(".") and name.startswith(module))
+               for module in CALLEE_MODULES)
+
+
+#: Environment variable: "1" compiles every function with numba's wrappers (the comparison of
+#: tests/test_jit_callee.py, and a way out should a numba release break jit_callee).
+WRAPPERS_ENV = "LAGRANGE_GEN_NUMBA_WRAPPERS"
+
+
+def closure_stamp(path) -> str:
+    """JSON {package file: sha256 prefix} of the source closure of the package module at
+    ``path``; what a cache entry of a function defined there is valid for."""
+    return json.dumps(source_hashes(source_closure([module_name(path)])), sort_keys=True)
+
+
+def _guard_cache(dispatcher):
+    from numba.core.caching import FunctionCache
+    cache = getattr(dispatcher, "_cache", None)
+    if type(cache) is not FunctionCache:       # not cached (NullCache), or already guarded
+        return dispatcher
+    source = dispatcher.py_func.__code__.co_filename
+    if module_name(source) is None:
+        cache.__class__ = miss_on_error_cache_class()
+    else:
+        cache.__class__ = closure_keyed_cache_class()
+        cache.closure_source = source
+    return dispatcher
+
+
+@functools.lru_cache(maxsize=None)
+def miss_on_error_cache_class():
+    """numba's FunctionCache whose load/save failures are cache misses (defined on first use, so
+    that numba is imported only when something is jitted)."""
+    from numba.core.caching import FunctionCache
+
+    class MissOnErrorCache(FunctionCache):
+        def load_overload(self, sig, target_context):
+            try:
+                return super().load_overload(sig, target_context)
+            except Exception as exc:      # an unreadable entry: remove it and compile again
+                _discard_entry(self, exc)
+                return None
+
+        def save_overload(self, sig, data):
+            try:
+                super().save_overload(sig, data)
+            except Exception as exc:      # the compiled function works; only the cache failed
+                _discard_entry(self, exc)
+
+    return MissOnErrorCache
+
+
+@functools.lru_cache(maxsize=None)
+def closure_keyed_cache_class():
+    """MissOnErrorCache of a package function, whose stamp also holds closure_stamp of the file
+    that defines it (``closure_source``, set by _guard_cache)."""
+
+    class ClosureKeyedCache(miss_on_error_cache_class()):
+        # The stamp is made on the first load or save, not at decoration: reading the closure
+        # costs milliseconds per module, and most processes load a glue that already holds
+        # these functions without touching their caches.
+        closure_source = None
+
+        def _stamp_closure(self):
+            if self.closure_source is not None:
+                # numba compares this stamp with the one stored in the index file: a mismatch
+                # drops every entry of the function (caching.IndexDataCacheFile._load_index).
+                cache_file = self._cache_file
+                cache_file._source_stamp = (cache_file._source_stamp,
+                                            closure_stamp(self.closure_source))
+                self.closure_source = None
+
+        def load_overload(self, sig, target_context):
+            self._stamp_closure()
+            return super().load_overload(sig, target_context)
+
+        def save_overload(self, sig, data):
+            self._stamp_closure()
+            super().save_overload(sig, data)
+
+    return ClosureKeyedCache
+
+
+_WARNED = set()
+
+
+def _discard_entry(cache, exc):
+    """Delete one function's cache files (index and data; names as numba.core.caching makes
+    them) and warn once per source file."""
+    directory, base = Path(cache.cache_path), cache._impl.filename_base
+    removed = 0
+    for entry in [directory / f"{base}.nbi", *directory.glob(f"{glob.escape(base)}.*.nbc")]:
+        try:
+            entry.unlink()
+            removed += 1
+        except OSError:
+            pass
+    source = cache._py_func.__code__.co_filename
+    if source not in _WARNED:
+        _WARNED.add(source)
+        what = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        print(f"lagrange-gen: warning: numba cache of {source} unreadable ({what}); removed "
+              f"{removed} file(s) in {directory} and compiling again", file=sys.stderr)

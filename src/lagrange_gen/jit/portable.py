@@ -1,0 +1,332 @@
+"""Portable glue: one compiled copy of each stepper for every model.
+
+The generated ``run_<method>`` (steppers/core/registry.py) reaches the model's kernels through the
+generated module, a numba compile-time constant: numba inlines the kernels into the stepper and
+compiles the whole stepper library again for every model (seconds to tens of seconds on first
+use). The portable glue ``run_<method>(kern, n_saved, ...)`` is the same loop (base.run_loop or
+adaptive.run_adaptive) with the same method module, but ``kern`` is a named tuple of
+first-class functions (the addresses of the model's compiled kernels, typed by numba as
+``FunctionType(signature)``) and of the module constants the method reads. Its numba type is
+the same for every model, so the stepper is compiled once per method and then loaded from
+numba's cache for every model: a model just written compiles only its own kernels.
+
+The price is a call through a pointer per kernel evaluation, without inlining across kernels
+(measured on the cart pendulum: verlet 505 against 356 ns per step). The results are the same
+floating-point operations in the same order, so a portable run equals the specialized run
+bit for bit (tests/test_portable.py checks every method). simulate(jit="auto") runs the
+specialized glue when numba's cache already holds it, and otherwise starts portable and
+switches to the specialized glue between chunks when the run is long enough to pay for its
+compile (run/fixed_driver.py).
+
+Layout: the portable glue sources (codegen.glue.portable_glue_source) are written to
+``portable_dir()/<library hash>/``; the hash covers every package file the glue compiles, so a
+changed library gives new files and numba never loads a stale entry (numba's cache checks only
+the glue file itself). A version directory no process has used for UNUSED_DAYS is removed when
+a new one is made (remove_unused_versions), so upgrades do not pile up compiled glue.
+"""
+
+from __future__ import annotations
+
+import collections
+import functools
+import hashlib
+import importlib.util
+import inspect
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+#: Environment variable naming the directory of the portable glue sources (default
+#: ~/.cache/lagrange_gen/portable, or a temporary directory when the home is not writable).
+DIR_ENV = "LAGRANGE_GEN_PORTABLE_DIR"
+
+#: A library version's glue directory (portable_dir()/<library hash>) not used for this many days
+#: is removed when a new version's directory is made: every upgrade of lagrange-gen, and every
+#: edit of a stepper in a checkout, writes a new one (a few MB of compiled glue each).
+UNUSED_DAYS = 30
+
+#: The values of simulate(jit=...).
+JIT_MODES = ("auto", "specialized", "portable")
+
+#: Environment variable giving simulate's jit when the call does not (the bench sets it to
+#: "specialized": it measures the specialized loops unless a row says otherwise).
+JIT_ENV = "LAGRANGE_GEN_JIT"
+
+
+def jit_mode(jit) -> str:
+    """The jit of simulate / ensemble: ``jit``, or when None $LAGRANGE_GEN_JIT, else "auto";
+    SimulationError naming it when it is not one of JIT_MODES."""
+    jit = jit or os.environ.get(JIT_ENV) or "auto"
+    if jit not in JIT_MODES:
+        from ..errors import SimulationError
+        raise SimulationError(f"unknown jit={jit!r}; known: {', '.join(JIT_MODES)}")
+    return jit
+
+
+def portable_dir() -> Path:
+    """Directory under which the portable glue sources are written."""
+    if os.environ.get(DIR_ENV):
+        return Path(os.environ[DIR_ENV])
+    home = Path(os.path.expanduser("~"))
+    if os.access(home, os.W_OK):
+        return home / ".cache" / "lagrange_gen" / "portable"
+    return Path(tempfile.gettempdir()) / "lagrange_gen_portable"
+
+
+def _kernel_arg_types(fn):
+    """numba types of a kernel's arguments, from their names: t a float, the outputs that are
+    always 2-D (codegen.spec._ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
+    C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
+    from numba import types
+    from ..codegen.spec import _ALWAYS_2D
+    names = list(inspect.signature(fn).parameters)
+    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in _ALWAYS_2D
+                 else types.float64[::1] for a in names)
+
+
+@functools.lru_cache(maxsize=None)
+def _function_kernel_class():
+    """The FunctionKernel class (defined on first use: numba is imported only when a run
+    needs it)."""
+    from numba.experimental.function_type import WrapperAddressProtocol
+
+    class FunctionKernel(WrapperAddressProtocol):
+        """A generated kernel as a numba first-class function: the address of its compiled C
+        wrapper for the portable argument types (the dispatcher, kept alive here, owns it)."""
+
+        def __init__(self, dispatcher):
+            args = _kernel_arg_types(dispatcher.py_func)
+            dispatcher.compile(args)
+            result = dispatcher.overloads[args]
+            self.dispatcher, self.sig = dispatcher, result.signature
+            self.address = result.library.get_pointer_to_function(
+                result.fndesc.llvm_cfunc_wrapper_name)
+
+        def __wrapper_address__(self):
+            return self.address
+
+        def signature(self):
+            return self.sig
+
+    return FunctionKernel
+
+
+@functools.lru_cache(maxsize=None)
+def table_class(method: str):
+    """The named tuple class of ``method``'s kernel table: one field per ``kern.<name>`` its
+    glue reaches (codegen.needs: kernels and module constants) and N_EVENTS (the glue passes
+    it to the loop), sorted. Defined in this module under a fixed name, so that numba's cache
+    can pickle the type by reference."""
+    from ..codegen.needs import method_needs
+    from numba.core.typing.typeof import typeof_impl
+    name = f"Kernels_{method}"
+    cls = collections.namedtuple(name, sorted(method_needs(method) | {"N_EVENTS"}))
+    cls.__module__ = __name__
+    globals()[name] = cls
+    typeof_impl.register(cls)(_typeof_table)
+    return cls
+
+
+#: {id(table): (table, its numba type)}: a kernel table is typed once (tables are cached on
+#: their module and live as long as it; the table is kept here so that its id is not reused).
+_TABLE_TYPES: dict = {}
+
+
+def _typeof_table(table, context):
+    """numba's type of a kernel table (registered for every table class): numba's own tuple
+    typing, done on the first call only. numba types the arguments of every call of the glue
+    in Python; a table of 11 first-class functions took a third of the time of a short
+    simulate() call (cProfile: 22 FunctionType constructions per call)."""
+    from numba.core.typing.typeof import typeof_impl
+    entry = _TABLE_TYPES.get(id(table))
+    if entry is None or entry[0] is not table:
+        entry = _TABLE_TYPES[id(table)] = (table, typeof_impl.dispatch(tuple)(table, context))
+    return entry[1]
+
+
+def kernel_table(module, method):
+    """The kernel table of ``module`` for ``method`` (cached on the module): kernels as
+    FunctionKernel (compiled for the portable types on first use), constants as they are."""
+    tables = module.__dict__.setdefault("_PORTABLE_TABLES", {})
+    if method not in tables:
+        kernel = _function_kernel_class()
+        cls = table_class(method)
+        tables[method] = cls(*(getattr(module, field) if field.isupper()
+                               else kernel(getattr(module, field)) for field in cls._fields))
+    return tables[method]
+
+
+def _library_hash(method: str) -> str:
+    """sha256 prefix of every package file the portable glue of ``method`` compiles."""
+    from ..codegen.sources import source_closure, source_hashes
+    from ..steppers.core.registry import LOOPS, spec
+    loop_module = LOOPS[spec(method).adaptive][0]
+    files = source_closure([f"steppers.methods.{method}", f"steppers.core.{loop_module}"])
+    digest = hashlib.sha256(repr(sorted(source_hashes(files).items())).encode())
+    return digest.hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=None)
+def _glue_module(method: str):
+    """The module of the portable glue of ``method``: its source is written (atomically, once
+    per library version) and imported under a unique module name."""
+    from ..codegen.glue import portable_glue_source
+    digest = _library_hash(method)
+    source = portable_glue_source(method, digest)
+    folder = portable_dir() / digest
+    path = folder / f"run_{method}.py"
+    if not folder.is_dir():
+        folder.mkdir(parents=True, exist_ok=True)
+        remove_unused_versions(folder)
+    try:
+        os.utime(folder)               # marks the version used now (remove_unused_versions)
+    except OSError:                    # a shared directory we may not touch: it is only a mark
+        pass
+    if not path.exists() or path.read_text() != source:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".run_{method}.", suffix=".tmp")
+        with os.fdopen(fd, "w") as f:
+            f.write(source)
+        os.replace(tmp, path)
+    name = f"lagrange_gen_portable_{digest}_{method}"
+    module = sys.modules.get(name)
+    if module is None:
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return module
+
+
+def remove_unused_versions(current: Path) -> list:
+    """Remove the sibling library-version directories of ``current`` (16 hex digits, as
+    _library_hash names them; anything else is left alone) whose modification time, refreshed
+    by every process that uses one (_glue_module), is more than UNUSED_DAYS old. A process still
+    loading from one loses only its cache: an unreadable entry is a miss (lagrange_gen.jit).
+    Returns the directories removed."""
+    import shutil
+    import time
+    cutoff = time.time() - UNUSED_DAYS * 86400
+    removed = []
+    for entry in current.parent.iterdir():
+        name = entry.name
+        if entry == current or len(name) != 16 or not all(c in "0123456789abcdef" for c in name):
+            continue
+        try:
+            if entry.is_dir() and entry.stat().st_mtime < cutoff:
+                shutil.rmtree(entry)
+                removed.append(entry)
+        except OSError:                # another process removed or is writing it: leave it
+            pass
+    return removed
+
+
+def _bound(module, method, function):
+    """``function`` of the portable glue of ``method`` with ``module``'s kernel table and the
+    method's n_saved on that model (SPEC.n_saved) passed in front of the glue arguments."""
+    from ..steppers.core.registry import spec
+    run, table = getattr(_glue_module(method), function), kernel_table(module, method)
+    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
+
+    def bound(*args):
+        return run(table, n_saved, *args)
+
+    return bound
+
+
+def runner(module, method):
+    """A callable with the arguments of ``module.run_<method>`` (codegen.glue.GLUE_ARGS or
+    ADAPTIVE_GLUE_ARGS) that runs the portable glue on ``module``'s kernels."""
+    return _bound(module, method, f"run_{method}_events" if module.N_EVENTS else f"run_{method}")
+
+
+def choose(jit, specialized, module, method, args):
+    """(glue, "specialized" or "portable") for a first call with ``args``: jit="specialized"
+    the module's glue; "portable" the portable one; "auto" the module's glue when it runs
+    ``args`` without compiling (specialized_ready), else the portable one."""
+    if jit == "specialized" or (jit == "auto" and specialized_ready(specialized, args)):
+        return specialized, "specialized"
+    return runner(module, method), "portable"
+
+
+def choose_ensemble(jit, specialized, module, method, args):
+    """(glue, "specialized" or "portable") as choose, for ``module.ensemble_<method>`` and the
+    portable ``ensemble_<method>``, which has no event code: a model with events runs the
+    module's (jit="portable" is refused)."""
+    if module.N_EVENTS and jit == "portable":
+        from ..errors import SimulationError
+        raise SimulationError(f"{module.NAME}: the portable ensemble glue has no event code and "
+                              f"this model has events; use jit='auto' or 'specialized'")
+    if jit == "specialized" or module.N_EVENTS or (
+            jit == "auto" and specialized_ready(specialized, args)):
+        return specialized, "specialized"
+    return _bound(module, method, f"ensemble_{method}"), "portable"
+
+
+#: {argument key: numba signature} and {(cache index file, signature): the index's stamp when it
+#: did not hold that signature}: specialized_ready, which simulate calls on every run, types its
+#: arguments once per kind of arguments and reads a cache index once per version of it.
+_SIGNATURES: dict = {}
+_MISSES: dict = {}
+_UNSEEN = object()
+
+
+def _argument_key(value):
+    """What numba's type of an argument depends on, for the values simulate passes: an array's
+    dtype, dimensions, layout and writability; a tuple's class and items; else the class."""
+    import numpy as np
+    if isinstance(value, np.ndarray):
+        flags = value.flags
+        return (value.dtype.str, value.ndim, flags.c_contiguous, flags.f_contiguous,
+                flags.writeable, flags.aligned)
+    if isinstance(value, tuple):
+        return (type(value), tuple(_argument_key(v) for v in value))
+    return type(value)
+
+
+def _index_state(cache):
+    """(path, stamp) of a numba cache's index file: stamp = (mtime, size), or None while there is
+    no index (saving an entry writes it, which changes the stamp); None when numba's internals
+    moved (then nothing is remembered)."""
+    try:
+        path = cache._cache_file._index_path
+    except AttributeError:
+        return None
+    try:
+        info = os.stat(path)
+    except OSError:
+        return path, None
+    return path, (info.st_mtime_ns, info.st_size)
+
+
+def specialized_ready(dispatcher, args) -> bool:
+    """Whether the specialized glue ``dispatcher`` can run ``args`` without compiling: already
+    compiled in this process, or in numba's on-disk cache (then it is loaded now, as numba's own
+    first call would load it). A miss is remembered until the cache index changes (another
+    process may compile the glue meanwhile). Measured on the cart pole (midpoint, one
+    simulate() call per 1 ms step, its glue not compiled): 450 us per call before."""
+    try:
+        key = tuple(_argument_key(a) for a in args)
+        sig = _SIGNATURES.get(key)
+        if sig is None:
+            sig = _SIGNATURES[key] = tuple(dispatcher.typeof_pyval(a) for a in args)
+        if sig in dispatcher.overloads:
+            return True
+        cache = getattr(dispatcher, "_cache", None)
+        if cache is None:
+            return False
+        index = _index_state(cache)
+        if index is not None and _MISSES.get((index[0], sig), _UNSEEN) == index[1]:
+            return False
+        result = cache.load_overload(sig, dispatcher.targetctx)
+        if result is None:
+            if index is not None:
+                _MISSES[(index[0], sig)] = index[1]
+            return False
+        # as numba's Dispatcher.compile does with a cache hit
+        dispatcher.targetctx.insert_user_function(result.entry_point, result.fndesc,
+                                                  [result.library])
+        dispatcher.add_overload(result)
+        return True
+    except Exception:       # numba internals moved: treat as not cached (portable runs)
+        return False

@@ -1,0 +1,339 @@
+"""Kinetic and gravitational energy of sympy.physics.mechanics bodies, with the kinematic tree kept.
+
+sympy's ``RigidBody.kinetic_energy`` writes every velocity out in the inertial frame: on a
+spatial chain the terms triple with every body. Here each frame's orientation N.dcm(F), each
+body's angular velocity (in its own frame) and each point's position and velocity (in N) are
+computed from its parent's, one product of small matrices per joint, and every entry is an
+``Intermediate``: a symbol that stands for its definition (an expression of the coordinates,
+velocities, parameters and earlier intermediates). The energies returned are short sums over
+these symbols; the derivation differentiates through them (derive/graph.py) and never expands
+them.
+
+The frame tree is read from sympy's orientation records (``ReferenceFrame._dcm_dict``), the
+point tree from ``Point._pos_dict`` and ``Point._vel_dict``: sympy offers no public way to list
+a frame's or a point's neighbours. That reading lives in ``_neighbours`` alone; when it is not
+available (another sympy), the energies fall back to sympy's own ``kinetic_energy`` and
+``pos_from`` with one warning line: correct, but expanded.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections import deque
+
+import sympy as sp
+
+from ..errors import ModelError
+from .symbols import Coordinate, t
+
+__all__ = ["Intermediate", "kinetic_energy", "gravity_potential", "intermediates_of", "expand_intermediates"]
+
+
+class Intermediate(sp.Symbol):
+    """A symbol standing for ``definition`` (a sympy expression of coordinates, velocities,
+    parameters, t and other Intermediates). The definition is part of the symbol's identity, as
+    a Parameter's declaration is, so sympy's cache never mixes two of the same name."""
+
+    __slots__ = ("definition",)
+
+    def __new__(cls, name, definition):
+        obj = sp.Symbol.__xnew__(cls, name, real=True)
+        obj.definition = sp.sympify(definition)
+        return obj
+
+    def __getnewargs_ex__(self):
+        return ((self.name, self.definition), {})
+
+    def _hashable_content(self):
+        return super()._hashable_content() + (self.definition,)
+
+
+def intermediates_of(*exprs):
+    """[Intermediate] that ``exprs`` use, directly or through other definitions, each after
+    the ones its definition uses."""
+    order, seen = [], set()
+    for expr in exprs:
+        stack = [(s, False) for s in sp.sympify(expr).atoms(Intermediate)]
+        while stack:
+            sym, ready = stack.pop()
+            if sym in seen:
+                continue
+            if ready:
+                seen.add(sym)
+                order.append(sym)
+                continue
+            stack.append((sym, True))
+            stack.extend((u, False) for u in sym.definition.atoms(Intermediate) if u not in seen)
+    return order
+
+
+def expand_intermediates(expr):
+    """``expr`` with every Intermediate replaced by its definition, recursively (exponential on
+    deep trees: for models whose derivation cannot use the graph, and for tests)."""
+    expr = sp.sympify(expr)
+    values = {}
+    for sym in intermediates_of(expr):
+        values[sym] = sym.definition.xreplace({u: values[u] for u in sym.definition.atoms(Intermediate)})
+    return expr.xreplace(values) if values else expr
+
+
+class _Tree:
+    """The kinematics of one inertial frame N, built on demand and kept: R(F) = N.dcm(F) (3, 3),
+    w(F) the angular velocity of F in N in F's components (3, 1), r(P), v(P) the position (from
+    the fixed origin) and velocity of P in N components (3, 1); entries are Intermediates."""
+
+    def __init__(self, frame):
+        self.N = frame
+        self._count = 0
+        self._R = {frame: sp.eye(3)}
+        self._w = {frame: sp.zeros(3, 1)}
+        self._r, self._v = {}, {}
+        self._convert = {}
+        self._walk_frames()
+
+    # -- symbols --------------------------------------------------------------------------
+    def _coords(self, expr):
+        """A mechanics expression with dynamicsymbols q(t) as Coordinates, q(t)' as their
+        velocities and mechanics' time symbol as t (what Model does to the rest of T)."""
+        expr = sp.sympify(expr)
+        derivs, funcs = {}, {}
+        for d in expr.atoms(sp.Derivative):
+            f = d.expr
+            if (isinstance(f, sp.core.function.AppliedUndef) and len(f.args) == 1
+                    and d.variable_count == ((f.args[0], 1),)):
+                derivs[d] = Coordinate(str(f.func)).d
+        for f in expr.atoms(sp.core.function.AppliedUndef):
+            if len(f.args) == 1 and isinstance(f.args[0], sp.Symbol):
+                funcs[f] = Coordinate(str(f.func))
+                funcs[f.args[0]] = t
+        if derivs:
+            expr = expr.xreplace(derivs)
+        return expr.xreplace(funcs) if funcs else expr
+
+    def _name(self, expr):
+        """An Intermediate for ``expr`` (numbers and symbols stay as they are)."""
+        expr = sp.sympify(expr)
+        if expr.is_Number or expr.is_Symbol:
+            return expr
+        self._count += 1
+        return Intermediate(f"k{self._count}", expr)
+
+    def _named(self, matrix):
+        return matrix.applyfunc(self._name)
+
+    # -- frames ---------------------------------------------------------------------------
+    def _walk_frames(self):
+        """R and w of every frame connected to N, each from its parent in a breadth-first walk
+        over the orientation records."""
+        queue = deque([self.N])
+        while queue:
+            parent = queue.popleft()
+            for child in _neighbours(parent, "_dcm_dict"):
+                if child in self._R:
+                    continue
+                local = self._coords(child.dcm(parent))        # [v]_child = local [v]_parent
+                self._R[child] = self._named(self._R[parent] * local.T)
+                relative = self.components(child.ang_vel_in(parent), child, adjacent=parent)
+                self._w[child] = self._named(local * self._w[parent] + relative)
+                queue.append(child)
+
+    def R(self, frame):
+        if frame not in self._R:
+            raise ModelError(f"frame {frame} is not connected to the inertial frame {self.N} by "
+                             "orientations (orient_axis, orientnew, ...)")
+        return self._R[frame]
+
+    def w(self, frame):
+        self.R(frame)
+        return self._w[frame]
+
+    def components(self, vector, frame, adjacent=None):
+        """Components (3, 1) of a mechanics Vector in ``frame`` (converted to Coordinates),
+        through the kept R when its terms are in other frames."""
+        out = sp.zeros(3, 1)
+        for comps, where in vector.args:
+            comps = self._coords(comps)
+            if where == frame:
+                out += comps
+            elif where == adjacent:
+                out += self._coords(frame.dcm(where)) * comps
+            else:
+                out += self.R(frame).T * (self.R(where) * comps)
+        return out
+
+    def in_N(self, vector):
+        """Components (3, 1) in N of a mechanics Vector, each term through R of its frame."""
+        out = sp.zeros(3, 1)
+        for comps, where in vector.args:
+            out += self.R(where) * self._coords(comps)
+        return out
+
+    def rate_in_N(self, vector):
+        """Components (3, 1) in N of d/dt_N of a mechanics Vector (the velocity of a position
+        vector): for each term c in frame F, R(F) (dc/dt + w(F) x c)."""
+        out = sp.zeros(3, 1)
+        for comps, where in vector.args:
+            c = self._coords(comps)
+            out += self.R(where) * (_time_derivative(c) + self.w(where).cross(c))
+        return out
+
+    # -- points ---------------------------------------------------------------------------
+    def velocity(self, point):
+        """v (3, 1) in N of ``point``: from the nearest point whose velocity in N is given (a
+        fixed origin, or a point set with set_vel / v2pt_theory), as sympy's Point.vel finds
+        it, adding d/dt of each position vector on the way out."""
+        if point not in self._v:
+            root, path = _nearest(point, lambda p: self.N in _records(p, "_vel_dict"), self.N)
+            if root not in self._v:
+                self._v[root] = self._named(self.in_N(root.vel(self.N)))
+            for child, parent in path:
+                if child not in self._v:
+                    self._v[child] = self._named(self._v[parent] + self.rate_in_N(child.pos_from(parent)))
+        return self._v[point]
+
+    def position(self, point):
+        """r (3, 1) in N of ``point`` from the nearest fixed point (velocity given as zero)."""
+        if point not in self._r:
+            def fixed(p):
+                given = _records(p, "_vel_dict").get(self.N)
+                return given is not None and given == 0
+            root, path = _nearest(point, fixed, self.N, what="a fixed point (O.set_vel(N, 0))")
+            self._r.setdefault(root, sp.zeros(3, 1))
+            for child, parent in path:
+                if child not in self._r:
+                    self._r[child] = self._named(self._r[parent] + self.in_N(child.pos_from(parent)))
+        return self._r[point]
+
+
+def _time_derivative(c):
+    """d/dt of components (3, 1) in Coordinates: sum over coordinates of dc/dq q.d."""
+    coords = sorted({s for s in c.free_symbols if isinstance(s, Coordinate)}, key=str)
+    out = sp.zeros(*c.shape)
+    for q in coords:
+        out += c.diff(q) * q.d
+    if t in c.free_symbols:
+        out += c.diff(t)
+    return out
+
+
+def _records(obj, record):
+    """sympy's table ``record`` of a frame or point ({other: DCM or Vector}); _NoRecords when this
+    sympy keeps it elsewhere (the one place that reads sympy's internals)."""
+    table = getattr(obj, record, None)
+    if not isinstance(table, dict):
+        raise _NoRecords(record)
+    return table
+
+
+def _neighbours(obj, record):
+    """The frames (or points) ``obj`` is directly related to in sympy's record ``record``."""
+    return sorted(_records(obj, record), key=str)
+
+
+class _NoRecords(Exception):
+    """sympy's orientation or position records are not where this sympy keeps them."""
+
+
+def _nearest(point, wanted, frame, what=None):
+    """(root, path): the nearest point (breadth first over positions) for which ``wanted`` is
+    true, and path [(child, parent)] from root out to ``point`` ([] when ``point`` is the root).
+    ModelError naming ``what`` when there is none."""
+    parents, queue = {point: None}, deque([point])
+    while queue:
+        here = queue.popleft()
+        if wanted(here):
+            path, node = [], here
+            while parents[node] is not None:
+                path.append((parents[node], node))
+                node = parents[node]
+            return here, path
+        for other in _neighbours(here, "_pos_dict"):
+            if other not in parents:
+                parents[other] = here
+                queue.append(other)
+    what = what or f"a velocity given in {frame}"
+    raise ModelError(f"point {point}: no point located from it has {what}; set one with "
+                     f"O.set_vel({frame}, 0)")
+
+
+def _bodies(bodies, who):
+    me = _me()
+    if len(bodies) == 1 and isinstance(bodies[0], (list, tuple)):
+        bodies = tuple(bodies[0])
+    if not bodies:
+        raise ModelError(f"{who}: no bodies given (Particles or RigidBodies)")
+    for body in bodies:
+        if not isinstance(body, (me.Particle, me.RigidBody)):
+            raise ModelError(f"{who}: {body!r} is not a Particle or RigidBody")
+    return bodies
+
+
+def _me():
+    import sympy.physics.mechanics as me
+    return me
+
+
+def _check_frame(frame, who):
+    if not isinstance(frame, _me().ReferenceFrame):
+        raise ModelError(f"{who}: the first argument must be the inertial ReferenceFrame, got {frame!r}")
+
+
+def _fallback(who, exc):
+    warnings.warn(f"lagrange_gen.{who}: sympy's frame and point records were not found "
+                  f"({exc}); using sympy's expanded kinematics (slow on deep trees)", stacklevel=3)
+
+
+def kinetic_energy(frame, *bodies):
+    """T = sum over Particles and RigidBodies of 1/2 m v.v + 1/2 w.I w (v of the mass centre in
+    ``frame``, w the body's angular velocity, I its central inertia, both in the body's frame):
+    a scalar sympy expression over Intermediates (module docstring); give it to Model as T.
+    ModelError when ``frame`` is not a ReferenceFrame, a body is neither, or a velocity cannot
+    be found."""
+    _check_frame(frame, "kinetic_energy")
+    bodies = _bodies(bodies, "kinetic_energy")
+    me = _me()
+    try:
+        tree = _Tree(frame)
+        total = sp.S.Zero
+        for body in bodies:
+            v = tree.velocity(body.masscenter)
+            total += body.mass * v.dot(v) / 2
+            if isinstance(body, me.RigidBody):
+                w = tree.w(body.frame)
+                inertia = tree._coords(body.central_inertia.to_matrix(body.frame))
+                total += (w.T * inertia * w)[0, 0] / 2
+        return total
+    except _NoRecords as exc:
+        _fallback("kinetic_energy", exc)
+    except ValueError as exc:
+        raise ModelError(f"kinetic_energy: {exc}") from None
+    total = sp.S.Zero
+    for body in bodies:
+        try:
+            total += body.kinetic_energy(frame)
+        except ValueError as exc:
+            raise ModelError(f"kinetic_energy of {body}: {exc}") from None
+    return total
+
+
+def gravity_potential(frame, gravity, *bodies):
+    """V = -sum m gravity . r of the bodies' mass centres (``gravity`` a constant Vector in
+    ``frame``, e.g. -g*N.z), positions measured from the nearest fixed point (velocity set to
+    zero) they are located from; over Intermediates like kinetic_energy."""
+    _check_frame(frame, "gravity_potential")
+    bodies = _bodies(bodies, "gravity_potential")
+    me = _me()
+    if not isinstance(gravity, me.Vector):
+        raise ModelError(f"gravity_potential: gravity must be a Vector in {frame}, e.g. -g*{frame}.z; got {gravity!r}")
+    try:
+        tree = _Tree(frame)
+        g = tree.components(gravity, frame)
+        total = sp.S.Zero
+        for body in bodies:
+            total -= body.mass * g.dot(tree.position(body.masscenter))
+        return total
+    except _NoRecords as exc:
+        raise ModelError(f"gravity_potential: sympy's point records were not found ({exc}): "
+                         "write V from the positions instead") from None
+    except ValueError as exc:
+        raise ModelError(f"gravity_potential: {exc}") from None

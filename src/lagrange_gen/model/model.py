@@ -1,0 +1,366 @@
+"""The user-facing model: coordinates, parameters, energies, forces and constraints.
+
+A model file under ``models/`` builds a :class:`Model` from SymPy expressions and assigns it to a
+variable named ``model`` (optionally it also defines ``build(**options)`` returning a Model, for
+families such as the n-link pendulum). :func:`lagrange_gen.model.model_file.load_model` executes such
+a file; Model validates what it is given.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .bodies import expand_intermediates, intermediates_of
+from .drawing import Drawing, check_drawing
+from ..errors import ModelError
+from .expressions import (Event, _check_rayleigh, _convert_dynamicsymbols, _equation_as_expr, _events,
+                          _mechanics_speeds, _prescriptions, _sympify, is_mechanics_load,
+                          unknown_symbols_hint)
+from .loads import DryFriction, PointForce, SaintVenant
+from .symbols import Coordinate, Parameter, Velocity, _check_name, coordinates, parameters, t
+
+__all__ = [
+    "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Event", "Model",
+    "Drawing",
+    "coordinates", "parameters", "t", "inputs",
+]
+
+
+def inputs(names, defaults=None):
+    """Declare control inputs, e.g. ``u = inputs("u")``: parameters that a Model lists in
+    ``inputs=`` (the trailing slots of its parameter vector, written by the run loop from a
+    controller or a signal before each step; see lagrange_gen.run.control). Without a default
+    (``defaults`` as for parameters()) a run must supply the input."""
+    return parameters(names, defaults)
+
+
+class Model:
+    """A Lagrangian model. Build it in a model file and assign it to ``model``.
+
+    Parameters
+    ----------
+    name : identifier used for the generated module (generated/<name>.py).
+    coords : list of n Coordinate (or sympy.physics.mechanics dynamicsymbols).
+    T : kinetic energy T(q, qdot, t) of degree <= 2 in the velocities, T = T2 + T1 + T0
+        (rheonomic systems and rotating frames; see derive/lagrangian.py).
+    V : potential energy V(q[, t]); default 0.
+    forces : generalized forces Q(q, qdot, t): a length-n sequence, a dict {coordinate: Q}, or a
+        list of loads converted by virtual work: PointForce, and sympy.physics.mechanics
+        Force(Point, Vector), Torque(ReferenceFrame, Vector) or such (Point/ReferenceFrame,
+        Vector) tuples (lagrange_gen.model.mechanics; they need ``frame``). Conservative forces may
+        go in V instead.
+    dissipation : Rayleigh function D(q, qdot); contributes Q = -dD/dqdot.
+    constraints : list of holonomic constraints Phi(q) = 0 or Phi(q, t) = 0 (rheonomic; an
+        sp.Eq(lhs, rhs) means lhs - rhs).
+    elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
+    events : {name: g} with g(q, qdot, t) an expression, or Event(g, terminal=, direction=):
+        simulate locates the zero crossings of each g and records them (steppers/core/events.py).
+    prescribed : {Coordinate: expression of t and parameters}: coordinates whose motion is
+        given (a driven pivot, a crank turning at w t); each is substituted, with its velocity
+        (the expression's time derivative), in every expression before anything is derived.
+        They are not in coords.
+    params : optional explicit parameter order; default: order of declaration.
+    description : one line shown in the generated module's docstring.
+    frame : the inertial sympy.physics.mechanics ReferenceFrame of mechanics loads in forces=.
+    inputs : list of input symbols (``inputs("u1 u2")``), usable wherever a parameter is; they
+        are the last entries of PARAMS (zero-order hold over a step, lagrange_gen.run.control).
+    outputs : {name: y(q, qdot, t)} evaluated by the generated ``outputs`` kernel and saved
+        with the trajectory (Trajectory.saved["output_<name>"]).
+    draw : optional Drawing(points={name: (x, y[, z])}, segments=[(a, b)]) in q, parameters and t:
+        what an animation shows (model/drawing.py; never generated, the module does not change).
+    """
+
+    def __init__(self, name, coords, T, V=0, forces=None, dissipation=0, constraints=(),
+                 elements=(), params=None, description="", events=None, prescribed=None, frame=None,
+                 inputs=(), outputs=None, draw=None):
+        _check_name("model", str(name))
+        self.name = str(name)
+        self.description = description
+        coords = list(coords)
+        if not coords:
+            raise ModelError(f"model {name}: no coordinates")
+        speeds = _mechanics_speeds(coords)
+        coords, replace = _convert_dynamicsymbols(coords)
+        self.coords = coords
+        self.T = self._scalar(T, "T", replace)
+        self.V = self._scalar(V, "V", replace)
+        self.dissipation = self._scalar(dissipation, "dissipation", replace)
+        self.forces = self._generalized_forces(forces, replace, frame, speeds)
+        self.constraints = [self._scalar(_equation_as_expr(c), f"constraint {i}", replace)
+                            for i, c in enumerate(self._sequence(constraints, "constraints", "expressions Phi(q)"))]
+        self.elements = self._elements(elements, replace)
+        self.events = _events(self.name, events, replace)
+        self.inputs = self._inputs(inputs)
+        self.outputs = {str(k): self._scalar(v, f"output {k}", replace) for k, v in (outputs or {}).items()}
+        self.prescribed = _prescriptions(self.name, prescribed, coords, replace)
+        if self.prescribed:
+            self._substitute_prescribed()
+        self.intermediates = intermediates_of(*(e for _, e in self._expressions_and_events()))
+        self.params = self._collect_params(params)
+        self.source_path = None      # set by load_model
+        self.source_text = ""
+        self.build_options = {}
+        self._validate()
+        # A drawing may show a prescribed coordinate (the driven pivot): substituted like the rest.
+        sub = getattr(self, "_prescribed_sub", {})
+        self.draw = check_drawing(self, draw, lambda e, what: self._scalar(e, what, replace).xreplace(sub))
+
+    # -- construction helpers -------------------------------------------------------------
+    def _substitute_prescribed(self):
+        """Replace each prescribed coordinate by its expression and its velocity by the time
+        derivative of that expression, in every expression of the model."""
+        sub = {}
+        for c, expr in self.prescribed.items():
+            sub[c], sub[c.d] = expr, sp.diff(expr, t)
+        if intermediates_of(*(e for _, e in self._expressions_and_events())):
+            # a prescribed coordinate inside an Intermediate's definition: substituted in the
+            # expanded expressions (small models; the structured path has no prescriptions)
+            self._expand_intermediates()
+        self.T, self.V = self.T.xreplace(sub), self.V.xreplace(sub)
+        self.dissipation = self.dissipation.xreplace(sub)
+        self.forces = [f.xreplace(sub) for f in self.forces]
+        self.constraints = [c.xreplace(sub) for c in self.constraints]
+        for e in self.elements:
+            e.strain = e.strain.xreplace(sub)
+        for e in self.events:
+            e.expr = e.expr.xreplace(sub)
+        self.outputs = {k: y.xreplace(sub) for k, y in self.outputs.items()}
+        self._prescribed_sub = sub
+
+    @property
+    def velocities(self):
+        return [c.d for c in self.coords]
+
+    @property
+    def n_coords(self):
+        return len(self.coords)
+
+    @property
+    def n_constraints(self):
+        return len(self.constraints)
+
+    def _scalar(self, expr, what, replace):
+        try:
+            return _sympify(expr, what, replace)
+        except ModelError as exc:
+            raise ModelError(f"model {self.name}: {exc}") from None
+
+    def _sequence(self, items, what, of):
+        """``items`` as a list; ModelError naming ``what`` when it is not a sequence."""
+        if isinstance(items, (sp.Basic, str, bytes)) and not getattr(items, "is_Matrix", False):
+            raise ModelError(f"model {self.name}: {what} must be a sequence of {of}, got {items}")
+        try:
+            return list(items)
+        except TypeError:
+            raise ModelError(f"model {self.name}: {what} must be a sequence of {of}, got {items!r}") from None
+
+    def _generalized_forces(self, forces, replace, frame=None, speeds=()):
+        n = len(self.coords)
+        Q = [sp.S.Zero] * n
+        if forces is None:
+            return Q
+        if isinstance(forces, dict):
+            for key, value in forces.items():
+                key = replace.get(key, key)
+                if key not in self.coords:
+                    raise ModelError(f"model {self.name}: force given for {key}, which is not a coordinate")
+                Q[self.coords.index(key)] += self._scalar(value, f"force on {key}", replace)
+            return Q
+        forces = self._sequence(forces, "forces", "one Q per coordinate (or a dict {coordinate: Q}, "
+                                "or a list of PointForce)")
+        if forces and all(isinstance(f, PointForce) or is_mechanics_load(f) for f in forces):
+            if any(is_mechanics_load(f) for f in forces):
+                from .mechanics import generalized_loads
+                mech = [f for f in forces if is_mechanics_load(f)]
+                for j, Qj in enumerate(generalized_loads(mech, frame, speeds, self.name)):
+                    Q[j] += self._scalar(Qj, f"generalized force of the loads on {self.coords[j]}", replace)
+                forces = [f for f in forces if not is_mechanics_load(f)]
+            for i, f in enumerate(forces):
+                point = [self._scalar(r, f"point of PointForce {i}", replace) for r in f.point]
+                force = [self._scalar(F, f"force of PointForce {i}", replace) for F in f.force]
+                for rk, Fk in zip(point, force):
+                    for j, qj in enumerate(self.coords):
+                        Q[j] += Fk * sp.diff(rk, qj)
+            return Q
+        if len(forces) != n:
+            raise ModelError(f"model {self.name}: forces has {len(forces)} entries for {n} coordinates "
+                             "(give one per coordinate, a dict, or a list of PointForce)")
+        return [self._scalar(f, f"force {i}", replace) for i, f in enumerate(forces)]
+
+    def _elements(self, elements, replace):
+        out = []
+        for i, e in enumerate(elements):
+            if not isinstance(e, (SaintVenant, DryFriction)):
+                raise ModelError(f"model {self.name}: element {i} is {type(e).__name__}, not SaintVenant or DryFriction")
+            e.name = e.name or f"{e.kind}_{i}"
+            _check_name("element", e.name)
+            e.strain = self._scalar(e.strain, f"strain of element {e.name}", replace)
+            for c in e.coefficients():
+                self._scalar(c, f"coefficient of element {e.name}", {})
+            out.append(e)
+        return out
+
+    @property
+    def n_elements(self):
+        return len(self.elements)
+
+    def _all_expressions(self):
+        yield "T", self.T
+        yield "V", self.V
+        yield "dissipation", self.dissipation
+        for c, f in zip(self.coords, self.forces):
+            yield f"force on {c}", f
+        for i, c in enumerate(self.constraints):
+            yield f"constraint {i}", c
+        for e in self.elements:
+            yield f"strain of element {e.name}", e.strain
+            for c in e.coefficients():
+                yield f"coefficient of element {e.name}", c
+
+    def _expressions_and_events(self):
+        """_all_expressions, the events and the outputs, as the user gave them."""
+        yield from self._all_expressions()
+        for e in self.events:
+            yield f"event {e.name}", e.expr
+        for name, y in self.outputs.items():
+            yield f"output {name}", y
+
+    def _input_expressions(self):
+        """Everything whose symbols must be known: _all_expressions, the events, the outputs
+        and the definitions of the Intermediates they use (bodies.py). The events stay out of
+        _all_expressions, which chooses the derivation backend (derive/backend.py): an event is
+        evaluated, never differentiated."""
+        yield from self._expressions_and_events()
+        for sym in self.intermediates:
+            yield f"intermediate {sym.name} of {sym.definition}", sym.definition
+
+    def symbols_of(self, expr):
+        """The free symbols of ``expr`` seen through its Intermediates' definitions."""
+        out = set()
+        for s in expr.free_symbols:
+            out |= self._intermediate_symbols.get(s, {s})
+        return out
+
+    @property
+    def _intermediate_symbols(self):
+        table = self.__dict__.get("_symbols_table")
+        if table is None or len(table) != len(self.intermediates):
+            table = {}
+            for sym in self.intermediates:       # definitions come after what they use
+                table[sym] = set().union(*(table.get(u, {u}) for u in sym.definition.free_symbols))
+            self.__dict__["_symbols_table"] = table
+        return table
+
+    def _expand_intermediates(self):
+        """Replace every Intermediate by its definition in every expression (exact; large on
+        deep trees)."""
+        self.T, self.V = expand_intermediates(self.T), expand_intermediates(self.V)
+        self.dissipation = expand_intermediates(self.dissipation)
+        self.forces = [expand_intermediates(f) for f in self.forces]
+        self.constraints = [expand_intermediates(c) for c in self.constraints]
+        for e in self.elements:
+            e.strain = expand_intermediates(e.strain)
+        for e in self.events:
+            e.expr = expand_intermediates(e.expr)
+        self.outputs = {k: expand_intermediates(y) for k, y in self.outputs.items()}
+
+    def _inputs(self, given):
+        """The input symbols (Parameters declared by inputs()), checked."""
+        out = self._sequence(given, "inputs", "symbols declared by inputs()")
+        for u in out:
+            if not isinstance(u, Parameter):
+                raise ModelError(f"model {self.name}: input {u} is not declared by "
+                                 f"lagrange_gen.inputs(); write {u} = inputs({str(u)!r})")
+        if len(set(out)) != len(out):
+            raise ModelError(f"model {self.name}: an input is listed twice in inputs=")
+        return out
+
+    def _collect_params(self, explicit):
+        """The parameters in PARAMS order: ``explicit`` (params=), or the used ones in
+        declaration order. Fills param_defaults {name: default or None}."""
+        found = {}
+        for where, expr in self._input_expressions():
+            for s in expr.free_symbols:
+                if isinstance(s, Parameter) and found.setdefault(s.name, s) != s:
+                    raise ModelError(f"model {self.name}: parameter {s.name} is declared twice (two "
+                                     f"parameters() calls) and both are used ({where} uses one of "
+                                     "them); declare it once and use that symbol")
+        # Inputs are the trailing parameters, in inputs= order (their slots are the loop's).
+        params = sorted((s for s in found.values() if s not in self.inputs),
+                        key=lambda s: (s.declaration == 0, s.declaration, s.name))
+        if explicit is not None:
+            params = [s for s in explicit if s not in self.inputs]
+            for s in params:
+                if not isinstance(s, Parameter):
+                    raise ModelError(f"model {self.name}: params entry {s} is not a Parameter "
+                                     "(declare it with lagrange_gen.parameters)")
+            missing = [name for name, s in found.items() if s not in params and s not in self.inputs]
+            if missing:
+                raise ModelError(f"model {self.name}: parameter(s) {', '.join(sorted(missing))} "
+                                 "used but not in params=")
+        params = params + list(self.inputs)
+        self.param_defaults = {s.name: s.default for s in params}
+        return params
+
+    def _validate(self):
+        names = {}
+        for kind, syms in (("coordinate", self.coords), ("velocity", self.velocities),
+                           ("parameter", self.params)):
+            for s in syms:
+                _check_name(kind, s.name)
+                if s.name in names or s.name == "t":
+                    other = names.get(s.name, "time")
+                    raise ModelError(f"model {self.name}: duplicate name {s.name!r} ({other} and {kind})")
+                names[s.name] = kind
+        for name in self.outputs:
+            _check_name("output", name)
+        q, qd = set(self.coords), set(self.velocities)
+        allowed = q | qd | set(self.params) | {t} | set(self.intermediates)
+        for where, expr in self._input_expressions():
+            unknown = sorted(str(s) for s in expr.free_symbols - allowed)
+            if unknown:
+                raise ModelError(f"model {self.name}: {where} uses symbol(s) {', '.join(unknown)} "
+                                 "that are neither coordinates, velocities, parameters nor t"
+                                 + unknown_symbols_hint(expr.free_symbols - allowed))
+            if expr.has(sp.Derivative) or expr.atoms(sp.core.function.AppliedUndef):
+                raise ModelError(f"model {self.name}: {where} contains an undefined function or derivative: {expr}")
+        moving = [f"{v} ({c}.d)" for c, v in zip(self.coords, self.velocities) if v in self.symbols_of(self.V)]
+        if moving:
+            raise ModelError(f"model {self.name}: V depends on the velocit{'y' if len(moving) == 1 else 'ies'} "
+                             f"{', '.join(moving)}; V is a function of q and t: velocity-dependent "
+                             "potentials belong in T or in forces")
+        _check_rayleigh(self.name, expand_intermediates(self.dissipation), self.velocities)
+        if self.symbols_of(self.dissipation) & {t}:
+            raise ModelError(f"model {self.name}: dissipation depends on t")
+        for i, c in enumerate(self.constraints):
+            bad = sorted(str(s) for s in self.symbols_of(c) & qd)
+            if bad:
+                raise ModelError(f"model {self.name}: constraint {i} ({c}) depends on {', '.join(bad)}; "
+                                 "only holonomic constraints Phi(q, t) = 0 are supported")
+        self._validate_elements(qd)
+        if not (self.symbols_of(self.T) & qd):
+            raise ModelError(f"model {self.name}: T does not depend on any velocity")
+
+    def _validate_elements(self, qd):
+        for e in self.elements:
+            bad = sorted(str(s) for s in self.symbols_of(e.strain) & (qd | {t}))
+            if bad:
+                raise ModelError(f"model {self.name}: element {e.name}: the strain {e.strain} depends on "
+                                 f"{', '.join(bad)}; a strain must be a function s(q) of the coordinates")
+            for label, c in zip(("stiffness/bound", "threshold"), e.coefficients()):
+                if c.free_symbols - set(self.params):
+                    raise ModelError(f"model {self.name}: element {e.name}: {label} {c} must depend on parameters only")
+                value = c.xreplace({p: sp.Float(p.default) for p in c.free_symbols
+                                    if isinstance(p, Parameter) and p.default is not None})
+                if e.kind == "dry_friction" and label == "threshold":
+                    continue
+                if value.is_number and not float(value) > 0:
+                    raise ModelError(f"model {self.name}: element {e.name}: {label} must be > 0, got {c} = {float(value):g}")
+
+    def defaults(self):
+        """Default parameter values in PARAMS order (None where a value is required)."""
+        return [self.param_defaults[p.name] for p in self.params]
+
+    def __repr__(self):
+        return (f"Model({self.name!r}, coords={[c.name for c in self.coords]}, "
+                f"params={[p.name for p in self.params]}, constraints={len(self.constraints)})")

@@ -1,0 +1,214 @@
+"""What simulate checks before it allocates or integrates; each failure is one SimulationError line.
+
+* The scalar and vector arguments (``check_scalars``, ``vector``).
+* Element coefficients at the parameters of this run (``check_element_coefficients``): the model
+  file checks them at its defaults only, and ``--param eta=-1`` or ``--freeze eta=0`` would
+  otherwise run the return map with a non-positive threshold or stiffness into garbage.
+* The step count (``check_step_count``): at most MAX_STEPS steps.
+* The resolution of the time grid (``check_time_resolution``): the stepper evaluates forces at
+  t0 + k h, and the driver saves those times; they must resolve h (TIME_RESOLUTION).
+* Memory for the saved rows (``check_memory``), against the memory the system has available now.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from ..errors import SimulationError
+from .params import is_number
+
+#: Largest step count simulate runs. At the fastest measured step (tens of ns, reports/steppers.md)
+#: 1e12 steps are already more than half a day of integration; and the rounding error of a
+#: fixed-step method grows up to about n_steps * 2.2e-16, i.e. 1e-4 relative at 1e12 steps, so
+#: more steps of a smaller h cannot buy accuracy any more.
+MAX_STEPS = 10**12
+
+#: Largest spacing of float64 numbers near the run's times, as a fraction of h. The stepper
+#: evaluates time-dependent forces at t0 + k h rounded to that spacing, so each time is off by at
+#: most half of it: with TIME_RESOLUTION = 1e-6 a forcing resolved by the step (omega_f h <= 1)
+#: is sampled with a phase error below 5e-7 rad, not accumulating (times are not summed), smaller
+#: than the discretization error of a second-order method at omega h >= 1e-3, and saved times are
+#: t0 + k h to six digits of h. (t0 = 1.7e9 has spacing 2.4e-7: steps below 0.24 are refused.)
+#: Long runs may use more: near t = n h the spacing is up to n * 2.2e-16 * h, the relative
+#: rounding that n steps accumulate in the state anyway, so a run from t0 = 0 is never refused.
+TIME_RESOLUTION = 1e-6
+
+#: Value columns simulate holds per saved row at its peak, besides 2 n (q, v) and 2 n_saved
+#: (out_extra and its copy): t, the three out_stats columns, and the energy, newton_iters and
+#: newton_residual copies made for the Trajectory.
+_ROW_COLUMNS = 7
+
+
+def check_scalars(h, t0, t_end, save_every):
+    """simulate's scalar arguments: finite numbers (not bools), h > 0, t_end >= t0, save_every a
+    positive integer. (A method's own settings are checked by steppers.spec.make_settings.)"""
+    for name, value in (("h", h), ("t0", t0), ("t_end", t_end)):
+        if not is_number(value) or not math.isfinite(value):
+            raise SimulationError(f"{name} must be a finite number, got {value!r}")
+    if h <= 0:
+        raise SimulationError(f"step size h must be > 0, got {h}")
+    if t_end < t0:
+        raise SimulationError(f"t_end = {t_end} is before t0 = {t0}")
+    if (not is_number(save_every) or not math.isfinite(save_every) or int(save_every) != save_every
+            or save_every < 1):
+        raise SimulationError(f"save_every must be a positive integer, got {save_every!r}")
+
+
+def check_t_eval(t_eval, t0, t_end):
+    """t_eval: finite, strictly increasing times within [t0, t_end]."""
+    try:
+        times = np.asarray(t_eval, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SimulationError(f"t_eval must be a sequence of numbers, got {t_eval!r}") from None
+    if times.ndim != 1 or not len(times) or not np.all(np.isfinite(times)):
+        raise SimulationError("t_eval must be a non-empty 1-d sequence of finite times")
+    if np.any(np.diff(times) <= 0):
+        k = int(np.argmax(np.diff(times) <= 0))
+        raise SimulationError(f"t_eval must be strictly increasing: t_eval[{k + 1}] = "
+                              f"{times[k + 1]:g} after {times[k]:g}")
+    if times[0] < t0 or times[-1] > t_end:
+        raise SimulationError(f"t_eval must lie in [t0, t_end] = [{t0:g}, {t_end:g}], got "
+                              f"[{times[0]:g}, {times[-1]:g}]")
+
+
+def vector(name, value, n, coords):
+    """value as a float64 vector (n,) (zeros when None), or a SimulationError naming ``name``."""
+    if value is None:
+        return np.zeros(n)
+    try:
+        arr = np.asarray(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise SimulationError(f"{name} must be a sequence of {n} numbers, got {value!r}") from None
+    if arr.shape[0] != n:
+        raise SimulationError(f"{name} has {arr.shape[0]} entries but the model has {n} "
+                              f"coordinates ({', '.join(coords)})")
+    if not np.all(np.isfinite(arr)):
+        raise SimulationError(f"{name} contains a non-finite value: {arr.tolist()}")
+    return np.ascontiguousarray(arr)
+
+
+def check_element_coefficients(module, p):
+    """Refuse a non-positive (or non-finite) stiffness, threshold or friction bound of a
+    nonsmooth element at the parameter vector p (n_params,), naming the element and the
+    parameters the coefficient depends on (found by perturbing each parameter)."""
+    ne = getattr(module, "N_ELEMENTS", 0)
+    if not ne:
+        return
+    coef = element_coefficients(module, p)
+    labels = ({0: "stiffness", 1: "threshold"}, {0: "friction bound"})
+    for e in range(ne):
+        kind = int(coef[e, 2])
+        for col, label in labels[kind].items():
+            value = coef[e, col]
+            if math.isfinite(value) and value > 0:
+                continue
+            raise SimulationError(
+                f"{module.NAME}: element {module.ELEMENTS[e]!r}: {label} = {value:g} must be a "
+                f"finite number > 0; {_coefficient_source(module, p, coef, e, col)}")
+
+
+def element_coefficients(module, p):
+    """coef (ne, 3) of the generated ``elements`` kernel: (stiffness, threshold, 0) or
+    (bound, 0, 1); they depend on parameters only (model/model.py checks that)."""
+    ne, n = module.N_ELEMENTS, module.N_COORDS
+    s, G, coef = np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))
+    module.elements(np.zeros(n), np.ascontiguousarray(p, dtype=np.float64), s, G, coef)
+    return coef
+
+
+def _coefficient_source(module, p, coef, e, col):
+    """'it depends on eta = -1 (...)': the parameters whose change moves coef[e, col]."""
+    used = []
+    for j, name in enumerate(module.PARAMS):
+        trial = np.array(p, dtype=np.float64)
+        trial[j] += 0.5 * max(1.0, abs(trial[j]))
+        moved = element_coefficients(module, trial)[e, col]
+        if not (moved == coef[e, col] or (math.isnan(moved) and math.isnan(coef[e, col]))):
+            used.append(f"{name} = {p[j]:g}")
+    frozen = getattr(module, "FROZEN", None) or {}
+    if used:
+        return (f"it depends on {', '.join(used)}: pass other values (params={{...}} or "
+                f"--param NAME=VALUE)")
+    if frozen:
+        values = ", ".join(f"{k} = {v:g}" for k, v in frozen.items())
+        return (f"it comes from the frozen parameters ({values}): regenerate with other "
+                f"--freeze values")
+    return "it is a constant of the model file"
+
+
+def check_step_count(t0, t_end, h):
+    """Refuse more than MAX_STEPS steps (also an overflowing (t_end - t0) / h) before anything
+    is sized from the step count."""
+    steps = (t_end - t0) / h
+    if steps > MAX_STEPS:
+        raise SimulationError(
+            f"t0 = {t0:g} to t_end = {t_end:g} with h = {h:g} is {steps:.3g} steps, more than "
+            f"the {MAX_STEPS:.0e} simulate runs (beyond that rounding errors, about n_steps * "
+            f"2.2e-16, outgrow any gain from a smaller h); use a larger h or a shorter run")
+
+
+def check_time_resolution(t0, t_last, h, n_steps):
+    """Refuse a run whose times t0 + k h (up to t_last) cannot be told apart to
+    max(TIME_RESOLUTION, 2 n_steps eps) h in float64 (e.g. t0 = 1.7e9 with h = 1e-7: saved
+    times repeat, forces see frozen times)."""
+    biggest = max(abs(t0), abs(t_last))
+    spacing = float(np.spacing(biggest))
+    allowed = max(TIME_RESOLUTION, 2 * n_steps * np.finfo(float).eps) * h
+    if spacing > allowed:
+        raise SimulationError(
+            f"t0 = {t0:g} with h = {h:g}: float64 numbers near |t| = {biggest:g} are "
+            f"{spacing:.3g} apart, more than {allowed / h:.3g} h, so t + h cannot be told from t "
+            f"to the precision a step needs; shift the time origin (t0 near 0) or use "
+            f"h >= {spacing / TIME_RESOLUTION:.3g}")
+
+
+def available_memory():
+    """Bytes the system can give a new allocation now: MemAvailable from /proc/meminfo, else
+    the free physical pages (os.sysconf); None when neither is known."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def saved_rows(n_steps, save_every):
+    """Rows of a run: the initial state, one per save_every steps, and the final state when it
+    does not fall on a save."""
+    return n_steps // save_every + 1 + (1 if n_steps % save_every else 0)
+
+
+def saved_bytes(rows, n, n_saved):
+    """Bytes simulate holds at its peak for ``rows`` saved states of n coordinates and n_saved
+    extra values per row (see _ROW_COLUMNS)."""
+    return rows * 8 * (2 * n + 2 * n_saved + _ROW_COLUMNS)
+
+
+def check_memory(model, n_steps, save_every, n, n_saved, need=None, what=None):
+    """Refuse, before allocating, a run whose saved rows do not fit in the available memory,
+    suggesting the save_every that would leave half of it free. need: the bytes the caller
+    holds at its peak (default saved_bytes of one run), what: the run named in the message
+    (default "saving S states (N steps, save_every = K)")."""
+    rows = saved_rows(n_steps, save_every)
+    need = saved_bytes(rows, n, n_saved) if need is None else need
+    free = available_memory()
+    if free is None or need <= free:
+        return
+    suggest = save_every * math.ceil(need / (0.5 * free))
+    what = what or f"saving {rows} states ({n_steps} steps, save_every = {save_every})"
+    raise SimulationError(
+        f"{model}: {what} needs {_gb(need)} of memory and {_gb(free)} is available; use "
+        f"save_every >= {suggest} (--save-every {suggest})")
+
+
+def _gb(nbytes):
+    return f"{nbytes / 1e9:.3g} GB"

@@ -1,0 +1,240 @@
+"""Model inputs inside the stepping loop: a jitted controller or a sampled signal.
+
+A model's inputs (``Model(inputs=[u1, ...])``) are the last N_INPUTS entries of its parameter
+vector p, so every generated kernel reads them without a change of signature. Before each step
+(and once at t0) the run loop (steppers/base.run_loop, argument ``control``) calls a jitted
+``apply(data, t, q, v, p) -> changed`` that writes them: a zero-order hold over each step (a
+changed input re-runs the method's prepare, which may have cached forces). Supplied by
+
+* a controller ``u = f(t, q, qd, p)``, a numba-jitted function returning a float (one input),
+  a 1-D array or a tuple (n_inputs), evaluated at the state at the start of each step;
+* a :class:`Signal` of samples (times (S,), values (S, n_inputs)), held between samples
+  (``hold="zoh"``) or interpolated linearly (``hold="linear"``, evaluated at the middle of each
+  step, which keeps an input error of O(h^2) in the step);
+* constants: ``params={"u": 0.5}`` (an input is a parameter; no loop hook then).
+
+The loop with a hook is compiled in this process for (module, method, controller) and kept (not
+cached on disk: numba does not cache code that receives a function). Trajectories of a model
+with inputs carry ``saved["input_<name>"]`` (the input held over the step that starts at each
+saved row) and, with outputs, ``saved["output_<name>"]`` (the generated ``outputs`` kernel).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, types
+from numba.extending import overload
+
+from ..errors import SimulationError
+from .params import resolve_params
+from ..steppers.core.base import FAST
+
+__all__ = ["Signal", "input_slots", "make_apply", "controlled_run", "resolve_inputs",
+           "attach_inputs_outputs"]
+
+
+class Signal:
+    """Sampled inputs: times (S,) increasing, values (S,) or (S, n_inputs); hold "zoh" (the last
+    sample before t) or "linear" (between samples; constant before the first and after the
+    last sample)."""
+
+    def __init__(self, times, values, hold="zoh"):
+        self.times = np.ascontiguousarray(times, dtype=np.float64)
+        values = np.asarray(values, dtype=np.float64)
+        self.values = np.ascontiguousarray(values.reshape(len(values), -1))
+        if hold not in ("zoh", "linear"):
+            raise SimulationError(f"Signal: hold={hold!r}; use 'zoh' or 'linear'")
+        if self.times.ndim != 1 or len(self.times) == 0 or len(self.values) != len(self.times):
+            raise SimulationError(f"Signal: {len(self.times)} times for {len(self.values)} samples")
+        if np.any(np.diff(self.times) <= 0) or not np.all(np.isfinite(self.values)):
+            raise SimulationError("Signal: times must increase and values be finite")
+        self.hold = hold
+
+    def __call__(self, t):
+        """The input (n_inputs,) the loop applies over a step evaluated at t (for checks)."""
+        out = np.zeros(self.values.shape[1] + 1)
+        _signal_apply((self.times, self.values, self.hold == "linear", 1, 0.0), t, None, None, out)
+        return out[1:]
+
+
+def _write_inputs(u, p, first):
+    """p[first + j] = u_j for a float, a 1-D array or a tuple u; True when an entry changed
+    (jitted: see the overload)."""
+
+
+@overload(_write_inputs, jit_options=FAST)
+def _write_inputs_impl(u, p, first):
+    if isinstance(u, (types.Float, types.Integer)):
+        def impl(u, p, first):
+            changed = p[first] != u
+            p[first] = u
+            return changed
+    elif isinstance(u, types.Array):
+        def impl(u, p, first):
+            changed = False
+            for j in range(u.shape[0]):
+                changed |= p[first + j] != u[j]
+                p[first + j] = u[j]
+            return changed
+    elif isinstance(u, types.BaseTuple):
+        def impl(u, p, first):
+            changed = False
+            j = 0
+            for value in u:
+                changed |= p[first + j] != value
+                p[first + j] = value
+                j += 1
+            return changed
+    else:
+        raise TypeError(f"a controller returns a float, a 1-D array or a tuple, not {u}")
+    return impl
+
+
+@njit(**FAST)
+def _signal_apply(data, t, q, v, p):
+    """data = (times (S,), values (S, k), linear, first, half step): p[first:] = the signal at
+    t (zero-order hold) or at t + h/2 (linear); True when an entry changed."""
+    times, values, linear, first, half = data
+    s = t + half if linear else t
+    i = np.searchsorted(times, s, side="right") - 1      # last sample at or before s
+    changed = False
+    w = 0.0
+    if linear and 0 <= i < times.shape[0] - 1:
+        w = (s - times[i]) / (times[i + 1] - times[i])
+    i = min(max(i, 0), times.shape[0] - 1)
+    for j in range(values.shape[1]):
+        value = values[i, j] if w == 0.0 else (1.0 - w) * values[i, j] + w * values[i + 1, j]
+        changed |= p[first + j] != value
+        p[first + j] = value
+    return changed
+
+
+_APPLY = {}
+
+
+def make_apply(controller):
+    """The loop hook apply(data, t, q, v, p) of a jitted controller u = f(t, q, qd, p); data =
+    (first input slot,). One per controller (kept, so its compilation is reused)."""
+    if not hasattr(controller, "py_func"):
+        raise SimulationError(f"control: {getattr(controller, '__name__', controller)!r} is not "
+                              "numba-jitted; decorate it with @numba.njit (it runs inside the loop)")
+    if controller not in _APPLY:
+        @njit(**FAST)
+        def apply(data, t, q, v, p):
+            return _write_inputs(controller(t, q, v, p), p, data[0])
+        _APPLY[controller] = apply
+    return _APPLY[controller]
+
+
+def input_slots(module):
+    """(first slot, n_inputs) of a module's inputs in p."""
+    k = getattr(module, "N_INPUTS", 0)
+    return len(module.PARAMS) - k, k
+
+
+_RUNS = {}
+
+
+def controlled_run(module, method, apply):
+    """run(q0, v0, t0, h, n_steps, save_every, p, settings, out_t, out_q, out_v, out_stats,
+    out_extra, out_last, out_events, data): the fixed-step glue of ``method`` with the hook
+    ``apply`` (compiled on first use in this process, then kept)."""
+    import importlib
+    from ..steppers.core import registry
+    from ..steppers.core.base import run_loop, stepping_loop
+    key = (module.__name__, module.KEY, method, apply)
+    if key not in _RUNS:
+        stepper = importlib.import_module(f"lagrange_gen.steppers.methods.{method}")
+        spec = registry.spec(method)
+        n_saved = spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
+        kern, n_events = module, module.N_EVENTS
+        if spec.adaptive:
+            raise SimulationError(f"inputs from a controller or a signal need a fixed-step method; "
+                                  f"{method} chooses its own steps")
+        loop = stepping_loop(stepper, kern, n_events)
+
+        @njit(error_model="numpy")
+        def run(q0, v0, t0, h, n_steps, save_every, p, settings, out_t, out_q, out_v,
+                out_stats, out_extra, out_last, out_events, data):
+            return run_loop(stepper, loop, kern, n_saved, n_events, q0, v0, t0, h, n_steps,
+                            save_every, p, settings, out_t, out_q, out_v, out_stats, out_extra,
+                            out_last, out_events, apply, data)
+        _RUNS[key] = run
+    return _RUNS[key]
+
+
+def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None):
+    """(p (n_params,), hook, data) for a run: the parameters with the inputs' slots filled
+    (controller and signal: by the loop; hook None for constant inputs). A model input with no
+    value (no control, no params entry, no default), or a controller whose value at (t0, q0,
+    v0) has the wrong size, is a SimulationError naming it."""
+    first, k = input_slots(module)
+    names = list(module.PARAMS[first:])
+    if control is None:
+        if params is None or isinstance(params, dict):
+            missing = [u for u, d in zip(names, module.DEFAULTS[first:])
+                       if d is None and u not in (params or {})]
+            if missing:
+                raise SimulationError(
+                    f"{module.NAME}: input {missing[0]} has no value; give control= (a jitted "
+                    f"controller u = f(t, q, qd, p) or a Signal) or params={{{missing[0]!r}: ...}} "
+                    f"(--param {missing[0]}=... on the command line)")
+        return resolve_params(module.PARAMS, module.DEFAULTS, params, model=module.NAME,
+                              frozen=getattr(module, "FROZEN", None)), None, None
+    if not k:
+        raise SimulationError(f"{module.NAME}: control= given but the model has no inputs "
+                              "(declare them with Model(inputs=[...]))")
+    if isinstance(params, dict) and set(params) & set(names):
+        raise SimulationError(f"{module.NAME}: input {sorted(set(params) & set(names))[0]} is "
+                              "given both by control= and by params=")
+    given = dict(params or {}) if isinstance(params, dict) or params is None else params
+    defaults = list(module.DEFAULTS[:first]) + [0.0] * k
+    p = resolve_params(module.PARAMS, defaults, given, model=module.NAME,
+                       frozen=getattr(module, "FROZEN", None))
+    if isinstance(control, Signal):
+        if control.values.shape[1] != k:
+            raise SimulationError(f"{module.NAME}: the Signal has {control.values.shape[1]} "
+                                  f"value(s) per sample for {k} input(s) ({', '.join(names)})")
+        return p, _signal_apply, (control.times, control.values, control.hold == "linear",
+                                  first, 0.5 * h)
+    apply = make_apply(control)
+    if q0 is not None:
+        _check_size(module, control, float(t0), q0, v0, p, names)
+    return p, apply, (first,)
+
+
+def _check_size(module, controller, t0, q0, v0, p, names):
+    """The jitted loop writes a controller's value without bounds checks: its size must be
+    n_inputs, checked here once (the controller called from Python at the initial state)."""
+    u = np.atleast_1d(np.asarray(controller(t0, np.array(q0, dtype=np.float64),
+                                            np.array(v0, dtype=np.float64), p.copy())))
+    if u.ndim != 1 or u.shape[0] != len(names):
+        raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns "
+                              f"{u.size} value(s) at t0 for {len(names)} input(s) "
+                              f"({', '.join(names)})")
+
+
+def attach_inputs_outputs(traj, module, p, hook, data):
+    """Add saved["input_<name>"] (S, 1) and saved["output_<name>"] (S, 1) to a Trajectory:
+    the inputs the hook applies at each saved state (the hold over the next step) and the
+    generated outputs there."""
+    first, k = input_slots(module)
+    n_out = getattr(module, "N_OUTPUTS", 0)
+    if not (k or n_out):
+        return traj
+    rows = len(traj.t)
+    u = np.tile(p[first:], (rows, 1))
+    y = np.zeros((rows, n_out))
+    pk = p.copy()
+    for r in range(rows):
+        q, v = np.ascontiguousarray(traj.q[r]), np.ascontiguousarray(traj.v[r])
+        if hook is not None:
+            hook(data, float(traj.t[r]), q, v, pk)
+            u[r] = pk[first:]
+        if n_out:
+            module.outputs(q, v, float(traj.t[r]), pk, y[r])
+    for j, name in enumerate(module.PARAMS[first:]):
+        traj.saved[f"input_{name}"] = u[:, j:j + 1].copy()
+    for j, name in enumerate(getattr(module, "OUTPUTS", ())):
+        traj.saved[f"output_{name}"] = y[:, j:j + 1].copy()
+    return traj

@@ -1,0 +1,278 @@
+"""Many runs of one model in one call: members differing in q0, v0 and parameters.
+
+    import lagrange_gen as lg
+    ens = lg.ensemble("models/cart_pendulum.py", "rk4", q0=q0s, params=lg.grid(k=ks, m=ms),
+                      t_end=10, h=1e-3, save_every=100)
+    ens.q            # (M, S, n)
+    ens.failures()   # ["member 17: cart_pendulum, explicit_euler: step 312 of 1000 ..."]
+
+The members run in the generated module's ``ensemble_<method>`` (steppers/core/registry.py): one
+numba parallel loop over members, each member base.run_loop exactly as ``run_<method>`` runs it
+for simulate, so member i equals ``simulate(...)`` with member i's inputs (bitwise, as long as
+simulate runs in one chunk: fixed_run.CHUNK_STEPS steps). Fixed-step methods only. A member that
+fails (blow-up, Newton failure, singular matrix) stops alone: its status, step, time and state are
+kept, its rows after the failure are NaN, the other members finish.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import checks as run_checks
+from ..codegen.keys import regeneration_command_for
+from .ensemble_inputs import grid, member_count, member_params, member_states
+from ..errors import LagrangeGenError, SimulationError
+from .failures import raise_for_status
+from .fixed_driver import ProgressBar, n_steps_to
+from ..jit.portable import choose_ensemble, jit_mode
+from ..steppers.core import status as st
+from ..steppers.core import registry
+from ..steppers.core.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
+from ..steppers.core.method_spec import make_settings
+
+__all__ = ["ensemble", "grid", "EnsembleResult"]
+
+#: With a progress bar, members run in batches of at least this many per thread (a batch ends
+#: when its slowest member does, so batches of one member per thread would idle threads).
+MEMBERS_PER_THREAD = 32
+
+
+@dataclass
+class EnsembleResult:
+    """Outputs of an ensemble of M members, S saved rows, n coordinates.
+
+    t (S,); q, v (M, S, n); energy, newton_iters, newton_residual (M, S); saved {field: (M, S, w)}
+    (the method's SPEC.saved); status (M,) lagrange_gen.steppers.core.status codes (0 = OK); steps_done (M,)
+    (steps completed, also for a failed member); fail_time (M,) and fail_state (M, 2 n) (time and
+    [q, v] where the member stopped: the final state when it succeeded); params (M, n_params) in
+    param_names order. Rows after a member's failure are NaN."""
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    energy: np.ndarray
+    newton_iters: np.ndarray
+    newton_residual: np.ndarray
+    saved: dict
+    status: np.ndarray
+    steps_done: np.ndarray
+    fail_time: np.ndarray
+    fail_state: np.ndarray
+    params: np.ndarray
+    param_names: tuple
+    coords: tuple
+    model: str
+    method: str
+    h: float
+    n_steps: int
+    wall_time: float
+    compile_time: float
+    messages: dict = field(default_factory=dict)    # {member: one-line failure message}
+    jit: str = ""       # the glue that ran: "specialized" or "portable" (ensemble(jit=))
+
+    @property
+    def ok(self):
+        """(M,) bool: the members that reached t_end (or a terminal event)."""
+        return self.status == st.OK
+
+    def failures(self):
+        """["member i: <the message simulate would raise>", ...] for the failed members."""
+        return [f"member {i}: {self.messages[i]}" for i in sorted(self.messages)]
+
+
+def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
+             save_every=1, t0=0.0, progress=False, out_dir="generated", client=None,
+             worker_threads=1, jit=None, **settings):
+    """Integrate M members of one model with a fixed-step method; an EnsembleResult.
+
+    q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
+    array} (see grid), or an (M, n_params) table in PARAMS order; settings: the method's settings
+    by name (as simulate), shared. M comes from the per-member inputs, which must agree.
+    Constrained models: each member's (q0, v0) is made consistent first (lagrange_gen.run.consistent;
+    one warning counts the members moved). Raises SimulationError (one line) on bad input or
+    when the saved output would not fit in memory; failing members do not raise (failures()).
+    client: a dask.distributed Client: the members run as Dask tasks in chunks on its workers,
+    each on ``worker_threads`` numba threads (run/ensemble_dask.py); the result is the same.
+    jit: as simulate's (lagrange_gen.jit.portable): "auto" runs the generated ensemble_<method> when
+    numba's cache holds it, else the portable ensemble glue, compiled once for every model
+    (models with events: always the generated one); the Dask path runs the generated one.
+    EnsembleResult.jit says which ran."""
+    from .simulate import _check_times, _element_method, load_module
+    if method not in registry.METHODS:
+        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+    jit = jit_mode(jit)
+    module = load_module(module_or_path, out_dir, method)
+    method = _element_method(module, method)
+    from .consistent import check_method
+    check_method(module, method)
+    spec = registry.spec(method)
+    if spec.adaptive:
+        raise SimulationError(f"method {method!r} chooses its own steps; ensemble runs the "
+                              f"fixed-step methods only (e.g. rk4, midpoint, verlet)")
+    run = _ensemble_glue(module, method)
+    h = _check_times(spec, h, t0, t_end, save_every, None)
+    config = make_settings(spec, settings)
+    M = member_count(module, q0, v0, params)
+    q, v = member_states(module, "q0", q0, M), member_states(module, "v0", v0, M)
+    p = member_params(module, params, M)
+    for i in range(M) if getattr(module, "N_ELEMENTS", 0) else ():
+        run_checks.check_element_coefficients(module, p[i])
+    t0, t_end, save_every = float(t0), float(t_end), int(save_every)
+    n_steps = n_steps_to(t0, t_end, h)
+    run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
+    n, n_saved = module.N_COORDS, spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS,
+                                               module.N_ELEMENTS)
+    rows = run_checks.saved_rows(n_steps, save_every)
+    check_ensemble_memory(module.NAME, M, n_steps, save_every, n, n_saved)
+    out = _allocate(M, rows, n, n_saved)
+    if spec.constraints:
+        q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
+    if client is None:
+        run, ran, compile_time = _warm_up(
+            lambda args: choose_ensemble(jit, run, module, method, args),
+            q, v, p, t0, h, save_every, config, out)
+    else:
+        ran, compile_time = "specialized", 0.0   # done by each worker, inside its first task
+    start = time.perf_counter()
+    if client is None:
+        _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress)
+    else:
+        from .ensemble_dask import run_on_client
+        run_on_client(client, module, method, q, v, p, t0, h, n_steps, save_every, config, out,
+                      progress, worker_threads)
+    wall = time.perf_counter() - start
+    result = _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time,
+                     getattr(config, "max_iter", 0))
+    result.jit = ran
+    return result
+
+
+def _ensemble_glue(module, method):
+    run = getattr(module, f"ensemble_{method}", None)
+    if run is None:
+        raise SimulationError(
+            f"{module.NAME}: module {module.__file__} has no ensemble glue for {method!r} "
+            f"(generated before ensembles, or without that method); run "
+            f"`{regeneration_command_for(module, methods=[method])}`")
+    return run
+
+
+def ensemble_bytes(M, rows, n, n_saved):
+    """Bytes an ensemble holds at its peak: per member and row q, v, stats, extra, and the
+    energy / Newton copies of the result."""
+    return M * rows * 8 * (2 * n + N_STATS + n_saved + 3)
+
+
+def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved):
+    """Refuse, before allocating, an ensemble whose saved rows do not fit in the memory available
+    now (run_checks.check_memory with the ensemble's bytes), saying how much it needs and which
+    save_every fits."""
+    rows = run_checks.saved_rows(n_steps, save_every)
+    run_checks.check_memory(model, n_steps, save_every, n, n_saved,
+                            need=ensemble_bytes(M, rows, n, n_saved),
+                            what=f"an ensemble of {M} members saving {rows} states each")
+
+
+def _allocate(M, rows, n, n_saved):
+    """Outputs, NaN until written (rows after a member's failure stay NaN)."""
+    return dict(q=np.full((M, rows, n), np.nan), v=np.full((M, rows, n), np.nan),
+                stats=np.full((M, rows, N_STATS), np.nan),
+                extra=np.full((M, rows, n_saved), np.nan),
+                last=np.zeros((M, 2 * n + 3 + n_saved)), status=np.zeros((M, 3), np.int64))
+
+
+def _consistent_starts(module, q, v, p, t0, config, extra):
+    """Each member's consistent (q0, v0), its multipliers and residuals in row 0 of ``extra``;
+    one warning counting the members that were moved (instead of one per member)."""
+    from .consistent import consistent_initial_state
+    tol = getattr(config, "newton_tol", 1e-12)
+    q, v, moved = q.copy(), v.copy(), 0
+    for i in range(q.shape[0]):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            state = consistent_initial_state(module, q[i], v[i], p[i], t0, tol)
+        moved += bool(caught)
+        q[i], v[i] = state.q, state.v
+        extra[i, 0] = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
+    if moved:
+        warnings.warn(f"{module.NAME}: the initial state of {moved} of {q.shape[0]} members was "
+                      f"projected onto the constraints (lagrange_gen.run.consistent)", stacklevel=3)
+    return q, v
+
+
+def _args(q, v, p, t0, h, n_steps, save_every, config, out, members):
+    """The arguments of ensemble_<method> for the members (a slice)."""
+    s = members
+    return (q[s], v[s], t0, h, n_steps, save_every, p[s], config, out["q"][s], out["v"][s],
+            out["stats"][s], out["extra"][s], out["last"][s], out["status"][s])
+
+
+def _call(run, q, v, p, t0, h, n_steps, save_every, config, out, members):
+    run(*_args(q, v, p, t0, h, n_steps, save_every, config, out, members))
+
+
+def _warm_up(choose, q, v, p, t0, h, save_every, config, out):
+    """Choose the glue (``choose(args)`` -> (glue, what ran), portable.choose_ensemble) and
+    compile or load it from numba's cache with zero members; (glue, what ran, seconds)."""
+    start = time.perf_counter()
+    args = _args(q, v, p, t0, h, 0, save_every, config, out, slice(0, 0))
+    run, ran = choose(args)
+    run(*args)
+    return run, ran, time.perf_counter() - start
+
+
+def _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress):
+    """One call for all members, or with a progress bar batches of about 2 % of them (at least
+    MEMBERS_PER_THREAD per thread)."""
+    M = q.shape[0]
+    if not progress:
+        _call(run, q, v, p, t0, h, n_steps, save_every, config, out, slice(0, M))
+        return
+    import numba
+    batch = max(MEMBERS_PER_THREAD * numba.get_num_threads(), math.ceil(M / 50))
+    bar = ProgressBar(M)
+    for start in range(0, M, batch):
+        members = slice(start, min(M, start + batch))
+        _call(run, q, v, p, t0, h, n_steps, save_every, config, out, members)
+        bar.update(members.stop)
+    bar.close()
+
+
+def _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time, max_iter):
+    n, rows = module.N_COORDS, out["q"].shape[1]
+    t = t0 + h * save_every * np.arange(rows, dtype=np.float64)
+    t[-1] = t0 + h * n_steps if n_steps % save_every else t[-1]
+    status, steps = out["status"][:, 0].copy(), out["status"][:, 1].copy()
+    last = out["last"]
+    layout = spec.saved_layout(n, module.N_CONSTRAINTS, module.N_ELEMENTS)
+    saved = {name: out["extra"][:, :, a:a + w] for name, a, w in layout}
+    energy = out["stats"][:, :, STAT_ENERGY].copy()
+    if "element_state" in saved:
+        from .simulate import _element_energy
+        for i in range(p.shape[0]):
+            energy[i] += _element_energy(module, p[i], saved["element_state"][i])
+    messages = {int(i): _message(module, spec, int(status[i]), int(steps[i]), n_steps, last[i],
+                                 h, p[i], max_iter) for i in np.flatnonzero(status != st.OK)}
+    done = np.where(status == st.OK, steps, np.maximum(steps, 0))
+    return EnsembleResult(
+        t=t, q=out["q"], v=out["v"], energy=energy,
+        newton_iters=out["stats"][:, :, STAT_ITERS].copy(),
+        newton_residual=out["stats"][:, :, STAT_RESIDUAL].copy(), saved=saved, status=status,
+        steps_done=done, fail_time=last[:, 0].copy(), fail_state=last[:, 1:1 + 2 * n].copy(),
+        params=p, param_names=tuple(module.PARAMS), coords=tuple(module.COORDS),
+        model=module.NAME, method=spec.name, h=h, n_steps=n_steps, wall_time=wall,
+        compile_time=compile_time, messages=messages)
+
+
+def _message(module, spec, code, steps, n_steps, last, h, p, max_iter):
+    """The one line simulate would raise for this member (failures.raise_for_status)."""
+    try:
+        raise_for_status(code, module, spec.name, steps + 1, n_steps, last, max_iter, h, p)
+    except LagrangeGenError as exc:
+        return str(exc).splitlines()[0]
+    return f"status {code}"

@@ -1,0 +1,163 @@
+"""Import generated modules by path, generating them first when given a model file; the
+self-registration every generated module runs at import (its numba decorator is
+lagrange_gen.jit.njit)."""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import sys
+from pathlib import Path
+
+from ..codegen.keys import check_current, read_key
+from ..errors import GenerationError, StaleModuleError
+
+
+def import_generated(path):
+    """Import a generated module from its file path; the same path imported twice returns the
+    same module object. Raises StaleModuleError (from the module's own check) when stale."""
+    path = Path(path).resolve()
+    if not path.is_file():
+        raise GenerationError(f"{path}: no generated module here (run lagrange-gen on its model)")
+    # The name must be the same in every process: numba's cache refers to globals by module name.
+    name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
+    cached = sys.modules.get(name)
+    # The file may have been regenerated since this process imported it: then import it again;
+    # otherwise the module's own import-time check runs again (its model may have changed).
+    if cached is not None and getattr(cached, "KEY", None) == read_key(path):
+        if hasattr(cached, "SOURCES"):
+            check_current(cached.__file__, cached.KEY, cached.SOURCES, cached.MODEL_PATH,
+                          cached.OPTIONS, cached.TEXT_SHA)
+        return cached
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[name]
+        raise
+    return module
+
+
+def load(path, out_dir="generated", methods=None, options=None, regenerate=True, freeze=None,
+         force=False):
+    """Return the generated module for ``path``.
+
+    ``path`` is a generated module (it has a KEY line) or a model file. For a model file the
+    module already in ``out_dir`` is used when it is current and satisfies the request: it has
+    the ``methods`` (None: any), the ``freeze`` (None: whatever it was generated with, e.g. by
+    ``lagrange-gen --freeze``) and the build ``options`` (None: likewise). Otherwise it is
+    generated: when missing, when stale (keeping its own freeze, build and methods unless asked
+    otherwise), or when methods are missing (added to its own). A current module generated with
+    another freeze or build, or from another model file, is refused in one line naming what
+    differs and the command that regenerates it (``force=True`` regenerates it);
+    ``regenerate=False`` raises StaleModuleError instead of generating.
+    """
+    from ..codegen.generate import generate_model
+    path = Path(path)
+    if read_key(path) is not None:
+        return import_generated(path)
+    target, plan = _plan(path, out_dir, methods, options, freeze, force)
+    if plan is not None:
+        why, build, methods, freeze, command = plan
+        if not regenerate:
+            raise StaleModuleError(f"{target} is {why}: run {command}")
+        generate_model(path, out_dir, methods, build, freeze, force=True)
+    return import_generated(target)
+
+
+def _plan(path, out_dir, methods, options, freeze, force):
+    """(target, None) when the module on disk serves the request of load(), else (target,
+    (why, build, methods, freeze, command)) to generate with. Requested methods that do not
+    apply to the model are not added (simulate refuses them, naming why); whether the module
+    on disk is current is codegen.generate.module_current (re-derives only when the model file
+    or the generator changed since that was last decided)."""
+    from ..codegen.generate import (other_source, refuse_overwrite, describe_options, generation_options,
+                                   module_current, output_path, resolve_methods)
+    from ..codegen.keys import read_header, regeneration_command
+    from ..model.model_file import load_model
+    model = load_model(path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    header = read_header(target) or {}
+    if not force:
+        refuse_overwrite(path, target, model.name)
+    disk = header.get("OPTIONS") if other_source(path, target, header) is None else None
+    asked = resolve_methods(methods, model, drop_inapplicable=True) if methods else None
+    if not isinstance(disk, dict):          # missing (or forced over another model's module)
+        build, freeze = dict(options or {}), dict(freeze or {})
+        methods = resolve_methods(asked or None, model)
+        return target, ("missing", build, methods, freeze, regeneration_command(path, out_dir, build, methods, freeze))
+    have = list(disk.get("methods", ()))
+    build = dict(disk.get("build", {}) if options is None else options)
+    freeze = dict(disk.get("freeze", {}) if freeze is None else freeze)
+    if disk.get("build", {}) != model.build_options:
+        model = load_model(path, **disk.get("build", {}))   # the module's own build, to compare
+    methods = resolve_methods(have + list(asked or ()), model, drop_inapplicable=True)
+    wanted = generation_options(build, methods, freeze)
+    command = regeneration_command(path, out_dir, build, methods, freeze)
+    if not module_current(model, target, header):
+        return target, ("stale", build, methods, freeze, command)
+    if (wanted["build"], wanted.get("freeze")) != (disk.get("build"), disk.get("freeze")) and not force:
+        have_options = {"build": disk.get("build"), "freeze": disk.get("freeze")}
+        raise GenerationError(f"{target} was generated with {describe_options(have_options)}, not with "
+                              f"{describe_options(wanted | {'methods': None})} as asked: regenerate it "
+                              f"with `{command}`, or ask for what it has")
+    if wanted != disk:
+        return target, (f"missing method(s) {', '.join(m for m in methods if m not in have)}",
+                        build, methods, freeze, command)
+    return target, None
+
+
+def register_module(namespace):
+    """Make ``sys.modules[namespace['__name__']]`` the module whose globals are ``namespace``.
+
+    Every generated module calls this on import: its stepper glue finds the module in
+    sys.modules, and numba's cache re-imports it by name. Imports through the import system
+    or import_generated have done it already; importlib's spec_from_file_location +
+    exec_module by hand has not.
+    """
+    name = namespace["__name__"]
+    current = sys.modules.get(name)
+    if current is not None and getattr(current, "__dict__", None) is namespace:
+        return
+    import gc
+    import types
+    for owner in gc.get_referrers(namespace):
+        if isinstance(owner, types.ModuleType) and owner.__dict__ is namespace:
+            sys.modules[name] = owner
+            return
+
+
+def _kernel_args(module):
+    """{kernel name: arguments of a call on zeros} for every kernel a module may have."""
+    import numpy as np
+    n, m, ne = module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS
+    q, w, lam, we = np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(ne)
+    p = np.ones(module.N_PARAMS)
+    A, B, v = np.empty((n, n)), np.empty((n, n)), np.empty(n)
+    return {
+        "mass_matrix": (q, 0.0, p, A), "dynamics": (q, q, 0.0, p, A, v), "rhs": (q, q, 0.0, p, v),
+        "energy": (q, q, 0.0, p), "momentum_rate": (q, q, 0.0, p, v),
+        "rhs_jacobian": (q, q, 0.0, p, A, B), "momentum_rate_jacobian": (q, q, 0.0, p, A, B),
+        "mass_matvec_dq": (q, w, 0.0, p, A),
+        "constraints": (q, q, 0.0, p, np.empty(m), np.empty((m, n)), np.empty(m)),
+        "constraint_rate": (q, 0.0, p, np.empty(m)),
+        "transport": (q, 0.0, p, v), "power": (q, q, 0.0, p, np.empty(2 * n + 2)), "transport_dq": (q, 0.0, p, A),
+        "constraint_dq": (q, w, lam, 0.0, p, np.empty((m, n)), A),
+        "elements": (q, p, np.empty(ne), np.empty((ne, n)), np.empty((ne, 3))),
+        "elements_hessian": (q, we, p, A),
+        "forward_dynamics": (q, q, 0.0, p, A, v),
+        "events": (q, q, 0.0, p, np.empty(getattr(module, "N_EVENTS", 0))),
+    }
+
+
+def compile_all(module):
+    """Call every kernel a generated module has (its KERNELS, plus forward_dynamics) once on
+    zeros so numba compiles (or loads from its cache) all of them now rather than inside the
+    first simulation step. Kernels a module was generated without are skipped."""
+    args = _kernel_args(module)
+    for name in tuple(getattr(module, "KERNELS", ())) + ("forward_dynamics",):
+        if name not in args:
+            raise GenerationError(f"{module.__file__}: unknown kernel {name!r} (regenerate it)")
+        getattr(module, name)(*args[name])

@@ -1,0 +1,366 @@
+"""Python driver: integrate a generated module with a stepper, get a Trajectory.
+
+    from lagrange_gen.run.simulate import simulate
+    traj = simulate("models/cart_pendulum.py", method="midpoint", q0=[0.1, 0.5], t_end=10, h=1e-3)
+    traj.plot("traj.png"); traj.to_npz("traj.npz")
+
+The integration itself runs inside the generated module's jitted ``run_<method>`` (see
+steppers/core/registry.py), driven in chunks by run/fixed_driver.py or, for an adaptive method, by
+run/adaptive_driver.py; this module only checks inputs (run_checks: element coefficients, step count,
+time resolution, memory; the method's settings by its spec), builds the Trajectory from the
+method's declared saved fields, and warns when a conservative run lost its energy
+(run/energy_check.py). What a method is and which models it applies to is read from its spec
+(steppers/core/method_spec.py), never from its name.
+"""
+
+from __future__ import annotations
+
+import math
+import types
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import checks as run_checks
+from .adaptive_driver import C_ACCEPTED, C_EVALS, C_REJECTED, integrate_adaptive
+from ..codegen.keys import regeneration_command_for
+from .control import attach_inputs_outputs, controlled_run, resolve_inputs
+from .energy_check import energy_warning
+from ..errors import EnergyWarning, SimulationError
+from .failures import raise_for_status
+from .fixed_driver import allocate, integrate_fixed, n_steps_to
+from ..jit.portable import choose, jit_mode
+from ..steppers.core import status as st
+from ..steppers.core import registry
+from ..steppers.core.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK
+from ..steppers.core.method_spec import make_settings
+from .trajectory import Trajectory
+
+__all__ = ["simulate", "Trajectory", "load_module"]
+
+
+def load_module(module_or_path, out_dir="generated", method=None, force=False, options=None):
+    """A generated module from: the module itself, a generated .py, or a model file (generated
+    into ``out_dir`` first when missing or stale, keeping the freeze, build options and methods
+    of the module on disk, see loader.load). When the module lacks the glue of the method that
+    runs ``method`` on it (e.g. nonsmooth_euler for implicit_euler on a model with elements), it
+    is regenerated with that method added. ``force`` overwrites a module generated from another
+    model file or with another freeze. ``options``: build() options of a model file (None: those
+    of the module on disk)."""
+    if isinstance(module_or_path, types.ModuleType):
+        return module_or_path
+    from .loader import load, read_key
+    if options and read_key(Path(module_or_path)) is not None:
+        raise SimulationError(f"{module_or_path} is a generated module: build options "
+                              f"({', '.join(options)}) apply to model files; pass the model file")
+    module = load(Path(module_or_path), out_dir=out_dir, options=options, force=force)
+    if method is None or getattr(module, "KEY", None) is None:
+        return module
+    runs = _element_method(module, method)
+    if runs in registry.METHODS and not hasattr(module, f"run_{runs}"):
+        module = load(Path(module_or_path), out_dir=out_dir, methods=[runs], options=options,
+                      force=force)
+    return module
+
+
+def _runner(module, method):
+    run = getattr(module, f"run_{method}", None)
+    if run is None:
+        have = ", ".join(getattr(module, "METHODS", ())) or "none"
+        raise SimulationError(
+            f"{module.NAME}: module {module.__file__} was generated without method {method!r} "
+            f"(it has: {have}); run `{regeneration_command_for(module, methods=[method])}`")
+    return run
+
+
+def _element_method(module, method):
+    """The method that actually runs: on a model with nonsmooth elements a method that a
+    nonsmooth one stands in for (SPEC.stands_in_for) becomes it; a method that cannot treat
+    them is refused, naming them."""
+    names = tuple(getattr(module, "ELEMENTS", ()))
+    runs = registry.runs_as(method, len(names)) if method in registry.METHODS else method
+    if not names or runs not in registry.METHODS or registry.spec(runs).elements:
+        return runs
+    use = "; ".join(f"method={asked!r} (runs {m}: {registry.spec(m).summary})"
+                    for asked, m in registry.ON_ELEMENTS.items())
+    raise SimulationError(
+        f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) "
+        f"{', '.join(names)} (no silent regularization); use {use}")
+
+
+def _element_energy(module, p, state):
+    """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
+    coef = run_checks.element_coefficients(module, p)
+    k = np.where(coef[:, 2] == 0.0, coef[:, 0], 0.0)
+    return 0.5 * (state**2 * k).sum(axis=1)
+
+
+def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
+             save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
+             element_state0=None, force=False, keep=None, control=None, jit=None,
+             **settings) -> Trajectory:
+    """Integrate a generated model from t0 to t_end.
+
+    module_or_path: a generated module, the path of a generated .py, or a model file (generated
+        into out_dir when missing or stale; see load_module, and ``force`` there).
+    method: one of steppers.registry.METHODS.
+    q0, v0: initial coordinates and velocities (n,), default zeros.
+    h: the step of a fixed-step method (required); for an adaptive method (dop853) only the
+        first step tried (default: chosen automatically).
+    params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
+        parameter without default must be given.
+    save_every: fixed-step methods keep every save_every-th state (the initial and the final
+        state are always kept).
+    t_eval: adaptive methods return the states at these increasing times in [t0, t_end] (from
+        the dense output); default: the state after every accepted step.
+    element_state0: initial states of the nonsmooth elements (ne,), default 0 (virgin material).
+        On models with elements, method implicit_euler runs nonsmooth_euler; the trajectory's
+        energy then includes the elastic energy k u^2 / 2 stored in Saint-Venant elements.
+    settings: the method's settings by name (its SPEC.settings record; a name the method does
+        not have is refused): blowup_bound (BlowUp when |q| or |v| exceeds it) for every method;
+        newton_tol (relative to max(1, |unknown|), see steppers.base.newton_converged) and
+        max_iter for the implicit ones; newton_always (the Newton path of the partitioned
+        methods even when the model allows the explicit one); spook's compliance (epsilon >= 0)
+        and relaxation (d > 0); index1's baumgarte = (alpha, beta); dop853's rtol, atol, h_max.
+    control: the model's inputs (Model inputs=) inside the loop: a numba-jitted controller
+        u = f(t, q, qd, p) or a lagrange_gen.run.control.Signal (see lagrange_gen.run.control); constant
+        inputs are given in params. The Trajectory then saves "input_<name>" and, for a model
+        with outputs, "output_<name>" (Trajectory.saved).
+    jit: which compiled loop runs (lagrange_gen.jit.portable). "specialized": the generated
+        module's run_<method>, the model's kernels inlined into the stepper (fastest per step;
+        its first use compiles the stepper for this model, seconds). "portable": the stepper
+        compiled once for every model, calling this model's kernels through pointers (a new
+        model compiles only its kernels; 1.4x to 2.2x the specialized step time on the cart
+        pendulum, within 10 % on the 16-link chain; the same results bit for bit). "auto" (default): specialized when numba's cache already
+        holds it, else portable, switching to specialized between chunks of a fixed-step run
+        whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S). Runs
+        with a control= hook are always specialized. None: the environment variable
+        LAGRANGE_GEN_JIT, else "auto". Trajectory.jit says what ran.
+    Constrained models (``constraints=`` in the model) need a constrained method
+    (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
+    with a warning (lagrange_gen.run.consistent), and the Trajectory carries the multipliers and
+    max|Phi|, max|J v| per saved state. ``keep``: names of velocities (``theta_dot``, or the
+    coordinate ``theta``) whose v0 the projection keeps; the others are solved from J v = 0.
+    A fixed-step run ends at t0 + n_steps h with n_steps = (t_end - t0) / h rounded up.
+    Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
+    SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
+    blowup_bound), StepSizeTooSmall (adaptive). A conservative run whose energy error passes
+    energy_check.ENERGY_FRACTION of its energy scale warns (EnergyWarning, the line also in
+    Trajectory.warnings).
+    """
+    if method not in registry.METHODS:
+        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+    jit = jit_mode(jit)
+    module = load_module(module_or_path, out_dir, method, force)
+    method = _element_method(module, method)
+    from .consistent import check_method
+    check_method(module, method)
+    run = _runner(module, method)
+    spec = registry.spec(method)
+    n = module.N_COORDS
+    h = _check_times(spec, h, t0, t_end, save_every, t_eval)
+    config = make_settings(spec, settings)
+    q = run_checks.vector("q0", q0, n, module.COORDS)
+    v = run_checks.vector("v0", v0, n, module.COORDS)
+    p, hook, data = resolve_inputs(module, params, control, h, t0, q, v)     # inputs: run/control.py
+    if hook is not None:
+        run = _with_data(controlled_run(module, method, hook), data)
+        jit = "specialized"       # the control glue is compiled per model and controller
+    run_checks.check_element_coefficients(module, p)
+    t0, t_end, save_every = float(t0), float(t_end), int(save_every)
+    n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS)
+    initial = np.zeros(0)
+    if keep and not spec.constraints:
+        raise SimulationError(f"{module.NAME}: keep= ({', '.join(keep)}) chooses the velocities "
+                              "kept when v0 is projected onto J v = 0; this model has no constraints")
+    if spec.constraints:
+        q, v, initial = _constrained_start(module, q, v, p, t0,
+                                           getattr(config, "newton_tol", 1e-12), keep)
+    elif n_saved:
+        initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    if spec.adaptive:
+        task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit)
+        wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
+        out, compile_time, wall = integrate_adaptive(
+            task, q, v, initial, t_end, None if wanted is None else wanted[wanted > t0], progress)
+        return attach_inputs_outputs(_adaptive_trajectory(task, out, wanted, wall, compile_time),
+                                     module, p, hook, data)
+    n_steps = n_steps_to(t0, t_end, h)
+    run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
+    run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
+    task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
+                 jit=jit)
+    out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
+                   getattr(module, "N_EVENTS", 0))
+    compile_time, wall = integrate_fixed(task, q, v, out, progress)
+    return attach_inputs_outputs(_trajectory(task, out, wall, compile_time), module, p, hook, data)
+
+
+def _with_data(run, data):
+    """The glue signature of a run with an input hook (control.controlled_run): data bound."""
+    return lambda *args: run(*args, data)
+
+
+def _check_times(spec, h, t0, t_end, save_every, t_eval):
+    """The step (float, or 0.0 for an adaptive method's automatic first step) after checking
+    the time arguments; SimulationError naming the one that is wrong."""
+    if spec.adaptive:
+        run_checks.check_scalars(1.0 if h is None else h, t0, t_end, save_every)
+        if save_every != 1:
+            raise SimulationError(f"save_every is for the fixed-step methods; {spec.name} saves "
+                                  f"every accepted step, or the times given as t_eval")
+        if t_eval is not None:
+            run_checks.check_t_eval(t_eval, t0, t_end)
+        return 0.0 if h is None else float(h)
+    if h is None:
+        raise SimulationError(f"method {spec.name!r} has a fixed step: give h")
+    if t_eval is not None:
+        raise SimulationError(f"t_eval is for the adaptive methods "
+                              f"({', '.join(registry.ADAPTIVE_METHODS)}); {spec.name} saves every "
+                              f"save_every-th step")
+    run_checks.check_scalars(h, t0, t_end, save_every)
+    run_checks.check_step_count(float(t0), float(t_end), float(h))
+    return float(h)
+
+
+@dataclass
+class _Task:
+    """What one run integrates: the module, the method's spec and glue, and the run's numbers."""
+
+    module: types.ModuleType
+    spec: object        # the method's Spec
+    run: object
+    p: np.ndarray
+    settings: tuple     # the method's settings record
+    h: float            # the step (adaptive: the first step tried, 0 = automatic)
+    t0: float
+    n_steps: int        # fixed-step methods
+    save_every: int
+    controlled: bool = False    # inputs written by a controller or a signal (run/control.py)
+    jit: str = "specialized"    # simulate(jit=): "auto", "specialized" or "portable"
+    ran: str = ""               # what ran (Trajectory.jit), set by fixed_run / adaptive_run
+
+    def glue(self, args):
+        """The glue to run (``run`` or the portable one, see portable.choose) for a first call
+        with ``args``; records the choice in ``ran``."""
+        run, self.ran = choose(self.jit, self.run, self.module, self.method, args)
+        return run
+
+    @property
+    def method(self):
+        return self.spec.name
+
+    @property
+    def max_iter(self):
+        return getattr(self.settings, "max_iter", 0)
+
+
+def _trajectory(task, out, wall, compile_time):
+    """The Trajectory of a finished fixed-step run: times t0 + k h (not accumulated,
+    independent of the chunking), the final state when it is not on a save (or a terminal
+    event stopped the run), energies, and the energy warning."""
+    m, n, h, p = task.module, task.module.N_COORDS, task.h, task.p
+    last, row = out["last"], out["rows"] - 1
+    out["t"][:row + 1] = task.t0 + h * task.save_every * np.arange(row + 1)
+    steps = out["steps"]
+    if steps % task.save_every or steps < task.n_steps:
+        row += 1
+        q, v = last[1:1 + n], last[1 + n:1 + 2 * n]
+        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v), float(last[0]), p)
+        if not math.isfinite(energy):
+            raise_for_status(st.NON_FINITE, m, task.method, steps, task.n_steps, last,
+                             task.max_iter, h, p)
+        out["t"][row], out["q"][row], out["v"][row] = last[0], q, v
+        out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n], last[-1])
+        out["extra"][row] = last[3 + 2 * n:-1]
+    rows = slice(0, row + 1)
+    traj = _build(task, {k: out[k][rows] for k in ("t", "q", "v", "stats", "extra")},
+                  out, steps, h, wall, compile_time)
+    return _warn_energy(task, traj, h, "reduce h")
+
+
+def _adaptive_trajectory(task, out, t_eval, wall, compile_time):
+    """The Trajectory of an adaptive run; with t_eval, only the requested times (row 0, the
+    initial state, only when t_eval starts at t0). h = the mean accepted step."""
+    rows = {k: out[k] for k in ("t", "q", "v", "stats", "extra")}
+    if t_eval is not None and not (len(t_eval) and t_eval[0] == task.t0):
+        rows = {k: a[1:] for k, a in rows.items()}
+    counters = out["counters"]
+    accepted = int(counters[C_ACCEPTED])
+    h = (out["last"][0] - task.t0) / max(accepted, 1)
+    traj = _build(task, rows, out, accepted, h, wall, compile_time)
+    traj.newton_iters[:] = 0.0          # the stats columns hold step counts and error norms
+    traj.newton_residual[:] = 0.0
+    traj.saved["accepted_steps"] = rows["stats"][:, STAT_ITERS:STAT_ITERS + 1].copy()
+    traj.saved["error_norm"] = rows["stats"][:, STAT_RESIDUAL:STAT_RESIDUAL + 1].copy()
+    traj.step_counts = dict(accepted=accepted, rejected=int(counters[C_REJECTED]),
+                            evaluations=int(counters[C_EVALS]))
+    return _warn_energy(task, traj, h, "tighten rtol and atol")
+
+
+def _has_work(module, spec):
+    """Whether the run integrated W (steppers/core/work.py): fixed-step methods on a model whose
+    energy E = T2 - T0 + V is not conserved (WORK; modules generated before it have none)."""
+    return bool(getattr(module, "WORK", False)) and not spec.adaptive
+
+
+def _build(task, rows, out, steps, h, wall, compile_time):
+    """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
+    m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
+    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS)
+    saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
+    energy = rows["stats"][:, STAT_ENERGY].copy()
+    if "element_state" in saved:
+        energy = energy + _element_energy(m, p, saved["element_state"])
+    return Trajectory(t=rows["t"], q=rows["q"], v=rows["v"], energy=energy,
+                      newton_iters=rows["stats"][:, STAT_ITERS].copy(),
+                      newton_residual=rows["stats"][:, STAT_RESIDUAL].copy(), method=spec.name,
+                      h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
+                      coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
+                      compile_time=compile_time, jit=task.ran, saved=saved,
+                      work=rows["stats"][:, STAT_WORK].copy() if _has_work(m, spec) else None,
+                      element_names=tuple(m.ELEMENTS) if spec.elements else (),
+                      constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
+                      events=_events(m, out), source=_source(m))
+
+
+def _source(module):
+    """{model_file (absolute), build options, frozen parameters} of a generated module; {} for a
+    module without MODEL_PATH (hand-made modules in tests)."""
+    if getattr(module, "MODEL_PATH", None) is None:
+        return {}
+    model_file = (Path(module.__file__).parent / module.MODEL_PATH).resolve()
+    return dict(model_file=str(model_file), build=dict(module.OPTIONS.get("build", {})),
+                frozen=dict(getattr(module, "FROZEN", {})))
+
+
+def _events(module, out):
+    """The located events of a run (steppers/core/events.py), () for a model without events."""
+    if not out["n_events"]:
+        return ()
+    from ..steppers.core.events import events_table
+    return events_table(module, out["events"], out["n_events"])
+
+
+def _warn_energy(task, traj, h, advice):
+    if task.controlled:         # driven by its inputs: the premise of a conservative model fails
+        return traj
+    message = energy_warning(task.module, task.method, traj.q, traj.v, traj.t, traj.energy,
+                             task.p, h, advice)
+    if message:
+        traj.warnings.append(message)
+        # stacklevel 4: _warn_energy <- _trajectory <- simulate <- the user's call
+        warnings.warn(message, EnergyWarning, stacklevel=4)
+    return traj
+
+
+def _constrained_start(module, q, v, p, t0, tol, keep=None):
+    """The consistent initial state and row 0 of the saved fields of a constrained method:
+    (q, v, [lam0, max|Phi|, max|J v|])."""
+    from .consistent import consistent_initial_state
+    # stacklevel 4: the warning points at the user's call of simulate().
+    state = consistent_initial_state(module, q, v, p, t0, tol, stacklevel=4, keep=keep)
+    initial = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
+    return np.ascontiguousarray(state.q), np.ascontiguousarray(state.v), initial

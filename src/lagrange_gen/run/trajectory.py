@@ -1,0 +1,147 @@
+"""The result of lagrange_gen.simulate: saved states, energies, Newton statistics, writers.
+
+    traj = simulate(...); traj.to_npz("traj.npz"); traj.to_csv("traj.csv"); traj.plot("traj.png")
+    traj.to_dataframe(); Trajectory.load("traj.npz"); traj.animate("traj.gif")
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .trajectory_io import dataframe, read_npz, write_csv, write_npz
+
+
+@dataclass
+class Trajectory:
+    """Saved states of one simulation.
+
+    t (S,), q (S, n), v (S, n), energy (S,) the energy function E = T2 - T0 + V (T + V for a
+    scleronomic T), work (S,) or None: W, the work of the non-conservative forces, dissipation
+    and explicit time since t0 (steppers/core/work.py: fixed-step runs on models whose E is not
+    conserved), newton_iters (S,) Newton iterations summed
+    over the steps since the previous saved row, newton_residual (S,) the largest final Newton
+    residual over those steps. S = n_steps // save_every + 1 (+1 when the final state does not
+    fall on a save).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    energy: np.ndarray
+    newton_iters: np.ndarray
+    newton_residual: np.ndarray
+    method: str
+    h: float
+    model: str
+    params: dict
+    coords: tuple
+    n_steps: int
+    wall_time: float = 0.0       # integration only, seconds
+    compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
+    # the compiled loop that ran (simulate(jit=), lagrange_gen.jit.portable): "specialized",
+    # "portable", or "portable, then specialized from step k"
+    jit: str = ""
+    saved: dict = field(default_factory=dict)   # {field name: (S, width)}: the method's SPEC.saved
+    element_names: tuple = ()
+    constraint_names: tuple = ()
+    warnings: list = field(default_factory=list)   # one line each (also issued as Python warnings)
+    events: tuple = ()          # located events (steppers/core/events.py events_table), in time order
+    step_counts: dict = field(default_factory=dict)  # adaptive runs: accepted, rejected, evaluations
+    # where the module came from: {"model_file": absolute path, "build": {...}, "frozen": {...}}
+    # (what animate needs to rebuild the model's Drawing)
+    source: dict = field(default_factory=dict)
+    work: np.ndarray | None = None   # W (S,), see above; None when E is conserved or not tracked
+
+    @property
+    def multipliers(self) -> np.ndarray:
+        """(S, m): the constraint forces lam (H qdd = rhs + J^T lam) at each saved state, from a
+        constrained method (see its module docstring for which of its multipliers it reports);
+        (S, 0) for a run without constraints."""
+        lam = self.saved.get("multipliers")
+        return lam if lam is not None else np.zeros((len(self.t), 0))
+
+    @property
+    def constraint_error(self):
+        """(S,): max_i |Phi_i(q)| at each saved state; None for a run without constraints."""
+        phi = self.saved.get("constraint_error")
+        return None if phi is None else phi[:, 0]
+
+    @property
+    def velocity_constraint_error(self):
+        """(S,): max_i |(J(q) v)_i| at each saved state; None for a run without constraints."""
+        jv = self.saved.get("velocity_constraint_error")
+        return None if jv is None else jv[:, 0]
+
+    @property
+    def element_state(self) -> np.ndarray:
+        """(S, ne): per nonsmooth element, u (elastic strain of a Saint-Venant element) or r (the
+        dry-friction force) at each saved state; (S, 0) for a run without elements."""
+        state = self.saved.get("element_state")
+        return state if state is not None else np.zeros((len(self.t), 0))
+
+    @property
+    def energy_error(self) -> np.ndarray:
+        """E - E0 (S,)."""
+        return self.energy - self.energy[0]
+
+    @property
+    def max_energy_error(self) -> float:
+        return float(np.max(np.abs(self.energy_error)))
+
+    @property
+    def energy_balance(self) -> np.ndarray:
+        """E - E0 - (W - W0) (S,): zero up to the method's error when the work is tracked
+        (``work``), else E - E0. (W0 = 0 unless the trajectory was cut from a longer one.)"""
+        if self.work is None:
+            return self.energy_error
+        return self.energy_error - (np.asarray(self.work) - self.work[0])
+
+    @property
+    def max_energy_balance_error(self) -> float:
+        return float(np.max(np.abs(self.energy_balance)))
+
+    def to_npz(self, path):
+        """Write every field to a .npz file (run/trajectory_io.py); Trajectory.load reads it back."""
+        write_npz(self, path)
+
+    save = to_npz
+
+    @classmethod
+    def load(cls, path) -> "Trajectory":
+        """The Trajectory saved by to_npz/save (also a .npz of an older writer, without events,
+        warnings and source)."""
+        return read_npz(cls, path)
+
+    def to_csv(self, path):
+        """Write one row per saved state: t, coordinates, velocities, energy, newton_iters and
+        the method's saved fields (a field of width w > 1 as name_0..name_w-1; for a constrained
+        method lam_0..lam_m-1, constraint_error, velocity_constraint_error)."""
+        write_csv(self, path)
+
+    def to_dataframe(self):
+        """pandas.DataFrame indexed by t with the columns of to_csv (pandas is the optional extra
+        ``lagrange-gen[dataframe]``)."""
+        return dataframe(self)
+
+    def plot(self, path=None):
+        """Coordinates and velocities (one axis each), energy (balance), and the constraint
+        errors and multipliers or element states when the run has them (viz/plot.py). Writes
+        ``path`` (format from the suffix: .png, .pdf, .svg) or returns the Figure."""
+        from ..viz.plot import plot_trajectory
+        return plot_trajectory(self, path)
+
+    def animate(self, path, model=None, frames=None, fps=25, dpi=80):
+        """Write an animation of the model's Drawing (Model(draw=...)) along this trajectory:
+        .gif (Pillow) or .mp4 (ffmpeg). ``model``: a Model or model file; default the model file
+        the run came from (self.source). ``frames`` evenly spaced in time (default: real time at
+        ``fps``, at most 300). See viz/animate.py."""
+        from ..viz.animate import animate
+        return animate(self, path, model=model, frames=frames, fps=fps, dpi=dpi)
+
+    def __repr__(self):
+        return (f"Trajectory({self.model}, {self.method}, h={self.h:g}, steps={self.n_steps}, "
+                f"saved={len(self.t)}, t=[{self.t[0]:g}, {self.t[-1]:g}])")
+
+

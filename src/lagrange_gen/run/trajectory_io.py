@@ -1,0 +1,142 @@
+"""Trajectory <-> files and tables: npz (every field, loaded back by Trajectory.load), csv, pandas.
+
+The npz holds each array field under its name (t, q, v, energy, ..., events as a structured array
+when the run located any), each saved field under its own name (a width-1 field as (S,), as the
+writers always did, so existing readers keep working), and ``meta``: a JSON text with every other
+field (method, h, model, params, coords, warnings, source, ...) and the saved fields' names and
+widths. Fields are found from the dataclass, so a field added to Trajectory round-trips without
+an edit here when it is an array, a dict of arrays, or JSON-able.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import LagrangeGenError
+
+FORMAT = 1
+# what the CLI's readers (and older files) expect even when the method saved none
+_ALWAYS = ("element_state", "multipliers")
+
+
+def write_npz(traj, path):
+    """Write every field of ``traj`` to ``path`` (.npz)."""
+    arrays, meta = {}, {"format": FORMAT, "dict_arrays": {}}
+    for f in dataclasses.fields(traj):
+        value = getattr(traj, f.name)
+        if f.name == "saved":
+            meta["saved"] = [[name, a.shape[1]] for name, a in value.items()]
+            arrays.update({name: a[:, 0] if a.shape[1] == 1 else a for name, a in value.items()})
+        elif isinstance(value, np.ndarray):
+            arrays[f.name] = value
+        elif value and isinstance(value, dict) and all(isinstance(a, np.ndarray)
+                                                         for a in value.values()):
+            meta["dict_arrays"][f.name] = list(value)
+            arrays.update({f"{f.name}.{k}": a for k, a in value.items()})
+        else:
+            meta[f.name] = value
+    for name in _ALWAYS:
+        arrays.setdefault(name, getattr(traj, name))
+    # the keys older readers use
+    legacy = dict(param_names=np.array(list(traj.params), dtype=str),
+                  param_values=np.array(list(traj.params.values()), dtype=float),
+                  method=traj.method, h=traj.h, model=traj.model, n_steps=traj.n_steps,
+                  coords=np.array(traj.coords, dtype=str),
+                  element_names=np.array(traj.element_names, dtype=str),
+                  constraint_names=np.array(traj.constraint_names, dtype=str))
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    np.savez(path, meta=json.dumps(meta, default=_plain), **legacy, **arrays)
+
+
+def _plain(value):
+    """JSON for numpy scalars and small arrays inside metadata."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+
+
+def read_npz(cls, path):
+    """The Trajectory (class ``cls``) written by write_npz; LagrangeGenError naming the file
+    when it is not one."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            data = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise LagrangeGenError(f"{path}: cannot read as a trajectory .npz ({exc})") from None
+    if "meta" not in data:
+        return _read_legacy(cls, path, data)
+    meta = json.loads(str(data["meta"]))
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name == "saved":
+            kwargs["saved"] = {name: data[name].reshape(len(data[name]), width)
+                               for name, width in meta["saved"]}
+        elif f.name in meta["dict_arrays"]:
+            kwargs[f.name] = {k: data[f"{f.name}.{k}"] for k in meta["dict_arrays"][f.name]}
+        elif f.name in meta:         # before data: the legacy keys repeat method, h, model, ...
+            value = meta[f.name]
+            if str(f.type).startswith("tuple") and isinstance(value, list):
+                value = tuple(value)         # JSON has lists only
+            kwargs[f.name] = value
+        elif f.name in data:
+            kwargs[f.name] = data[f.name]
+    return cls(**kwargs)
+
+
+def _read_legacy(cls, path, data):
+    """A file of the writer before ``meta`` (no events, warnings or source)."""
+    need = ("t", "q", "v", "energy", "method", "h", "model", "coords")
+    missing = [k for k in need if k not in data]
+    if missing:
+        raise LagrangeGenError(f"{path}: not a lagrange-gen trajectory (no {', '.join(missing)})")
+    known = ("multipliers", "constraint_error", "velocity_constraint_error", "element_state")
+    saved = {k: data[k].reshape(len(data["t"]), -1) for k in known
+             if k in data and data[k].size}
+    n = len(data["t"])
+    return cls(t=data["t"], q=data["q"], v=data["v"], energy=data["energy"],
+               newton_iters=data.get("newton_iters", np.zeros(n)),
+               newton_residual=data.get("newton_residual", np.zeros(n)),
+               method=str(data["method"]), h=float(data["h"]), model=str(data["model"]),
+               params=dict(zip(data["param_names"].tolist(), data["param_values"].tolist())),
+               coords=tuple(data["coords"].tolist()), n_steps=int(data.get("n_steps", n - 1)),
+               saved=saved, element_names=tuple(data.get("element_names", np.array([])).tolist()),
+               constraint_names=tuple(data.get("constraint_names", np.array([])).tolist()))
+
+
+def table(traj):
+    """(column names, (S, columns) data): t, coordinates, velocities (name_dot), energy,
+    newton_iters, then the saved fields (width w > 1 as name_0..name_w-1; multipliers as
+    lam_0..lam_m-1)."""
+    header = ["t", *traj.coords, *(f"{c}_dot" for c in traj.coords), "energy", "newton_iters"]
+    columns = [traj.t[:, None], traj.q, traj.v, traj.energy[:, None], traj.newton_iters[:, None]]
+    short = {"multipliers": "lam"}
+    for name, values in traj.saved.items():
+        stem = short.get(name, name)
+        header += [stem] if values.shape[1] == 1 and name not in short else [
+            f"{stem}_{i}" for i in range(values.shape[1])]
+        columns.append(values)
+    return header, np.hstack(columns)
+
+
+def write_csv(traj, path):
+    header, data = table(traj)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    np.savetxt(path, data, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+
+
+def dataframe(traj):
+    """pandas.DataFrame of :func:`table`, indexed by t."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise LagrangeGenError("Trajectory.to_dataframe needs pandas: pip install "
+                               "'lagrange-gen[dataframe]'") from None
+    header, data = table(traj)
+    index = pd.Index(data[:, 0], name="t")
+    return pd.DataFrame(data[:, 1:], index=index, columns=header[1:])

@@ -1,0 +1,68 @@
+"""Registry of stepper methods: the list, each method's Spec, and which methods apply to a model.
+
+Everything about a method is declared by its module's SPEC (steppers/methods/<method>.py,
+core/method_spec.py); this module lists the methods in report order and answers the questions
+simulate, the CLI and the generator ask about them. The glue a generated module runs them
+through is written by lagrange_gen.codegen.glue.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+#: The registry: one line per method, in the order reports list them. Everything else about a
+#: method is declared by its module's SPEC (method_spec.py).
+METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
+           "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
+           "constrained_midpoint", "constrained_implicit_euler", "spook", "index1")
+
+#: {method: its Spec}.
+INFO = {m: importlib.import_module(f"lagrange_gen.steppers.methods.{m}").SPEC for m in METHODS}
+
+#: Methods for models with holonomic constraints (they save multipliers and residuals).
+CONSTRAINED_METHODS = tuple(m for m in METHODS if INFO[m].constraints)
+
+#: Methods that treat nonsmooth elements (SaintVenant, DryFriction).
+NONSMOOTH_METHODS = tuple(m for m in METHODS if INFO[m].elements)
+
+#: Methods that choose their own steps (adaptive glue signature, simulate's rtol/atol/t_eval).
+ADAPTIVE_METHODS = tuple(m for m in METHODS if INFO[m].adaptive)
+
+#: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
+ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}
+
+
+def spec(method: str):
+    """The Spec of a method; KeyError naming the known ones."""
+    if method not in INFO:
+        raise KeyError(f"unknown stepper method {method!r}; known: {', '.join(METHODS)}")
+    return INFO[method]
+
+
+def runs_as(method: str, n_elements: int) -> str:
+    """The method whose glue runs ``method`` on a model with ``n_elements`` nonsmooth elements."""
+    return ON_ELEMENTS.get(method, method) if n_elements else method
+
+
+def inapplicable(method: str, n_constraints: int, n_elements: int) -> str:
+    """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
+    flags = INFO[method]
+    if n_constraints and n_elements:
+        return "constraints together with nonsmooth elements are not supported by any method"
+    if bool(n_constraints) != flags.constraints:
+        return ("it ignores the model's constraints" if n_constraints
+                else "it is for models with constraints and this model has none")
+    if n_elements and not flags.elements:
+        standins = [f"{a} runs {m}" for a, m in ON_ELEMENTS.items()]
+        return ("it cannot treat the model's nonsmooth elements"
+                + (f" ({', '.join(standins)})" if standins else ""))
+    return ""
+
+
+def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
+    """The methods that apply to a model with these counts, in METHODS order."""
+    return tuple(m for m in METHODS if not inapplicable(m, n_constraints, n_elements))
+
+
+#: The jitted loop each kind of method runs in: (module, function).
+LOOPS = {False: ("base", "run_loop"), True: ("adaptive", "run_adaptive")}
