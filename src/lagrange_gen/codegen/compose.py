@@ -26,6 +26,8 @@ def compositions(dyn, selected, needs) -> dict:
     out = {}
     if dyn.has_transport:       # momentum_rate (canonical, with b) is not dT/dq - g + Q there
         return out
+    if hasattr(dyn.jac, "columns"):     # graph models: the Jacobians are column loops already
+        return out
     if "mass_matvec_dq" in selected and "momentum_rate_jacobian" in selected:
         out["momentum_rate_jacobian"] = "d/dqd part = mass_matvec_dq(q, qd)^T + dQ/dqd"
     # The steppers reach dynamics through the module function forward_dynamics (steppers/core/base.py

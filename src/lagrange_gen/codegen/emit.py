@@ -144,6 +144,8 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
 
     inputs: codegen.printer.Inputs of the model (symbol -> placeholder and load statement).
     """
+    if spec.columns:
+        return render_column_kernel(spec, inputs)
     entries = _entries(spec)
     live = [e for e in entries if e.expr != 0]
     zeros = [e for e in entries if e.expr == 0 and e.out is not None and not e.out.accumulate]
@@ -186,17 +188,55 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
                       cse_exprs=[e for _, e in temps] + list(reduced))
 
 
-def graph_body(inputs, exprs):
-    """(nodes, reduced) for a model derived through an expression graph (derive/graph.py):
-    nodes [(name, symengine definition over placeholders)] that ``exprs`` use, in evaluation
-    order, and ``exprs`` over placeholders. No CSE: every node is already a short expression
-    shared by name, and the outputs are nodes or short sums of node products."""
+def render_column_kernel(spec: KernelSpec, inputs) -> KernelText:
+    """A Jacobian kernel of a graph model as loops over its columns: the graph nodes that do not
+    depend on the seeds once, then for each output ``for k in range(cols)`` with seed_i = 1.0
+    where i == k, the tangent nodes and the stores of column k. numba's compile time follows
+    the operations in the text, and the loop holds one tangent pass where the written-out
+    Jacobian holds cols of them; the run time is the same number of operations."""
+    graph = inputs.graph
+    placeholders = _placeholder_map(inputs)
+    seeds = {s for _, column_seeds, _ in spec.columns for s in column_seeds}
+    everything = [e for _, _, column in spec.columns for e in column]
+    outside = [(s, d) for s, d in graph.used_nodes(everything) if not (graph.inputs_of(s) & seeds)]
+    printed, used = [], set()
+
+    def text(expr):
+        expr = placeholders(expr)
+        used.update(s.name for s in expr.free_symbols)
+        return print_native(expr)
+
+    body = [f"    {s} = {text(d)}" for s, d in outside]
+    for name, column_seeds, column in spec.columns:
+        inside = [(s, d) for s, d in graph.used_nodes(column) if graph.inputs_of(s) & seeds]
+        printed.append(f"    for k in range({len(column_seeds)}):")
+        printed += [f"        {s} = 1.0 if k == {i} else 0.0" for i, s in enumerate(column_seeds)]
+        printed += [f"        {s} = {text(d)}" for s, d in inside]
+        printed += [f"        {name}[{i}, k] = {text(se.sympify(e)) if e != 0 else '0.0'}" for i, e in enumerate(column)]
+    args = ", ".join(spec.signature)
+    lines = ['@njit(cache=True, _nrt=False, error_model="numpy")', f"def {spec.name}({args}):",
+             f'    """{spec.doc}."""']
+    lines += _load_lines(used, inputs.loads(spec.args)) + body + printed
+    n_entries = sum(len(column) * len(column_seeds) for _, column_seeds, column in spec.columns)
+    return KernelText(spec.name, [], "\n".join(lines), n_entries=n_entries, n_temps=len(body))
+
+
+def _placeholder_map(inputs):
+    """expr -> expr with the model's input symbols renamed to their placeholders (q_0, p_1, t)."""
     rename = {se.Symbol(s.name): se.Symbol(new) for s, new in inputs.rename.items()}
 
     def placeholders(expr):
         used = {s: rename[s] for s in expr.free_symbols if s in rename}
         return expr.xreplace(used) if used else expr
+    return placeholders
 
+
+def graph_body(inputs, exprs):
+    """(nodes, reduced) for a model derived through an expression graph (derive/graph.py):
+    nodes [(name, symengine definition over placeholders)] that ``exprs`` use, in evaluation
+    order, and ``exprs`` over placeholders. No CSE: every node is already a short expression
+    shared by name, and the outputs are nodes or short sums of node products."""
+    placeholders = _placeholder_map(inputs)
     nodes = [(str(sym), placeholders(d)) for sym, d in inputs.graph.used_nodes(exprs)]
     return nodes, [placeholders(se.sympify(e)) for e in exprs]
 

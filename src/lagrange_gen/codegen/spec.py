@@ -46,7 +46,9 @@ class KernelSpec:
     args: input argument names in order (q, qd, t, p, w, lam); doc: one line for the docstring.
     out_args: output argument names when they are not exactly the symbolic outputs' names (a
     composed kernel, see codegen.compose); prologue: statements run first (calls of other kernels,
-    numeric loops); epilogue: statements run last (they may ``return``).
+    numeric loops); epilogue: statements run last (they may ``return``). columns: for a
+    Jacobian written as a loop over its columns (graph models, emit.render_column_kernel),
+    [(output name, seeds, column expressions)] from derive.structured.GraphJacobians.columns.
     """
 
     name: str
@@ -57,6 +59,7 @@ class KernelSpec:
     out_args: list | None = None
     prologue: list = field(default_factory=list)
     epilogue: list = field(default_factory=list)
+    columns: list = field(default_factory=list)
 
     @property
     def signature(self):
@@ -127,7 +130,25 @@ def kernel_table(dyn) -> dict:
                 "steppers/core/events.py locates"),
     }
     table.update(io_kernels(dyn))
+    if hasattr(dyn.jac, "columns"):
+        table.update(column_kernels(dyn))
     return table
+
+
+def column_kernels(dyn) -> dict:
+    """The Newton Jacobian kernels of a graph model as loops over their columns (same names,
+    arguments and outputs as the written-out ones of kernel_table)."""
+    docs = {"rhs_jacobian": (["q", "qd", "t", "p"], "d rhs/dq and d rhs/dqd (n, n)"),
+            "momentum_rate_jacobian": (["q", "qd", "t", "p"], "d(dp/dt)/dq and d(dp/dt)/dqd (n, n)"),
+            "mass_matvec_dq": (["q", "w", "t", "p"], "d(H(q) w)/dq (n, n) for a vector w (n,)")}
+    out = {}
+    for name, (args, doc) in docs.items():
+        def build(name=name, args=args, doc=doc):
+            columns = dyn.jac.columns(name)
+            return KernelSpec(name, args, doc=f"{doc}, column by column (one tangent pass per column)",
+                              out_args=[c[0] for c in columns], columns=columns)
+        out[name] = build
+    return out
 
 
 def io_kernels(dyn) -> dict:

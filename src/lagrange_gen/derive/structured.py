@@ -25,6 +25,7 @@ from __future__ import annotations
 import copy
 
 import numpy as np
+import symengine as se
 import sympy as sp
 
 from ..model.bodies import Intermediate, expand_intermediates
@@ -210,6 +211,13 @@ def _check_quadratic(model, o, T, mom, H, samples):
                              f"{_weakest_direction(model.coords, vectors[:, 0])})") from None
 
 
+#: Names of the seed variables of a column loop (never a placeholder, temporary or node name).
+SEED_PREFIX = "seed_"
+
+#: The Jacobian kernels a graph model writes as loops over columns (GraphJacobians.columns).
+COLUMN_KERNELS = ("rhs_jacobian", "momentum_rate_jacobian", "mass_matvec_dq")
+
+
 class GraphJacobians(Jacobians):
     """The Newton Jacobians (jacobians.JACOBIANS) by forward passes through the graph."""
 
@@ -233,8 +241,29 @@ class GraphJacobians(Jacobians):
     def _dmom_dqd(self):
         return self._graph_jacobian("momentum_rate", self._qd)
 
-    def _dHw_dq(self):
+    def _Hw(self):
+        """H w (n,) as the tangent of p = H qd along w in the velocities."""
         graph = self._o.graph
-        along_w = dict(zip(self._qd, self._w))
-        Hw = [graph.node(e) for e in graph.tangents(self._p["p"], along_w)]
-        return self._o.jacobian(Hw, self._q)
+        return [graph.node(e) for e in graph.tangents(self._p["p"], dict(zip(self._qd, self._w)))]
+
+    def _dHw_dq(self):
+        return self._o.jacobian(self._Hw(), self._q)
+
+    def columns(self, kernel):
+        """[(output name, seeds, column)] of a Jacobian kernel written as a loop over its columns
+        (codegen.emit.render_column_kernel): column k of the output is ``column`` (n
+        expressions) with seeds[i] = 1 for i == k and 0 otherwise, the tangent of the
+        differentiated vector along one coordinate (or velocity). The code holds one tangent
+        pass instead of n: its size is a small multiple of the kernel it differentiates, where
+        the written-out Jacobian is n times that."""
+        graph = self._o.graph
+        seeds = [se.Symbol(f"{SEED_PREFIX}{i}") for i in range(len(self._q))]
+
+        def along(exprs, xs):
+            return graph.tangents(exprs, dict(zip(xs, seeds)))
+
+        if kernel == "mass_matvec_dq":
+            return [("out_mat", seeds, along(self._Hw(), self._q))]
+        field = {"rhs_jacobian": "rhs", "momentum_rate_jacobian": "momentum_rate"}[kernel]
+        values = list(self._p[field])
+        return [("Jq", seeds, along(values, self._q)), ("Jqd", seeds, along(values, self._qd))]
