@@ -82,6 +82,22 @@ def accelerations(q, qd, t=0.0, params=None):
 '''
 
 
+_WITH_TORQUES = '''
+
+@njit(cache=True, _nrt=False)
+def forward_dynamics_torques(q, qd, tau, t, p, H, qdd):
+    """Solve H(q) qdd = rhs + tau for generalized forces tau (n,) added to the model's own
+    (joint torques); H (n, n) is workspace, qdd (n,) the output. Returns OK or SINGULAR_MASS."""
+    dynamics(q, qd, t, p, H, qdd)
+    for i in range(N_COORDS):
+        qdd[i] += tau[i]
+    if not cholesky_inplace(H):
+        return SINGULAR_MASS
+    cholesky_solve_inplace(H, qdd)
+    return OK
+'''
+
+
 def factor_at_import(dyn) -> bool:
     """True when H is constant and every parameter it depends on has a default value."""
     if not dyn.mass_is_constant:
@@ -132,10 +148,11 @@ def unrolled_forward_text(dyn) -> str:
 
 def forward_source(dyn) -> str:
     """Source of forward_dynamics and accelerations for this model (see the module docstring)."""
+    torques = _WITH_TORQUES if hasattr(dyn.jac, "inverse_dynamics") and not dyn.mass_is_constant else ""
     if not factor_at_import(dyn):
         if not dyn.mass_is_constant and dyn.n <= UNROLL_MAX:
-            return unrolled_forward_text(dyn) + "\n" + _ACCELERATIONS
-        return _GENERAL + _ACCELERATIONS
+            return unrolled_forward_text(dyn) + "\n" + _ACCELERATIONS + torques
+        return _GENERAL + _ACCELERATIONS + torques
     used = {str(s) for s in dyn.native["H"].free_symbols}
     checks = [f"p[{k}] == {float(d)!r}" for k, (s, d) in enumerate(zip(dyn.params, dyn.model.defaults()))
               if s.name in used]

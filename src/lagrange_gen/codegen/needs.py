@@ -145,7 +145,7 @@ def select_kernels(dyn, methods) -> dict:
     empty list, not None) asks for a kernel library without steppers: every kernel is emitted.
     """
     from ..errors import GenerationError
-    from .spec import CORE_KERNELS, default_kernels, kernel_table
+    from .spec import CORE_KERNELS, ROBOT_KERNELS, default_kernels, kernel_table
     table = kernel_table(dyn)
     if not methods:
         return {name: ["no stepper requested: kernel library"] for name in default_kernels(dyn)}
@@ -157,6 +157,9 @@ def select_kernels(dyn, methods) -> dict:
         why.setdefault("constraint_rate", []).append("constrained model (consistent initial velocities)")
     if dyn.n_elements:
         why.setdefault("elements", []).append("model with nonsmooth elements (element energy)")
+    if hasattr(dyn.jac, "inverse_dynamics"):
+        for name in ROBOT_KERNELS:
+            why.setdefault(name, []).append("model built from bodies (robotics kernels)")
     if {"input_jacobian", "outputs"} & set(table):   # inputs or outputs: run/control.py, linearize
         for name in ("input_jacobian", "outputs", "output_jacobian", "rhs_jacobian",
                      "mass_matvec_dq") + (("constraint_dq",) if dyn.m else ()):

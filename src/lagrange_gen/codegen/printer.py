@@ -61,10 +61,10 @@ class Inputs:
     the kernels use, else None.
     """
 
-    _VECTORS = ("q", "qd", "p", "w", "lam", "we")
+    _VECTORS = ("q", "qd", "qdd", "p", "w", "lam", "we")
 
     def __init__(self, dyn):
-        symbols = {"q": dyn.q, "qd": dyn.qd, "p": dyn.params, "w": dyn.aux["w"],
+        symbols = {"q": dyn.q, "qd": dyn.qd, "qdd": dyn.aux.get("qdd", []), "p": dyn.params, "w": dyn.aux["w"],
                    "lam": dyn.aux["lam"], "we": dyn.aux.get("we", [])}
         self.graph = getattr(dyn.ops, "graph", None)
         self.rename = {dyn.t: "t"}

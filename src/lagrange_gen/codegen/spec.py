@@ -132,7 +132,33 @@ def kernel_table(dyn) -> dict:
     table.update(io_kernels(dyn))
     if hasattr(dyn.jac, "columns"):
         table.update(column_kernels(dyn))
+        table.update(robot_kernels(dyn))
     return table
+
+
+#: The kernels of a model built from bodies that controllers and robotics users call.
+ROBOT_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
+
+
+def robot_kernels(dyn) -> dict:
+    """inverse_dynamics, gravity_forces and bias_forces of a graph model (each one pass over
+    the graph, cheaper than dynamics: no mass matrix is formed)."""
+    nat, o = dyn.native, dyn.ops
+    minus_rhs = o.column([-e for e in nat["rhs"]])
+    return {
+        "inverse_dynamics": lambda: KernelSpec(
+            "inverse_dynamics", ["q", "qd", "qdd", "t", "p"],
+            [Output("tau", o.column(dyn.jac.inverse_dynamics(o.symbols(dyn.aux["qdd"]))))],
+            doc="tau = H(q) qdd + h(q, qd) + g(q) - Q (n,): the generalized forces that give the "
+                "accelerations qdd (n,) (RNEA's answer)"),
+        "gravity_forces": lambda: KernelSpec(
+            "gravity_forces", ["q", "t", "p"], [Output("out", nat["g"])],
+            doc="g(q) = dV/dq (n,)"),
+        "bias_forces": lambda: KernelSpec(
+            "bias_forces", ["q", "qd", "t", "p"], [Output("out", minus_rhs)],
+            doc="h(q, qd) + g(q) - Q (n,): tau at qdd = 0 (velocity terms, gravity and the "
+                "model's own forces)"),
+    }
 
 
 def column_kernels(dyn) -> dict:

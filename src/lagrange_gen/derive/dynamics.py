@@ -133,7 +133,7 @@ def _finish(model, o, parts, frozen, jacobians):
     q = o.symbols(model.coords)
     parts.update(derive_constraints(model, o, q))
     n, m = len(model.coords), len(model.constraints)
-    aux = {"w": input_symbols("w", n), "lam": input_symbols("lam", m),
+    aux = {"w": input_symbols("w", n), "qdd": input_symbols("qdd", n), "lam": input_symbols("lam", m),
            "we": input_symbols("we", len(model.elements))}
     for key, value in derive_elements(model, aux["we"]).items():
         parts[key] = o.matrix(*value.shape, list(value))

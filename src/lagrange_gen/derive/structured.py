@@ -249,6 +249,13 @@ class GraphJacobians(Jacobians):
     def _dHw_dq(self):
         return self._o.jacobian(self._Hw(), self._q)
 
+    def inverse_dynamics(self, qdd):
+        """tau (n,) = H qdd + h + g - Q for accelerations ``qdd`` (n symbols): the tangent of
+        p = H qd along qdd minus rhs, one pass over the graph (no H formed)."""
+        graph = self._o.graph
+        Hqdd = graph.tangents(self._p["p"], dict(zip(self._qd, qdd)))
+        return [graph.node(a - r) for a, r in zip(Hqdd, self._p["rhs"])]
+
     def columns(self, kernel):
         """[(output name, seeds, column)] of a Jacobian kernel written as a loop over its columns
         (codegen.emit.render_column_kernel): column k of the output is ``column`` (n
