@@ -316,6 +316,36 @@ def kinetic_energy(frame, *bodies):
     return total
 
 
+def is_constant_force(frame, load):
+    """True for a force at a Point whose vector is constant in ``frame`` (every term in
+    ``frame``, components free of the dynamicsymbols and of time): a uniform field such as
+    gravity, whose work is a potential."""
+    me = _me()
+    point, vector = load
+    if not isinstance(point, me.Point) or not isinstance(vector, me.Vector):
+        return False
+    for comps, where in vector.args:
+        if where != frame or comps.atoms(sp.core.function.AppliedUndef) or comps.atoms(sp.Derivative):
+            return False
+        if any(s.name == "t" for s in comps.free_symbols):
+            return False
+    return True
+
+
+def constant_force_potential(frame, loads):
+    """V = -sum F . r_P of constant forces F at points P ((point, vector) pairs, is_constant_force),
+    positions from the nearest fixed point, over Intermediates; None when a point has no fixed
+    point to be located from (the loads then stay generalized forces)."""
+    try:
+        tree = _Tree(frame)
+        total = sp.S.Zero
+        for point, vector in loads:
+            total -= tree.components(vector, frame).dot(tree.position(point))
+        return total
+    except (_NoRecords, ModelError, ValueError):
+        return None
+
+
 def gravity_potential(frame, gravity, *bodies):
     """V = -sum m gravity . r of the bodies' mass centres (``gravity`` a constant Vector in
     ``frame``, e.g. -g*N.z), positions measured from the nearest fixed point (velocity set to

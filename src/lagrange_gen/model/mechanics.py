@@ -56,6 +56,11 @@ def _where_and_vector(item):
     return item[0], item[1]
 
 
+def where_and_vector(item):
+    """(Point or ReferenceFrame, Vector) of a load."""
+    return _where_and_vector(item)
+
+
 def generalized_loads(loads, frame, speeds, model_name):
     """Q (list of n sympy expressions, still in dynamicsymbols) of mechanics ``loads`` in the
     inertial ``frame``; ``speeds`` (n,) the time derivatives of the coordinate dynamicsymbols.

@@ -172,6 +172,7 @@ class Model:
             if any(is_mechanics_load(f) for f in forces):
                 from .mechanics import generalized_loads
                 mech = [f for f in forces if is_mechanics_load(f)]
+                mech = self._fold_constant_forces(mech, frame, replace)
                 for j, Qj in enumerate(generalized_loads(mech, frame, speeds, self.name)):
                     Q[j] += self._scalar(Qj, f"generalized force of the loads on {self.coords[j]}", replace)
                 forces = [f for f in forces if not is_mechanics_load(f)]
@@ -186,6 +187,24 @@ class Model:
             raise ModelError(f"model {self.name}: forces has {len(forces)} entries for {n} coordinates "
                              "(give one per coordinate, a dict, or a list of PointForce)")
         return [self._scalar(f, f"force {i}", replace) for i, f in enumerate(forces)]
+
+    def _fold_constant_forces(self, loads, frame, replace):
+        """The mechanics loads that stay generalized forces: constant forces at points (gravity
+        as me.Force(G, -m*g*N.z)) become the potential -F . r_P, added to V, so a model with
+        gravity written as a load stays conservative (energy conserved by the symplectic
+        methods, no work to track)."""
+        from .bodies import constant_force_potential, is_constant_force
+        from .mechanics import where_and_vector
+        if frame is None:
+            return loads
+        # sympy's Force objects only (how a model states gravity on a point); tuples and
+        # PointForce stay generalized forces by virtual work, as written
+        constant = [f for f in loads if type(f).__name__ == "Force" and is_constant_force(frame, where_and_vector(f))]
+        potential = constant_force_potential(frame, [where_and_vector(f) for f in constant]) if constant else None
+        if potential is None:
+            return loads
+        self.V = self.V + self._scalar(potential, "potential of the constant forces", replace)
+        return [f for f in loads if not any(f is c for c in constant)]
 
     def _elements(self, elements, replace):
         out = []
