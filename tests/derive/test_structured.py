@@ -3,6 +3,8 @@
 with full inertia tensors; the robotics kernels; what users write with sympy.physics.mechanics
 (v2pt_theory on every point, a constraint on top of a body model); bad input."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -115,15 +117,22 @@ def test_constraint_on_a_body_model():
     assert sp.simplify(dyn.J - sp.Matrix([[1, -sp.Rational(1, 2)]])) == sp.zeros(1, 2)
 
 
-def test_robot_kernels_invert_each_other(tmp_path):
-    """inverse_dynamics(forward_dynamics_torques(tau)) = tau; bias at rest = gravity (Python
-    bodies of the kernels, no numba compile)."""
+@pytest.fixture(scope="module")
+def chain_module(tmp_path_factory):
+    """The generated module of a 3-link chain (rk4 only)."""
     from lagrange_gen.codegen import generate_model
     from lagrange_gen.run.loader import import_generated
-    path = tmp_path / "chain_model.py"
+    where = tmp_path_factory.mktemp("structured")
+    path = where / "chain_model.py"
     path.write_text("import sys\nsys.path.insert(0, %r)\nfrom test_structured import chain\nmodel = chain(3)\n"
-                    % str(__import__("pathlib").Path(__file__).parent))
-    mod = import_generated(generate_model(path, tmp_path / "gen", methods=["rk4"]).path)
+                    % str(Path(__file__).parent))
+    return import_generated(generate_model(path, where / "gen", methods=["rk4"]).path)
+
+
+def test_robot_kernels_invert_each_other(chain_module):
+    """inverse_dynamics(forward_dynamics_torques(tau)) = tau; bias at rest = gravity (Python
+    bodies of the kernels, no numba compile)."""
+    mod = chain_module
     n = mod.N_COORDS
     rng = np.random.default_rng(1)
     q, v, tau = rng.uniform(-1, 1, (3, n))
@@ -136,6 +145,25 @@ def test_robot_kernels_invert_each_other(tmp_path):
     mod.gravity_forces.py_func(q, 0.0, p, g)
     mod.bias_forces.py_func(q, np.zeros(n), 0.0, p, b)
     assert np.allclose(b, g, rtol=1e-13, atol=1e-13)
+
+
+def test_forward_dynamics_jacobian_is_the_derivative_of_the_accelerations(chain_module):
+    mod = chain_module
+    n = mod.N_COORDS
+    rng = np.random.default_rng(4)
+    q, v = rng.uniform(-1, 1, (2, n))
+    p = np.array(mod.DEFAULT_PARAMS, dtype=float)
+    H, W, Jq, Jqd = (np.empty((n, n)) for _ in range(4))
+    qdd = np.empty(n)
+    assert mod.forward_dynamics_jacobian(q, v, 0.0, p, H, qdd, Jq, Jqd, W) == 0
+    assert np.allclose(qdd, mod.accelerations(q, v), rtol=1e-13, atol=1e-13)
+    eps = 1e-6
+    dq = np.array([(mod.accelerations(q + eps * e, v) - mod.accelerations(q - eps * e, v)) / (2 * eps)
+                   for e in np.eye(n)]).T
+    dv = np.array([(mod.accelerations(q, v + eps * e) - mod.accelerations(q, v - eps * e)) / (2 * eps)
+                   for e in np.eye(n)]).T
+    assert np.allclose(Jq, dq, rtol=1e-6, atol=1e-7)
+    assert np.allclose(Jqd, dv, rtol=1e-6, atol=1e-7)
 
 
 def test_gravity_needs_a_fixed_point():

@@ -95,6 +95,31 @@ def forward_dynamics_torques(q, qd, tau, t, p, H, qdd):
         return SINGULAR_MASS
     cholesky_solve_inplace(H, qdd)
     return OK
+
+
+@njit(cache=True, _nrt=False)
+def forward_dynamics_jacobian(q, qd, t, p, H, qdd, Jq, Jqd, W):
+    """qdd (n,) = H^-1 rhs and its derivatives Jq = d qdd/dq, Jqd = d qdd/dqd (n, n):
+    H Jq = d rhs/dq - d(H w)/dq at w = qdd, H Jqd = d rhs/dqd, solved with the factor of H.
+    H and W (n, n) are workspace. Returns OK or SINGULAR_MASS."""
+    dynamics(q, qd, t, p, H, qdd)
+    if not cholesky_inplace(H):
+        return SINGULAR_MASS
+    cholesky_solve_inplace(H, qdd)
+    rhs_jacobian(q, qd, t, p, Jq, Jqd)
+    mass_matvec_dq(q, qdd, t, p, W)
+    for i in range(N_COORDS):
+        for j in range(N_COORDS):
+            Jq[i, j] -= W[i, j]
+    column = W[0]                 # W is free now: its first row holds one column at a time
+    for J in (Jq, Jqd):
+        for j in range(N_COORDS):
+            for i in range(N_COORDS):
+                column[i] = J[i, j]
+            cholesky_solve_inplace(H, column)
+            for i in range(N_COORDS):
+                J[i, j] = column[i]
+    return OK
 '''
 
 

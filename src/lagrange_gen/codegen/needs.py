@@ -158,7 +158,7 @@ def select_kernels(dyn, methods) -> dict:
     if dyn.n_elements:
         why.setdefault("elements", []).append("model with nonsmooth elements (element energy)")
     if hasattr(dyn.jac, "inverse_dynamics"):
-        for name in ROBOT_KERNELS:
+        for name in ROBOT_KERNELS + ("rhs_jacobian", "mass_matvec_dq"):
             why.setdefault(name, []).append("model built from bodies (robotics kernels)")
     if {"input_jacobian", "outputs"} & set(table):   # inputs or outputs: run/control.py, linearize
         for name in ("input_jacobian", "outputs", "output_jacobian", "rhs_jacobian",
