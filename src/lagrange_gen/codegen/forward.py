@@ -73,7 +73,9 @@ def accelerations(q, qd, t=0.0, params=None):
     qd = np.ascontiguousarray(qd, dtype=np.float64)
     if q.shape != (N_COORDS,) or qd.shape != (N_COORDS,):
         raise ValueError(f"{NAME}: q and qd must have {N_COORDS} entries ({', '.join(COORDS)})")
-    p = resolve_params(PARAMS, DEFAULTS, params, NAME, frozen=FROZEN)
+    # the defaults need no checking: DEFAULT_PARAMS was built from them at import
+    p = DEFAULT_PARAMS if params is None and None not in DEFAULTS else resolve_params(
+        PARAMS, DEFAULTS, params, NAME, frozen=FROZEN)
     H = np.empty((N_COORDS, N_COORDS))
     qdd = np.empty(N_COORDS)
     if forward_dynamics(q, qd, float(t), p, H, qdd) != OK:
