@@ -23,6 +23,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
+from .loads import PointForce, is_point_and_vector
 
 __all__ = ["kinetic_energy", "is_mechanics_load", "generalized_loads"]
 
@@ -55,25 +56,16 @@ def kinetic_energy(frame, *bodies):
     return total
 
 
-def _is_vector(obj):
-    return isinstance(obj, _me().Vector)
-
-
 def is_mechanics_load(item):
     """True for Force, Torque, (Point, Vector), (ReferenceFrame, Vector) and a PointForce whose
     point is a mechanics Point; never imports sympy.physics.mechanics for other items."""
-    from .loads import PointForce
     if isinstance(item, PointForce):
         return item.mechanics
-    if not isinstance(item, tuple) or len(item) != 2 or "sympy.physics" not in type(item[0]).__module__:
-        return False
-    me = _me()
-    return isinstance(item[0], (me.Point, me.ReferenceFrame)) and _is_vector(item[1])
+    return isinstance(item, tuple) and len(item) == 2 and is_point_and_vector(*item)
 
 
 def _where_and_vector(item):
     """(Point or ReferenceFrame, Vector) of a load."""
-    from .loads import PointForce
     if isinstance(item, PointForce):
         return item.point, item.force
     return item[0], item[1]
