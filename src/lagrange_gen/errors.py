@@ -53,3 +53,9 @@ class SingularNewtonMatrix(NewtonDivergence):
 class EnergyWarning(UserWarning):
     """A run on a conservative model lost (or gained) energy far beyond what its step allows
     (lagrange_gen.run.energy_check); the trajectory is kept, with the line in Trajectory.warnings."""
+
+
+class IdentificationError(LagrangeGenError, ValueError):
+    """The data do not determine the requested parameters (lagrange_gen.identify); the message
+    says what is missing. A ValueError (bad input values) and a LagrangeGenError (the CLI prints
+    its one-line message)."""

@@ -15,7 +15,7 @@ def _cold_row(label, goal, library_cached, total):
 
 def _results():
     return {
-        "quick": True, "mujoco": False,
+        "quick": True, "mujoco": False, "case": speed.CASE, "chain_n": speed.CHAIN_N,
         "precision": {"ours": {"rk4": 5e-4}, "peers": {}, "pydy": None},
         "steps": [{"method": "rk4", "ours_ns": 130.0, "hand_ns": 76.0, "iters": 0.0,
                    "portable_ns": 195.0}],

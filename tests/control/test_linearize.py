@@ -117,7 +117,7 @@ def test_constrained_acceleration_derivatives_off_rest(generated):
     """The KKT derivatives (d(qdd)/dq, d(qdd)/dqd of H qdd = rhs + J^T lam, J qdd = gamma) at a
     moving state of the four-bar linkage (trigonometric constraints: d gamma/dq != 0), against
     central differences of the KKT solve of the generated kernels."""
-    from lagrange_gen.linear.linearize import _accel_jacobians
+    from lagrange_gen.linear.linearize import accel_jacobians
     mod = generated("four_bar")
     n, m, p = mod.N_COORDS, mod.N_CONSTRAINTS, mod.DEFAULT_PARAMS.copy()
     q, qd = np.array([0.7, 0.4, 1.9]), np.array([1.1, -0.6, 0.8])
@@ -130,7 +130,7 @@ def test_constrained_acceleration_derivatives_off_rest(generated):
         K = np.block([[H, -J.T], [J, np.zeros((m, m))]])
         return np.linalg.solve(K, np.concatenate((rhs, gamma)))[:n]
 
-    _, _, dq, dqd, _ = _accel_jacobians(mod, q, qd, 0.0, p)
+    _, _, dq, dqd, _ = accel_jacobians(mod, q, qd, 0.0, p)
     fd = _fd_jacobian(kkt, np.concatenate((q, qd)))
     np.testing.assert_allclose(dq, fd[:, :n], rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(dqd, fd[:, n:], rtol=1e-6, atol=1e-6)

@@ -36,7 +36,7 @@ class CaseResult:
     data: dict = field(default_factory=dict)
 
 
-def _verdict(oks):
+def verdict_of(oks):
     return PASS if oks and all(oks) else FAIL
 
 
@@ -47,7 +47,7 @@ def case3_tau(osc, methods=None):
     at HARD_CASES' taus; Verlet stable below tau = 2 and unstable above; midpoint's phase
     2 atan(tau / 2). ``methods`` restricts the unconstrained methods (None: all)."""
     rows, oks = [], []
-    for method, tau, rho, closed in stability.tau_table(osc, _methods(methods)):
+    for method, tau, rho, closed in stability.tau_table(osc, selected_methods(methods)):
         spec = registry.spec(method)
         ok = closed is None or abs(rho - closed) <= 1e-10 * max(1.0, closed)
         if spec.symplectic and spec.stable_tau and tau < spec.stable_tau:
@@ -64,7 +64,7 @@ def case3_tau(osc, methods=None):
              "2 - tau^2, det 1), RK4 |1 + z + ... + z^4/24| at z = i tau, the compositions the "
              "product of their Verlet matrices; a symplectic method has rho = 1 below its "
              "SPEC.stable_tau. Tolerance 1e-10 relative."]
-    return CaseResult(3, "linear stability: rho(tau) of the step matrix", _verdict(oks),
+    return CaseResult(3, "linear stability: rho(tau) of the step matrix", verdict_of(oks),
                       ["method", "tau", "measured rho", "closed form", "verdict"], rows, notes)
 
 
@@ -120,7 +120,7 @@ def case4_damped(models_dir, gen_dir, methods):
         p = params_of(mod, **sc.params)
         x, v = reference.oscillator_exact([0.0, sc.t_end], 1.0, c, sc.params["b"])
         e0, e_exact = 0.5 * x[0] ** 2 / c, 0.5 * v[1] ** 2 + 0.5 * x[1] ** 2 / c
-        for method in _methods(methods):
+        for method in selected_methods(methods):
             run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), sc.h,
                               sc.t_end, p)
             got = classify_damped(run, e_exact, e0)
@@ -136,13 +136,13 @@ def case4_damped(models_dir, gen_dir, methods):
                          f"{e_exact / e0:.3g}", got,
                          "-" if allowed is None else " or ".join(sorted(allowed)),
                          PASS if ok else FAIL])
-    return CaseResult(4, "damped oscillator at high frequency", _verdict(oks),
+    return CaseResult(4, "damped oscillator at high frequency", verdict_of(oks),
                       ["compliance c", "tau", "method", "E(T)/E0", "exact E(T)/E0", "outcome",
                        "expected", "verdict"], rows,
                       data={"energies": energies, "outcomes": outcomes})
 
 
-def _methods(methods):
+def selected_methods(methods):
     """The unconstrained methods of this build, restricted to ``methods`` when given."""
     return [m for m in unconstrained_methods() if methods is None or m in methods]
 
@@ -178,7 +178,7 @@ def case5_fpu(models_dir, gen_dir, methods, h=0.01):
     mod = load_module(models_dir, sc.stem, gen_dir)
     p = params_of(mod, **sc.params)
     rows, series, good, euler_ok = [], {}, [], None
-    for method in _methods(methods):
+    for method in selected_methods(methods):
         run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end,
                           p, save_every=round(0.5 / h))
         at, dev, drift, ok = fpu_row(run)
@@ -195,7 +195,7 @@ def case5_fpu(models_dir, gen_dir, methods, h=0.01):
     rows.append(["reference (HARD_CASES)",
                  *(", ".join(f"{x:.3f}" for x in v) for v in reference.FPU_REFERENCE.values()),
                  "-", "-", "-"])
-    verdict = _verdict([any(good), euler_ok is not True])
+    verdict = verdict_of([any(good), euler_ok is not True])
     notes = [f"h = {h:g} (h omega = {h * reference.FPU_OMEGA:g}), T = {sc.t_end:g}. A method "
              f"passes when every I_j is within {FPU_I_TOL} of the reference at t = 50, 100, "
              f"200, max |sum I_j - 1| <= {FPU_SUM_TOL:g}/omega and max |H - H0| <= "
@@ -221,7 +221,7 @@ def case6_separatrix(models_dir, gen_dir, methods, h=0.01):
     mod = load_module(models_dir, sc.stem, gen_dir, **sc.options)
     p = params_of(mod, **sc.params)
     rows, good, euler_over = [], [], None
-    for method in _methods(methods):
+    for method in selected_methods(methods):
         run = guarded_run(mod, method, np.array(sc.q0), np.array(sc.v0), h, sc.t_end, p)
         if not run.ok:
             rows.append([method, short_error(run.error), "-", "-", FAIL])
@@ -237,7 +237,7 @@ def case6_separatrix(models_dir, gen_dir, methods, h=0.01):
             euler_over = over if euler_over is None else (euler_over and over)
         rows.append([method, f"{err:.2e}", "yes" if over else "no",
                      f"{tr.max_energy_error:.1e}", PASS if ok else FAIL])
-    verdict = _verdict([any(good), euler_over is not False])
+    verdict = verdict_of([any(good), euler_over is not False])
     notes = [f"h = {h:g}, T = 4 periods = {sc.t_end:.4g}, theta_max = 2 asin(k) = "
              f"{2 * math.asin(reference.SEPARATRIX_K):.4f}. Error: max over every step of "
              f"|theta - exact| and |theta' - exact|; a method passes below {SEPARATRIX_TOL:g} "

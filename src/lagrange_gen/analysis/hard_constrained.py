@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from . import reference, scenes
-from .hard_cases import FAIL, PASS, CaseResult, _methods, _verdict
+from .hard_cases import FAIL, PASS, CaseResult, selected_methods, verdict_of
 from .runs import NOT_AVAILABLE, constrained_methods, guarded_run, has_method, load_module, \
     model_available, params_of, short_error
 from ..steppers.core import registry
@@ -55,7 +55,7 @@ def case7_stretchable(models_dir, gen_dir, methods, h=0.01, t_end=5.0):
     mod = load_module(models_dir, "stretchable_pendulum", gen_dir)
     rigid_mod, rigid_p, q0, rigid_end = _rigid_reference(models_dir, gen_dir, h, t_end)
     rows, oks = [], []
-    for method in _methods(methods):
+    for method in selected_methods(methods):
         dists, cells = zip(*(_stretch_row(mod, method, k, q0, h, t_end, rigid_end)
                              for k in STIFFNESSES))
         ok, expect = _stretch_verdict(method, dists, h)
@@ -73,7 +73,7 @@ def case7_stretchable(models_dir, gen_dir, methods, h=0.01, t_end=5.0):
              f"(the stiff mode starts at rest). Cells: max-norm distance of the bob at T from "
              f"the rigid pendulum (exact, angle form, DOP853 at 1e-13). h omega = 2 at k = "
              f"{(2 / h) ** 2:g}."]
-    return CaseResult(7, title, _verdict(oks),
+    return CaseResult(7, title, verdict_of(oks),
                       ["method", *(f"k = {k:g}" for k in STIFFNESSES), "expected", "verdict"],
                       rows, notes)
 
@@ -121,7 +121,7 @@ def case8_linkage(models_dir, gen_dir, methods, h=1e-3, n_steps=100_000):
                      (PASS if ok else FAIL) if expect else "-"])
     notes = [f"h = {h:g}, {n_steps:g} steps from rest at th1 = pi/2 (consistent start by "
              f"Newton on Phi); residuals at {min(n_steps, 1000)} sample times."]
-    return CaseResult(8, title, _verdict(oks),
+    return CaseResult(8, title, verdict_of(oks),
                       ["method", "max abs(Phi)", "max abs(J v)", "max abs(E - E0)", "expected",
                        "verdict"], rows, notes)
 

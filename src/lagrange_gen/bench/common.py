@@ -10,6 +10,7 @@ the clock starts), and its exceptions are what a failed run looks like to a user
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -107,3 +108,31 @@ def write_report(path, lines):
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines).rstrip() + "\n")
     return path
+
+
+#: The final-state error at which the precision suite compares methods (its headline).
+TARGET = 1e-8          # the headline's final-state error
+
+
+def time_at(points, target=TARGET, key="final"):
+    """Wall time at which a method's error (``key``) reaches ``target``, by log-log
+    interpolation between the two runs that bracket it (points in sweep order: coarse to fine).
+    None when no successful pair of consecutive runs brackets the target."""
+    ok = [pt for pt in points if not pt.failed and getattr(pt, key) > 0]
+    for a, b in zip(ok, ok[1:]):
+        ea, eb = getattr(a, key), getattr(b, key)
+        if ea >= target >= eb and ea > eb:
+            w = (math.log(ea) - math.log(target)) / (math.log(ea) - math.log(eb))
+            return math.exp((1 - w) * math.log(a.wall) + w * math.log(b.wall))
+    first = ok[0] if ok else None
+    if first is not None and getattr(first, key) <= target:
+        return first.wall          # already below target at the coarsest setting: an upper bound
+    return None
+
+
+def by_method(points):
+    """{method: its points, in sweep order}."""
+    groups = {}
+    for pt in points:
+        groups.setdefault(pt.method, []).append(pt)
+    return groups

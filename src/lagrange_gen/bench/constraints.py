@@ -28,7 +28,7 @@ from .common import ROOT, new_figure, save_figure, write_report
 from ..errors import EnergyWarning, SimulationError
 from ..run.consistent import consistent_initial_state
 from ..run.simulate import simulate
-from .steppers import _best_of
+from .steppers import best_of
 from ..steppers.core.base import N_STATS
 from ..steppers.core.method_spec import make_settings
 from ..steppers.core.registry import spec
@@ -129,7 +129,7 @@ def step_costs(mod, free, n_steps, repeats):
                    "spook", "index1"):
         go = _glue_runner(mod if spec(method).constraints else free, method, n_steps, q0, v0)
         go()                                                     # compile or load
-        best, iters = _best_of(go, repeats)
+        best, iters = best_of(go, repeats)
         rows.append(dict(method=method, ns=best / n_steps * 1e9, iters=iters))
     return rows
 

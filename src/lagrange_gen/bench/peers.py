@@ -26,7 +26,7 @@ def solver_run(f, y0, t_end, t_grid, method, rtol, jac=None, repeats=1):
     returns (best wall seconds over repeats, y_grid (2n, S) or None, y_end (2n,) or None, nfev,
     message). A failed solve (success False or an exception) returns None states and the
     message, with the time to failure."""
-    from .steppers import _best_of
+    from .steppers import best_of
     kwargs = {"jac": jac} if jac is not None else {}
 
     def go():
@@ -39,7 +39,7 @@ def solver_run(f, y0, t_end, t_grid, method, rtol, jac=None, repeats=1):
         return time.perf_counter() - start, None, None, 0, str(exc)
     if not sol.success:
         return time.perf_counter() - start, None, None, sol.nfev, sol.message
-    best, sol = _best_of(go, max(1, repeats))
+    best, sol = best_of(go, max(1, repeats))
     return best, sol.y, sol.y[:, -1], sol.nfev, ""
 
 

@@ -25,7 +25,6 @@ from ..analysis import reference as ref
 from ..analysis import runs
 from ..steppers.core import registry
 
-TARGET = 1e-8          # the headline's final-state error
 
 
 @dataclass(frozen=True)
@@ -180,22 +179,6 @@ def sweep_peer(name, f, jac, method, rtols, mod, case, p, reference, settings, p
     return points
 
 
-def time_at(points, target=TARGET, key="final"):
-    """Wall time at which a method's error (``key``) reaches ``target``, by log-log
-    interpolation between the two runs that bracket it (points in sweep order: coarse to fine).
-    None when no successful pair of consecutive runs brackets the target."""
-    ok = [pt for pt in points if not pt.failed and getattr(pt, key) > 0]
-    for a, b in zip(ok, ok[1:]):
-        ea, eb = getattr(a, key), getattr(b, key)
-        if ea >= target >= eb and ea > eb:
-            w = (math.log(ea) - math.log(target)) / (math.log(ea) - math.log(eb))
-            return math.exp((1 - w) * math.log(a.wall) + w * math.log(b.wall))
-    first = ok[0] if ok else None
-    if first is not None and getattr(first, key) <= target:
-        return first.wall          # already below target at the coarsest setting: an upper bound
-    return None
-
-
 def _peer_list(mod, case, p, model_file, settings):
     """[(name, f, jac, scipy method, rtols)] for a case; the sympy.mechanics and PyDy peers only
     for conservative unconstrained models (they derive their own equations)."""
@@ -244,18 +227,11 @@ def run_case(case, models_dir, gen_dir, settings, methods=None, progress=None):
             "missing": missing, "model": mod.NAME}
 
 
-def _by_method(points):
-    groups = {}
-    for pt in points:
-        groups.setdefault(pt.method, []).append(pt)
-    return groups
-
-
 def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports", quick=False,
                   methods=None, cases=None, progress=True):
     """Run the suite, write reports_dir/precision.md and precision_<model>.png; returns
     {"results": [case result], "report": path}."""
-    from . import precision_report     # figures and markdown (it imports this module)
+    from . import precision_report     # figures and markdown (matplotlib on first use)
     settings = QUICK if quick else FULL
     cases = [c for c in (settings.cases if cases is None else CASES) if cases is None
              or c.stem in cases]

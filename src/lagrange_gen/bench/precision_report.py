@@ -4,9 +4,9 @@ headline (best of ours against each peer at final error 1e-8)."""
 
 from __future__ import annotations
 
-from ..analysis import runs
 from . import common
-from .precision import TARGET, _by_method, time_at
+from ..analysis import runs
+from .common import TARGET, by_method, time_at
 
 
 def _panel(ax, points, key, label):
@@ -18,7 +18,7 @@ def _panel(ax, points, key, label):
         return
     ceiling = 10 * max(max(finite), 1e-16)
     floor = min(finite)
-    for i, (method, pts) in enumerate(_by_method(points).items()):
+    for i, (method, pts) in enumerate(by_method(points).items()):
         ours = pts[0].kind == "ours"
         good = [pt for pt in pts if not pt.failed and getattr(pt, key) > 0]
         style = dict(color=f"C{i % 10}", marker="o" if ours else "s", ms=4,
@@ -64,7 +64,7 @@ def _ms(x):
 def summary_rows(result, targets=(1e-4, 1e-6, TARGET)):
     """Per method: kind, interpolated times at the targets, smallest final error, failures."""
     rows = []
-    for method, pts in _by_method(result["points"]).items():
+    for method, pts in by_method(result["points"]).items():
         good = [pt.final for pt in pts if not pt.failed]
         rows.append([method, pts[0].kind, *(_ms(time_at(pts, t)) for t in targets),
                      runs.fmt(min(good)) if good else "-",
@@ -75,7 +75,7 @@ def summary_rows(result, targets=(1e-4, 1e-6, TARGET)):
 def headline(result, target=TARGET):
     """Best of ours at final error ``target`` against every peer: dict with 'best' (method,
     seconds) and 'peers' {name: seconds or None}."""
-    times = {m: time_at(pts, target) for m, pts in _by_method(result["points"]).items()}
+    times = {m: time_at(pts, target) for m, pts in by_method(result["points"]).items()}
     kinds = {pt.method: pt.kind for pt in result["points"]}
     ours = {m: t for m, t in times.items() if kinds[m] == "ours" and t is not None}
     best = min(ours.items(), key=lambda kv: kv[1]) if ours else (None, None)

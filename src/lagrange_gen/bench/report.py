@@ -34,10 +34,10 @@ def _fastest(result, methods, key, target, extra=None):
     """(method, seconds) reaching ``target`` in ``key`` fastest among ``methods`` (and
     satisfying extra(points) when given); (None, None) when none does."""
     best = (None, None)
-    for method, pts in precision._by_method(result["points"]).items():
+    for method, pts in common.by_method(result["points"]).items():
         if method not in methods or (extra and not extra(pts)):
             continue
-        t = precision.time_at(pts, target, key)
+        t = common.time_at(pts, target, key)
         if t is not None and (best[1] is None or t < best[1]):
             best = (method, t)
     return best
@@ -61,9 +61,9 @@ def energy_row(prec):
 def accuracy_row(prec):
     cart = _result(prec, "cart_pendulum")
     pool = runs.unconstrained_methods() + registry.ADAPTIVE_METHODS
-    method, t = _fastest(cart, pool, "final", precision.TARGET) if cart else (None, None)
+    method, t = _fastest(cart, pool, "final", common.TARGET) if cart else (None, None)
     why = "-" if method is None else \
-        f"fastest to final-state error {precision.TARGET:g} on the cart pendulum: {_ms(t)} " \
+        f"fastest to final-state error {common.TARGET:g} on the cart pendulum: {_ms(t)} " \
         f"(energy drifts slowly: not for long runs)"
     return ["short smooth run, accuracy first", method or "-", why]
 

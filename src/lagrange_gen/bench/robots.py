@@ -36,6 +36,8 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+from .robots_report import METHODS
+
 #: (label, model file stem, build options, seconds the child may take)
 CASES = (("UR5", "ur5", {}, 300),
          ("spatial chain, 8 links", "spatial_chain", {"n": 8}, 300),
@@ -45,13 +47,7 @@ CASES = (("UR5", "ur5", {}, 300),
 QUICK_CASES = (("UR5", "ur5", {}, 240),
                ("spatial chain, 3 links", "spatial_chain", {"n": 3}, 120),
                ("spatial chain, 4 links", "spatial_chain", {"n": 4}, 120))
-METHODS = ("rk4", "implicit_euler")
 H_STEP = 1e-3
-
-#: issue 28's goals: generate + compile + first step (s)
-GOAL_TOTAL_S = {"spatial chain, 8 links": 15.0, "spatial chain, 12 links": 30.0,
-                "humanoid tree, 30 DoF": 120.0}
-GOAL_ACCEL_RATIO = 1.5          # mod.accelerations against pin.aba
 
 
 def run_robots_bench(models_dir="models", reports_dir="reports", quick=False, timeout_scale=1.0):

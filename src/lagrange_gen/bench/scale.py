@@ -29,7 +29,6 @@ QUICK_SIZES = (1, 2, 4)
 METHODS = ("verlet", "midpoint")
 BUDGET_S, QUICK_BUDGET_S = 150.0, 20.0       # per LagrangesMethod case
 ALL_METHODS_AT = 16                           # size at which the all-methods module is compiled too
-GOAL_N, END_TO_END_N = 16, 20
 
 
 def measure_generation(model_file, n, out_dir, methods=METHODS):
@@ -119,7 +118,7 @@ def run_scale_bench(models_dir="models", reports_dir="reports", quick=False):
             _print_row(rows[-1], lm[n], budget)
         extra = measure_all_methods(model_file, ALL_METHODS_AT, work) if ALL_METHODS_AT in sizes else None
     peers = {name: installed(name) for name in ("pydy", "mujoco")}
-    write_report(Path(reports_dir), rows, lm, exceeded, budget, extra, peers)
+    write_report(Path(reports_dir), rows, lm, exceeded, budget, extra, peers, METHODS)
     return rows
 
 

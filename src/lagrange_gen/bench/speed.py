@@ -45,13 +45,12 @@ COLD = (("cart pendulum, midpoint", "cart_pendulum", {}, "midpoint", [0.1, 1.0],
          [math.sin(0.5), -math.cos(0.5)], 5.0),
         ("10-link chain, verlet", "n_link_pendulum", {"n": 10}, "verlet",
          list(0.3 * np.sin(np.arange(1, 11))), 10.0))
-WARM_GOAL_S, PEER_GOAL, HAND_GOAL, MUJOCO_RK4_GOAL = 0.5, 100.0, 1.5, 3.0
 
 
 def measure_precision(models_dir, gen_dir, quick, progress):
     """Seconds to final error 1e-8 per method: {"ours": {method: s or None}, "peers": {name:
     s or None}, "pydy": generator name or None}."""
-    settings = replace(precision.QUICK if quick else precision.FULL, floor=precision.TARGET / 10)
+    settings = replace(precision.QUICK if quick else precision.FULL, floor=common.TARGET / 10)
     mod = runs.load_module(models_dir, CASE.stem, gen_dir)
     p = runs.params_of(mod)
     reference = precision._reference(mod, CASE, p, settings)
@@ -59,13 +58,13 @@ def measure_precision(models_dir, gen_dir, quick, progress):
     for method in precision._ours(CASE, None):
         sweep = precision.sweep_adaptive if registry.spec(method).adaptive else \
             precision.sweep_ours
-        ours[method] = precision.time_at(sweep(mod, method, CASE, p, reference, settings,
+        ours[method] = common.time_at(sweep(mod, method, CASE, p, reference, settings,
                                                progress))
     found = {"scipy DOP853 on our right-hand side": ref.ode_rhs(mod, p)}
     pydy = peers.pydy_rhs(Path(models_dir) / f"{CASE.stem}.py", mod.PARAMS, p)
     if pydy is not None:
         found["PyDy + scipy DOP853"] = pydy[0]
-    peer_times = {name: precision.time_at(precision.sweep_peer(
+    peer_times = {name: common.time_at(precision.sweep_peer(
         name, f, None, "DOP853", settings.dop_rtols, mod, CASE, p, reference, settings, progress))
         for name, f in found.items()}
     return {"ours": ours, "peers": peer_times, "pydy": pydy and pydy[2]}
@@ -75,10 +74,10 @@ def portable_step_ns(mod, method, steps, repeats):
     """ns per step of the portable glue (lagrange_gen.jit.portable) of ``method`` on ``mod``, timed
     as bench/steppers.py times the module's own run_<method>."""
     from ..jit import portable
-    from .steppers import _best_of, _library_runner
-    go = _library_runner(mod, method, steps, portable.runner(mod, method))
+    from .steppers import best_of, library_runner
+    go = library_runner(mod, method, steps, portable.runner(mod, method))
     go()                                                  # compile or load
-    return _best_of(go, repeats)[0] / steps * 1e9
+    return best_of(go, repeats)[0] / steps * 1e9
 
 
 def chain_dir():
@@ -194,7 +193,8 @@ def run_speed_bench(models_dir="models", gen_dir="generated", reports_dir="repor
     from .speed_report import markdown
     common.precompile(models_dir, gen_dir, [(CASE.stem, {})])
     mod = runs.load_module(models_dir, CASE.stem, gen_dir)
-    results = {"quick": quick, "mujoco": mujoco_chain.available()}
+    results = {"quick": quick, "mujoco": mujoco_chain.available(), "case": CASE,
+               "chain_n": CHAIN_N}
     with tempfile.TemporaryDirectory() as tmp:
         results["cold"] = measure_cold(models_dir, tmp)
         # the warm start reuses the cache the cold rk4 row filled

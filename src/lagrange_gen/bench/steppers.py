@@ -242,7 +242,7 @@ def _kernel_loops(mod):
 
 # ---------------------------------------------------------------- measurement
 
-def _best_of(fn, repeats):
+def best_of(fn, repeats):
     best = math.inf
     for _ in range(repeats):
         start = time.perf_counter()
@@ -251,7 +251,7 @@ def _best_of(fn, repeats):
     return best, result
 
 
-def _library_runner(mod, method, n_steps, run=None):
+def library_runner(mod, method, n_steps, run=None):
     """A zero-argument call of ``run`` (default: the module's run_<method>; the portable glue's
     runner, lagrange_gen.jit.portable, takes the same arguments) for n_steps steps from (Q0, V0),
     returning (final state, Newton iterations per step)."""
@@ -279,9 +279,9 @@ def measure_step_times(mod, n_steps=100_000, repeats=5):
     kernel_loops = _kernel_loops(mod)
     rows = []
     for method in unconstrained_methods():
-        go = _library_runner(mod, method, n_steps)
+        go = library_runner(mod, method, n_steps)
         go()                                                      # compile or load
-        ours, (state, iters) = _best_of(go, repeats)
+        ours, (state, iters) = best_of(go, repeats)
         row = {"method": method, "ours_ns": ours / n_steps * 1e9, "iters": iters}
         refs = {}
         if method in HAND_CLOSED_FORM:
@@ -295,7 +295,7 @@ def measure_step_times(mod, n_steps=100_000, repeats=5):
         diffs = []
         for key, call in refs.items():
             call()
-            elapsed, ref_state = _best_of(call, repeats)
+            elapsed, ref_state = best_of(call, repeats)
             diffs.append(float(np.abs(ref_state - state).max()))
             if diffs[-1] > 1e-8 * max(1.0, np.abs(state).max()):
                 raise RuntimeError(f"bench: {key} reference of {method} disagrees with the "

@@ -71,7 +71,7 @@ def add_parser(subparsers):
                         "for every model: a new model compiles only its kernels), auto "
                         "(default, or $LAGRANGE_GEN_JIT: specialized when cached, else "
                         "portable, switching to specialized during a long run)")
-    _add_setting_options(p)
+    add_setting_options(p)
     p.add_argument("--force", action="store_true",
                    help="regenerate the module even when the one on disk comes from another model "
                         "file or was generated with another freeze or build options")
@@ -88,7 +88,7 @@ def _setting_fields():
     return fields
 
 
-def _add_setting_options(p):
+def add_setting_options(p):
     """One option per settings field of any method (--newton-tol, --compliance, --rtol, ...):
     read from the methods' specs, so a new method's settings need no edit here. Every option
     defaults to None: only what the user gives reaches simulate."""
@@ -105,14 +105,14 @@ def _add_setting_options(p):
             group.add_argument(flag, type=type(default), default=None, help=text)
 
 
-def _given_settings(args):
+def given_settings(args):
     """{field: value} of the settings options the user gave."""
     given = {name: getattr(args, name) for name in _setting_fields()}
     return {name: tuple(v) if isinstance(v, list) else v for name, v in given.items()
             if v is not None}
 
 
-def _parse_params(pairs):
+def parse_params(pairs):
     """--param values (a list of 'a=1,b=2') -> {name: float}; SimulationError when malformed."""
     return parse_assignments(pairs, "--param", NUMBER, SimulationError)
 
@@ -151,7 +151,7 @@ def run(args) -> int:
         check_output_path("--out", args.out, OUT_SUFFIXES)
     if args.plot:
         check_output_path("--plot", args.plot, PLOT_SUFFIXES)
-    params = _parse_params(args.param)
+    params = parse_params(args.param)
     options = parse_assignments(args.options, "--set", BUILD, SimulationError)
     keep = velocity_names(args.keep)
     with one_line_warnings():       # one line each, also when the run then fails
@@ -162,7 +162,7 @@ def run(args) -> int:
                         h=args.h, params=params, save_every=args.save_every,
                         t_eval=args.t_eval, t0=args.t0, progress=args.progress,
                         out_dir=args.gen_dir, force=args.force, keep=keep, jit=args.jit,
-                        **_given_settings(args))
+                        **given_settings(args))
     _summary(traj)
     _write_outputs(traj, args.out, args.plot)
     return 0

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from .options import BUILD, one_line_warnings, parse_assignments
-from .simulate import (_add_setting_options, _given_settings, _parse_params,
+from .simulate import (add_setting_options, given_settings, parse_params,
                            check_output_path)
 from ..steppers.core.registry import METHODS
 
@@ -63,7 +63,7 @@ def add_parser(subparsers):
     p.add_argument("--gen-dir", default="generated", metavar="DIR",
                    help="where model files are generated (default: generated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
-    _add_setting_options(p)
+    add_setting_options(p)
     return p
 
 
@@ -99,7 +99,7 @@ def run(args) -> int:
         if len(axes) > 2:
             raise SimulationError(f"--plot pictures one or two grid axes; {len(axes)} given "
                                   f"({', '.join(axes)})")
-    shared = _parse_params(args.param)
+    shared = parse_params(args.param)
     both = sorted(set(shared) & set(axes))
     if both:
         raise SimulationError(f"parameter {both[0]!r} is given both by --grid and --param")
@@ -112,7 +112,7 @@ def run(args) -> int:
         result = ensemble(model, args.method, q0=args.q0, v0=args.v0,
                           params={**shared, **grid(**axes)}, t_end=args.t_end, h=args.h,
                           save_every=args.save_every, progress=args.progress,
-                          out_dir=args.gen_dir, **_given_settings(args))
+                          out_dir=args.gen_dir, **given_settings(args))
     coord = _coord_index(result, args.coord)
     scalar = SCALARS[args.scalar][1](result, coord)
     scalar = np.where(result.ok, scalar, np.nan)

@@ -12,7 +12,7 @@ sources it reads) steppers.core.registry, never run/, cli/ or viz/.
 from importlib import import_module
 
 _LAZY = {"generate_model": "generate", "generate_text": "generate", "output_path": "generate",
-         "read_key": "keys", "KernelSpec": "spec", "make_kernels": "spec"}
+         "read_key": "keys", "KernelSpec": "spec", "make_kernels": "compose"}
 
 __all__ = sorted(_LAZY)
 

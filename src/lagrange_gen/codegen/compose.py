@@ -18,7 +18,7 @@ Results equal the symbolic kernels to rounding (tests compare them).
 
 from __future__ import annotations
 
-from .spec import KernelSpec, Output
+from .spec import KernelSpec, Output, default_kernels, kernel_table
 
 
 def compositions(dyn, selected, needs) -> dict:
@@ -68,3 +68,15 @@ def composed_spec(name, dyn) -> KernelSpec:
                       "    rhs[j] -= s",
                       "mass_matrix(q, t, p, H)"])
     raise KeyError(f"no composed form of kernel {name!r}")
+
+
+def make_kernels(dyn, names=None, composed=()) -> list[KernelSpec]:
+    """KernelSpecs of ``names`` (default: default_kernels) in the fixed table order; the kernels
+    in ``composed`` are built from other kernels (composed_spec) instead of symbolically."""
+    table = kernel_table(dyn)
+    wanted = set(default_kernels(dyn) if names is None else names)
+    unknown = sorted(wanted - set(table))
+    if unknown:
+        raise KeyError(f"no kernel named {', '.join(unknown)}")
+    return [composed_spec(name, dyn) if name in composed else build()
+            for name, build in table.items() if name in wanted]

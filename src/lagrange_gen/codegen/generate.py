@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .compose import compositions
+from .compose import make_kernels
 from ..derive import derive
 from .emit import render_kernel
 from ..errors import GenerationError
@@ -28,7 +29,6 @@ from .needs import methods_needs, select_kernels
 from .printer import Inputs
 from .render import COMPILED_IMPORTS, render_module
 from .sources import source_closure, source_hashes
-from .spec import make_kernels
 from .write import write_if_changed
 
 #: Seconds a generation stage may run before progress lines go to stderr (small models: none).

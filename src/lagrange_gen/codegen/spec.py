@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from .kernel_abi import ALWAYS_2D
 from ..model.symbols import Parameter
 
 
@@ -29,14 +30,13 @@ class Output:
 
     @property
     def is_vector(self):
-        return self.matrix.shape[1] == 1 and self.name not in _ALWAYS_2D
+        return self.matrix.shape[1] == 1 and self.name not in ALWAYS_2D
 
     @property
     def shape(self):
         return (self.matrix.shape[0],) if self.is_vector else tuple(self.matrix.shape)
 
 
-_ALWAYS_2D = {"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef", "Ju", "Cq", "Cqd", "Du"}
 
 
 @dataclass
@@ -235,16 +235,3 @@ def default_kernels(dyn) -> tuple:
     """The kernels of a module generated for every method: all of kernel_table except ``rhs``,
     which is added only for a constant mass matrix (forward dynamics with a pre-factored H)."""
     return tuple(k for k in kernel_table(dyn) if k != "rhs" or dyn.mass_is_constant)
-
-
-def make_kernels(dyn, names=None, composed=()) -> list[KernelSpec]:
-    """KernelSpecs of ``names`` (default: default_kernels) in the fixed table order; the kernels
-    in ``composed`` are built from other kernels (codegen.compose) instead of symbolically."""
-    from .compose import composed_spec
-    table = kernel_table(dyn)
-    wanted = set(default_kernels(dyn) if names is None else names)
-    unknown = sorted(wanted - set(table))
-    if unknown:
-        raise KeyError(f"no kernel named {', '.join(unknown)}")
-    return [composed_spec(name, dyn) if name in composed else build()
-            for name, build in table.items() if name in wanted]

@@ -3,7 +3,7 @@ acceleration-level right-hand side, in native objects."""
 
 from __future__ import annotations
 
-from .lagrangian import _dot, _quadratic
+from .lagrangian import dot, quadratic_form
 from ..model.symbols import t
 
 
@@ -30,8 +30,8 @@ def derive_constraints(model, o, q):
     Phi_t = [c.diff(time) for c in Phi]
     gamma = []
     for i, d2 in enumerate(d2Phi):
-        g = -_quadratic(d2, qd, zero)
+        g = -quadratic_form(d2, qd, zero)
         if Phi_t[i] != 0:
-            g = g - 2 * _dot([J[i, k].diff(time) for k in range(n)], qd, zero) - Phi_t[i].diff(time)
+            g = g - 2 * dot([J[i, k].diff(time) for k in range(n)], qd, zero) - Phi_t[i].diff(time)
         gamma.append(g)
     return dict(Phi=o.column(Phi), J=J, gamma=o.column(gamma), d2Phi=d2Phi, Phi_t=o.column(Phi_t))

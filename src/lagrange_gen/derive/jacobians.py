@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from .lagrangian import _dot
+from .lagrangian import dot
 
 #: name -> what it is (shapes for n coordinates, m constraints).
 JACOBIANS = {
@@ -61,7 +61,7 @@ class Jacobians(Mapping):
         key = id(vec)
         if key not in self._d_cache:
             dH, n, zero = self._p["dH"], len(self._q), self._o.native(0)
-            self._d_cache[key] = self._contract(n, n, lambda j, l: _dot([dH[l][j, k] for k in range(n)], vec, zero))
+            self._d_cache[key] = self._contract(n, n, lambda j, l: dot([dH[l][j, k] for k in range(n)], vec, zero))
         return self._d_cache[key]
 
     def _dQ_dqd(self):
@@ -91,8 +91,8 @@ class Jacobians(Mapping):
 
     def _dJw_dq(self):
         d2, n, zero = self._p["d2Phi"], len(self._q), self._o.native(0)
-        return self._contract(len(d2), n, lambda i, l: _dot([d2[i][k, l] for k in range(n)], self._w, zero))
+        return self._contract(len(d2), n, lambda i, l: dot([d2[i][k, l] for k in range(n)], self._w, zero))
 
     def _dJTlam_dq(self):
         d2, n, zero = self._p["d2Phi"], len(self._q), self._o.native(0)
-        return self._contract(n, n, lambda k, l: _dot([d2[i][k, l] for i in range(len(d2))], self._lam, zero))
+        return self._contract(n, n, lambda k, l: dot([d2[i][k, l] for i in range(len(d2))], self._lam, zero))

@@ -44,27 +44,27 @@ def derive_lagrangian(model, o, check_samples=8):
     _check_quadratic_and_definite(model, o, H, T, b, T0, check_samples)
     dH = [o.matrix(n, n, [H[j, k].diff(qi) for j in range(n) for k in range(n)]) for qi in q]
     zero = o.native(0)
-    Hdot = o.matrix(n, n, [_dot([dH[i][j, k] for i in range(n)], qd, zero)
+    Hdot = o.matrix(n, n, [dot([dH[i][j, k] for i in range(n)], qd, zero)
                            for j in range(n) for k in range(n)])
     Ht = o.matrix(n, n, [H[j, k].diff(time) for j in range(n) for k in range(n)])
     Ht = Ht if any(e != 0 for e in Ht) else None
-    dTdq = [_quadratic(dH[j], qd, zero) / 2 for j in range(n)]
-    h = [_dot([Hdot[j, k] for k in range(n)], qd, zero) - dTdq[j] for j in range(n)]
+    dTdq = [quadratic_form(dH[j], qd, zero) / 2 for j in range(n)]
+    h = [dot([Hdot[j, k] for k in range(n)], qd, zero) - dTdq[j] for j in range(n)]
     if Ht is not None:
-        h = [h[j] + _dot([Ht[j, k] for k in range(n)], qd, zero) for j in range(n)]
+        h = [h[j] + dot([Ht[j, k] for k in range(n)], qd, zero) for j in range(n)]
     g = [(V - T0).diff(qi) if T0 != 0 else V.diff(qi) for qi in q]
     D = o.native(model.dissipation)
     Q = [o.native(f) - D.diff(v) for f, v in zip(model.forces, qd)]
     Q_nc = Q
     Q = [Q[j] + _transport_force(b, q, qd, j, time, zero) for j in range(n)]
     db = o.matrix(n, n, [b[j].diff(q[k]) for j in range(n) for k in range(n)])
-    mom = [dTdq[j] - g[j] + Q_nc[j] + _dot([db[k, j] for k in range(n)], qd, zero) for j in range(n)]
+    mom = [dTdq[j] - g[j] + Q_nc[j] + dot([db[k, j] for k in range(n)], qd, zero) for j in range(n)]
     col = o.column
-    P = _dot(Q_nc, qd, zero) - (T - V).diff(time)
+    P = dot(Q_nc, qd, zero) - (T - V).diff(time)
     power = [P, *(P.diff(v) for v in q), *(P.diff(v) for v in qd), P.diff(time)]
     E = T + V
     if T0 != 0 or any(bj != 0 for bj in b):
-        E = _quadratic(H, qd, zero) / 2 - T0 + V
+        E = quadratic_form(H, qd, zero) / 2 - T0 + V
     return dict(H=H, h=col(h), g=col(g), Q=col(Q), rhs=col([Q[j] - h[j] - g[j] for j in range(n)]),
                 dTdq=col(dTdq), momentum_rate=col(mom), E=E, dH=dH, Hdot=Hdot, Ht=Ht,
                 b=col(b), db=db, power=col(power))
@@ -76,7 +76,7 @@ def _transport_force(b, q, qd, j, time, zero):
     if all(bk == 0 for bk in b):
         return zero
     terms = [b[k].diff(q[j]) - b[j].diff(q[k]) for k in range(len(q))]
-    return _dot(terms, qd, zero) - b[j].diff(time)
+    return dot(terms, qd, zero) - b[j].diff(time)
 
 
 def _mass_matrix(model, o, T, qd):
@@ -98,12 +98,12 @@ def _sum(terms, zero):
     return sum(terms[1:], terms[0]) if terms else zero
 
 
-def _dot(coeffs, vec, zero):
+def dot(coeffs, vec, zero):
     """sum_i coeffs_i vec_i over the nonzero coefficients (structural zeros skipped)."""
     return _sum([c * v for c, v in zip(coeffs, vec) if c != 0], zero)
 
 
-def _quadratic(M: Mat, vec, zero):
+def quadratic_form(M: Mat, vec, zero):
     """vec^T M vec for symmetric M, summing the upper triangle once (off-diagonal doubled)."""
     n = len(vec)
     terms = []
@@ -148,10 +148,10 @@ def _check_quadratic_and_definite(model, o, H, T, b, T0, samples):
             eig, vectors = np.linalg.eigh(Hs)
             raise ModelError(f"model {model.name}: H = d2T/dqdot2 is not positive definite at {state} "
                              f"(smallest eigenvalue {eig[0]:.3g}; check the terms in "
-                             f"{_weakest_direction(model.coords, vectors[:, 0])})") from None
+                             f"{weakest_direction(model.coords, vectors[:, 0])})") from None
 
 
-def _weakest_direction(coords, vector):
+def weakest_direction(coords, vector):
     """"y.d, x.d": the velocities along which T is not positive, i.e. the largest components
     (at least half the largest) of the eigenvector (n,) of H's smallest eigenvalue, largest
     first. A sign error in one term of T shows there, not in the smallest diagonal entry."""

@@ -188,7 +188,7 @@ def _check_quadratic(model, o, T, mom, H, samples):
     definite (the messages of derive/lagrangian.py)."""
     if samples <= 0:
         return
-    from .lagrangian import sample_values, _weakest_direction
+    from .lagrangian import sample_values, weakest_direction
     n = len(model.coords)
     args = o.symbols(list(model.coords) + list(model.velocities) + list(model.params) + [t])
     f = o.lambdify(args, [T, *mom, *H.entries])
@@ -208,7 +208,7 @@ def _check_quadratic(model, o, T, mom, H, samples):
             eig, vectors = np.linalg.eigh(H_at)
             raise ModelError(f"model {model.name}: H = d2T/dqdot2 is not positive definite at {state} "
                              f"(smallest eigenvalue {eig[0]:.3g}; check the terms in "
-                             f"{_weakest_direction(model.coords, vectors[:, 0])})") from None
+                             f"{weakest_direction(model.coords, vectors[:, 0])})") from None
 
 
 #: Names of the seed variables of a column loop (never a placeholder, temporary or node name).

@@ -13,20 +13,10 @@ what is missing. ``lagrange-gen identify data.csv --kind prandtl|damping`` is th
 (:mod:`.cli`).
 """
 
-from ..errors import LagrangeGenError
-
-
-class IdentificationError(LagrangeGenError, ValueError):
-    """The data do not determine the requested parameters; the message says what is missing.
-
-    A ValueError (bad input values) and a LagrangeGenError (the CLI prints its one-line message).
-    """
-
-
-# Imported after IdentificationError is defined: the submodules import it from this package.
-from .damping import DampingFit, identify_damping  # noqa: E402
-from .prandtl import PrandtlFit, identify_prandtl, loading_branch  # noqa: E402
-from .wavelet import wavelet_breakpoints  # noqa: E402
+from .damping import DampingFit, identify_damping
+from ..errors import IdentificationError
+from .prandtl import PrandtlFit, identify_prandtl, loading_branch
+from .wavelet import wavelet_breakpoints
 
 __all__ = ["IdentificationError", "PrandtlFit", "identify_prandtl", "loading_branch",
            "DampingFit", "identify_damping", "wavelet_breakpoints"]

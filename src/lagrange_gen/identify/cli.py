@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import IdentificationError
+from ..errors import IdentificationError
 
 _ALIASES = {"x": ("x",), "F": ("f", "f_minus_mxdd", "y"), "v": ("v", "xdot", "velocity"),
             "t": ("t", "time")}

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import IdentificationError
-from .wavelet import _pywt
+from ..errors import IdentificationError
+from .wavelet import import_pywt
 
 MIN_PERIODS = 2.0   # the log-modulus line is fitted over at least this many periods
 EDGE_STD = 4.0      # ends dropped: this many Gaussian standard deviations of the wavelet window
@@ -140,7 +140,7 @@ def identify_damping(t, x, period=None, scale=None, m=1.0, wavelet="cmor1.5-1.0"
     floor: the fit stops where |W| falls below this fraction of its maximum (or 20 times its
     noise level, whichever is larger). Raises IdentificationError when too little is recorded.
     """
-    pywt = _pywt()
+    pywt = import_pywt()
     t, x, dt = _uniform_samples(t, x)
     for name, value in (("m", m), ("period", period), ("scale", scale)):
         if value is not None and not value > 0:

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import IdentificationError
+from ..errors import IdentificationError
 from .piecewise import fit_hinges, fit_piecewise
 
 MIN_POINTS = 3          # samples per linear piece: two fix a line, one more to see its residual

@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import LagrangeGenError
 
 
-def _pywt():
+def import_pywt():
     try:
         import pywt
     except ImportError as exc:  # optional dependency: say how to get it
@@ -65,7 +65,7 @@ def slope_change_profile(x, y, n_grid=None, scales=None):
     grid cells (default 6 scales from n_grid/200 to n_grid/25). Returns (grid (G,), profile (G,)),
     where profile peaks at a kink with about its slope change dp (negative when the slope drops).
     """
-    pywt = _pywt()
+    pywt = import_pywt()
     n_grid = int(n_grid or max(16, min(1024, len(x) // 2)))
     scales = _default_scales(n_grid) if scales is None else np.asarray(scales, dtype=float)
     grid, values = _uniform_grid(np.asarray(x, float), np.asarray(y, float), n_grid)

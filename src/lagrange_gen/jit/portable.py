@@ -1,6 +1,6 @@
 """Portable glue: one compiled copy of each stepper for every model.
 
-The generated ``run_<method>`` (steppers/core/registry.py) reaches the model's kernels through the
+The generated ``run_<method>`` (codegen/glue.py) reaches the model's kernels through the
 generated module, a numba compile-time constant: numba inlines the kernels into the stepper and
 compiles the whole stepper library again for every model (seconds to tens of seconds on first
 use). The portable glue ``run_<method>(kern, n_saved, ...)`` is the same loop (base.run_loop or
@@ -76,12 +76,12 @@ def portable_dir() -> Path:
 
 def _kernel_arg_types(fn):
     """numba types of a kernel's arguments, from their names: t a float, the outputs that are
-    always 2-D (codegen.spec._ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
+    always 2-D (codegen.kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
     C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
     from numba import types
-    from ..codegen.spec import _ALWAYS_2D
+    from ..codegen.kernel_abi import ALWAYS_2D
     names = list(inspect.signature(fn).parameters)
-    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in _ALWAYS_2D
+    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
                  else types.float64[::1] for a in names)
 
 

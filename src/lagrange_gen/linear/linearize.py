@@ -64,14 +64,14 @@ def _need(module, *names):
                               "methods: lagrange-gen <model file>")
 
 
-def _vec(x, n, what, module):
+def as_vector(x, n, what, module):
     x = np.ascontiguousarray(np.zeros(n) if x is None else x, dtype=np.float64).ravel()
     if x.shape != (n,):
         raise SimulationError(f"{module.NAME}: {what} has {x.size} entries for {n} coordinates")
     return x
 
 
-def _accel_jacobians(module, q, qd, t, p):
+def accel_jacobians(module, q, qd, t, p):
     """(a (n,), lam (m,), da/dq, da/dqd (n, n), da/du (n, k)): the derivatives of the
     accelerations (for a constrained model of the KKT solution) at (q, qd, u in p)."""
     n, m = module.N_COORDS, module.N_CONSTRAINTS
@@ -129,7 +129,7 @@ def constraint_basis(module, q, params=None, t=0.0):
         return np.eye(n)
     p = parameter_vector(module, params)
     phi, J, gamma = np.zeros(m), np.zeros((m, n)), np.zeros(m)
-    module.constraints(_vec(q, n, "q", module), np.zeros(n), float(t), p, phi, J, gamma)
+    module.constraints(as_vector(q, n, "q", module), np.zeros(n), float(t), p, phi, J, gamma)
     return np.linalg.svd(J)[2][m:].T.copy()
 
 
@@ -141,9 +141,9 @@ def linearize(module, q, qd=None, u=None, t=0.0, params=None) -> Linearization:
     _need(module, "rhs_jacobian", "mass_matvec_dq",
           *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n = module.N_COORDS
-    q, qd = _vec(q, n, "q", module), _vec(qd, n, "qd", module)
+    q, qd = as_vector(q, n, "q", module), as_vector(qd, n, "qd", module)
     p = parameter_vector(module, params, u)
-    _, _, dq, dqd, du = _accel_jacobians(module, q, qd, float(t), p)
+    _, _, dq, dqd, du = accel_jacobians(module, q, qd, float(t), p)
     ny = getattr(module, "N_OUTPUTS", 0)
     Cq, Cqd, Du = np.zeros((ny, n)), np.zeros((ny, n)), np.zeros((ny, du.shape[1]))
     if ny:
@@ -165,7 +165,7 @@ def equilibrium(module, q, u=None, t=0.0, params=None, tol=1e-12, max_iter=50):
     module = load_module(module)
     _need(module, "rhs_jacobian", *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n, m = module.N_COORDS, module.N_CONSTRAINTS
-    x = np.concatenate((_vec(q, n, "q", module), np.zeros(m)))
+    x = np.concatenate((as_vector(q, n, "q", module), np.zeros(m)))
     p, zero = parameter_vector(module, params, u), np.zeros(n)
     for _ in range(max_iter):
         R, G = _balance(module, x[:n], x[n:], float(t), p, zero)

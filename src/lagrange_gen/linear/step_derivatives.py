@@ -34,7 +34,7 @@ from functools import partial
 import numpy as np
 
 from ..errors import SimulationError
-from .linearize import _accel_jacobians, _vec, parameter_vector
+from .linearize import accel_jacobians, as_vector, parameter_vector
 from ..run.control import input_slots
 from ..steppers.core.explicit_rk import RK4_A, RK4_B, RK4_C
 from ..steppers.methods import composition, composition6
@@ -63,7 +63,7 @@ def step_jacobian(module, method, h, q, v, u=None, t=0.0, params=None, **setting
                               f"velocities (canonical momentum H v + b); {method}'s step Jacobian "
                               f"covers p = H v only (use {', '.join(others[:-1])} or {others[-1]})")
     n = module.N_COORDS
-    q, v = _vec(q, n, "q", module), _vec(v, n, "v", module)
+    q, v = as_vector(q, n, "q", module), as_vector(v, n, "v", module)
     p = parameter_vector(module, params, u)
     stepper = Stepper(module, method, h, params=p, q0=q, v0=v, t0=t, **settings)
     stepper.step()
@@ -75,7 +75,7 @@ def step_jacobian(module, method, h, q, v, u=None, t=0.0, params=None, **setting
 def _f_jac(module, q, v, t, p):
     """(a, [[0, I, 0], [a_q, a_v, a_u]]) (2n, 2n + k): the first-order system's Jacobian."""
     n, k = module.N_COORDS, input_slots(module)[1]
-    a, _, aq, av, au = _accel_jacobians(module, q, v, t, p)
+    a, _, aq, av, au = accel_jacobians(module, q, v, t, p)
     top = np.hstack((np.zeros((n, n)), np.eye(n), np.zeros((n, k))))
     return a, np.vstack((top, np.hstack((aq, av, au))))
 

@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
-from .symbols import _check_name, t
+from .symbols import check_name, t
 
 __all__ = ["Drawing", "check_drawing", "positions_function"]
 
@@ -69,7 +69,7 @@ def check_drawing(model, draw, scalar):
 
 
 def _point(model, where, name, xyz, scalar):
-    _check_name(f"{where}: point", str(name))
+    check_name(f"{where}: point", str(name))
     if isinstance(xyz, (str, bytes, sp.Basic)) or not hasattr(xyz, "__len__") or len(xyz) not in (2, 3):
         raise ModelError(f"{where}: point {name} must be 2 or 3 coordinates (x, y[, z]), got {xyz!r}")
     exprs = tuple(scalar(e, f"draw point {name}") for e in xyz)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
-from .symbols import Coordinate, Parameter, Velocity, _check_name, t
+from .symbols import Coordinate, Parameter, Velocity, check_name, t
 
 
 def _is_dynamicsymbol(c):
@@ -15,7 +15,7 @@ def _is_dynamicsymbol(c):
             and isinstance(c.args[0], sp.Symbol))
 
 
-def _mechanics_speeds(coords):
+def mechanics_speeds(coords):
     """[q(t)' for q(t) in coords] when every coordinate is a dynamicsymbol (the speeds that
     sympy.physics.mechanics loads are converted with), else []."""
     if not all(_is_dynamicsymbol(c) for c in coords):
@@ -33,7 +33,7 @@ def is_mechanics_load(item):
     return check(item)
 
 
-def _equation_as_expr(c):
+def equation_as_expr(c):
     """An sp.Eq(lhs, rhs) constraint as lhs - rhs (Phi = 0 means lhs = rhs); others unchanged."""
     return c.lhs - c.rhs if isinstance(c, sp.Equality) else c
 
@@ -49,7 +49,7 @@ def unknown_symbols_hint(unknown):
             f"lagrange_gen.parameters({names!r}, defaults=...) (or coordinates() if they move)")
 
 
-def _convert_dynamicsymbols(coords):
+def convert_dynamicsymbols(coords):
     """Turn sympy.physics.mechanics dynamicsymbols q(t) into Coordinates.
 
     Returns (coordinates, replacement map) where the map sends q(t)' -> q.d, q(t) -> q and the
@@ -94,7 +94,7 @@ def _apply(expr, replace):
     return expr.xreplace(replace)
 
 
-def _sympify(expr, what, replace):
+def sympify_scalar(expr, what, replace):
     """``expr`` as a scalar sympy Expr with ``replace`` applied; ModelError naming ``what``."""
     try:
         expr = sp.sympify(expr)
@@ -109,7 +109,7 @@ def _sympify(expr, what, replace):
     return _apply(expr, replace) if replace else expr
 
 
-def _check_rayleigh(name, D, velocities):
+def check_rayleigh(name, D, velocities):
     """ModelError naming the first term of the dissipation function D that gives a wrong or no
     force: D and its velocity gradient must vanish at rest (D quadratic in the velocities, or of
     higher degree such as c |v|^3 / 3). A velocity-free term gives no force -dD/dqdot at all; a
@@ -161,7 +161,7 @@ class Event:
     """
 
     def __init__(self, expr, terminal=False, direction=0):
-        # Checked by the Model (_events), whose messages name the model and the event.
+        # Checked by the Model (named_events), whose messages name the model and the event.
         self.expr, self.terminal, self.direction = expr, terminal, direction
         self.name = None        # the key of the events dict (set by Model)
 
@@ -170,7 +170,7 @@ class Event:
                 f"direction={self.direction!r})")
 
 
-def _events(model_name, events, replace):
+def named_events(model_name, events, replace):
     """``events`` {name: expression or Event} as a list of named Events with scalar sympy
     expressions (``replace`` applied); ModelError naming the model and the event."""
     if events is None:
@@ -182,7 +182,7 @@ def _events(model_name, events, replace):
     for name, given in events.items():
         if not isinstance(name, str):
             raise ModelError(f"model {model_name}: event name {name!r} is not a string")
-        _check_name("event", name)
+        check_name("event", name)
         event = given if isinstance(given, Event) else Event(given)
         terminal, direction = event.terminal, event.direction
         if not isinstance(terminal, (bool, int)) or terminal not in (0, 1):
@@ -192,7 +192,7 @@ def _events(model_name, events, replace):
             raise ModelError(f"model {model_name}: event {name}: direction must be +1 (rising), "
                              f"-1 (falling) or 0 (both), got {direction!r}")
         try:
-            expr = _sympify(event.expr, f"event {name}", replace)
+            expr = sympify_scalar(event.expr, f"event {name}", replace)
         except ModelError as exc:
             raise ModelError(f"model {model_name}: {exc}") from None
         named = Event(expr, bool(terminal), int(direction))
@@ -201,7 +201,7 @@ def _events(model_name, events, replace):
     return out
 
 
-def _prescriptions(model_name, prescribed, coords, replace):
+def prescriptions(model_name, prescribed, coords, replace):
     """``prescribed`` {Coordinate: expression of t and parameters} checked: {Coordinate: sympy
     expression}. ModelError (one line naming the symbol) for a key that is not a Coordinate or
     is also in coords, and for an expression using a coordinate, a velocity or another symbol."""
@@ -220,7 +220,7 @@ def _prescriptions(model_name, prescribed, coords, replace):
             raise ModelError(f"model {model_name}: prescribed coordinate {c} is also in coords; "
                              "a coordinate is either free (coords) or prescribed, not both")
         try:
-            expr = _sympify(given, f"prescription of {c}", replace)
+            expr = sympify_scalar(given, f"prescription of {c}", replace)
         except ModelError as exc:
             raise ModelError(f"model {model_name}: {exc}") from None
         for s in sorted(expr.free_symbols, key=str):

@@ -12,6 +12,15 @@ from ..errors import ModelError
 __all__ = ["PointForce", "SaintVenant", "DryFriction"]
 
 
+def is_point_and_vector(where, vector):
+    """True for a sympy.physics.mechanics (Point or ReferenceFrame, Vector) pair; imports
+    sympy.physics.mechanics only for objects of sympy.physics."""
+    if "sympy.physics" not in type(where).__module__:
+        return False
+    import sympy.physics.mechanics as me
+    return isinstance(where, (me.Point, me.ReferenceFrame)) and isinstance(vector, me.Vector)
+
+
 @dataclass(frozen=True)
 class PointForce:
     """A force applied at a point; its generalized force follows from virtual work.
@@ -31,8 +40,7 @@ class PointForce:
 
     def __init__(self, point, force):
         if "sympy.physics" in type(point).__module__ or "sympy.physics" in type(force).__module__:
-            from .mechanics import is_mechanics_load
-            if not is_mechanics_load((point, force)):
+            if not is_point_and_vector(point, force):
                 raise ModelError(f"PointForce: with sympy.physics.mechanics give a Point and a "
                                  f"Vector, got {type(point).__name__} and {type(force).__name__}")
             for key, value in (("point", point), ("force", force), ("mechanics", True)):

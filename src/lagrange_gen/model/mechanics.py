@@ -23,6 +23,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
+from .loads import PointForce, is_point_and_vector
 
 __all__ = ["is_mechanics_load", "generalized_loads"]
 
@@ -32,33 +33,19 @@ def _me():
     return me
 
 
-def _is_vector(obj):
-    return isinstance(obj, _me().Vector)
-
-
 def is_mechanics_load(item):
     """True for Force, Torque, (Point, Vector), (ReferenceFrame, Vector) and a PointForce whose
     point is a mechanics Point; never imports sympy.physics.mechanics for other items."""
-    from .loads import PointForce
     if isinstance(item, PointForce):
         return item.mechanics
-    if not isinstance(item, tuple) or len(item) != 2 or "sympy.physics" not in type(item[0]).__module__:
-        return False
-    me = _me()
-    return isinstance(item[0], (me.Point, me.ReferenceFrame)) and _is_vector(item[1])
-
-
-def _where_and_vector(item):
-    """(Point or ReferenceFrame, Vector) of a load."""
-    from .loads import PointForce
-    if isinstance(item, PointForce):
-        return item.point, item.force
-    return item[0], item[1]
+    return isinstance(item, tuple) and len(item) == 2 and is_point_and_vector(*item)
 
 
 def where_and_vector(item):
     """(Point or ReferenceFrame, Vector) of a load."""
-    return _where_and_vector(item)
+    if isinstance(item, PointForce):
+        return item.point, item.force
+    return item[0], item[1]
 
 
 def generalized_loads(loads, frame, speeds, model_name):
@@ -77,7 +64,7 @@ def generalized_loads(loads, frame, speeds, model_name):
                          "move with them")
     Q = [sp.S.Zero] * len(speeds)
     for i, item in enumerate(loads):
-        where, vector = _where_and_vector(item)
+        where, vector = where_and_vector(item)
         kind = "force" if isinstance(where, me.Point) else "torque"
         try:
             velocity = where.vel(frame) if kind == "force" else where.ang_vel_in(frame)

@@ -13,11 +13,11 @@ import sympy as sp
 from .bodies import expand_intermediates, intermediates_of
 from .drawing import Drawing, check_drawing
 from ..errors import ModelError
-from .expressions import (Event, _check_rayleigh, _convert_dynamicsymbols, _equation_as_expr, _events,
-                          _mechanics_speeds, _prescriptions, _sympify, is_mechanics_load,
+from .expressions import (Event, check_rayleigh, convert_dynamicsymbols, equation_as_expr, named_events,
+                          mechanics_speeds, prescriptions, sympify_scalar, is_mechanics_load,
                           unknown_symbols_hint)
 from .loads import DryFriction, PointForce, SaintVenant
-from .symbols import Coordinate, Parameter, Velocity, _check_name, coordinates, parameters, t
+from .symbols import Coordinate, Parameter, Velocity, check_name, coordinates, parameters, t
 
 __all__ = [
     "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Event", "Model",
@@ -73,26 +73,26 @@ class Model:
     def __init__(self, name, coords, T, V=0, forces=None, dissipation=0, constraints=(),
                  elements=(), params=None, description="", events=None, prescribed=None, frame=None,
                  inputs=(), outputs=None, draw=None):
-        _check_name("model", str(name))
+        check_name("model", str(name))
         self.name = str(name)
         self.description = description
         coords = list(coords)
         if not coords:
             raise ModelError(f"model {name}: no coordinates")
-        speeds = _mechanics_speeds(coords)
-        coords, replace = _convert_dynamicsymbols(coords)
+        speeds = mechanics_speeds(coords)
+        coords, replace = convert_dynamicsymbols(coords)
         self.coords = coords
         self.T = self._scalar(T, "T", replace)
         self.V = self._scalar(V, "V", replace)
         self.dissipation = self._scalar(dissipation, "dissipation", replace)
         self.forces = self._generalized_forces(forces, replace, frame, speeds)
-        self.constraints = [self._scalar(_equation_as_expr(c), f"constraint {i}", replace)
+        self.constraints = [self._scalar(equation_as_expr(c), f"constraint {i}", replace)
                             for i, c in enumerate(self._sequence(constraints, "constraints", "expressions Phi(q)"))]
         self.elements = self._elements(elements, replace)
-        self.events = _events(self.name, events, replace)
+        self.events = named_events(self.name, events, replace)
         self.inputs = self._inputs(inputs)
         self.outputs = {str(k): self._scalar(v, f"output {k}", replace) for k, v in (outputs or {}).items()}
-        self.prescribed = _prescriptions(self.name, prescribed, coords, replace)
+        self.prescribed = prescriptions(self.name, prescribed, coords, replace)
         if self.prescribed:
             self._substitute_prescribed()
         self.intermediates = intermediates_of(*(e for _, e in self._expressions_and_events()))
@@ -141,7 +141,7 @@ class Model:
 
     def _scalar(self, expr, what, replace):
         try:
-            return _sympify(expr, what, replace)
+            return sympify_scalar(expr, what, replace)
         except ModelError as exc:
             raise ModelError(f"model {self.name}: {exc}") from None
 
@@ -212,7 +212,7 @@ class Model:
             if not isinstance(e, (SaintVenant, DryFriction)):
                 raise ModelError(f"model {self.name}: element {i} is {type(e).__name__}, not SaintVenant or DryFriction")
             e.name = e.name or f"{e.kind}_{i}"
-            _check_name("element", e.name)
+            check_name("element", e.name)
             e.strain = self._scalar(e.strain, f"strain of element {e.name}", replace)
             for c in e.coefficients():
                 self._scalar(c, f"coefficient of element {e.name}", {})
@@ -326,13 +326,13 @@ class Model:
         for kind, syms in (("coordinate", self.coords), ("velocity", self.velocities),
                            ("parameter", self.params)):
             for s in syms:
-                _check_name(kind, s.name)
+                check_name(kind, s.name)
                 if s.name in names or s.name == "t":
                     other = names.get(s.name, "time")
                     raise ModelError(f"model {self.name}: duplicate name {s.name!r} ({other} and {kind})")
                 names[s.name] = kind
         for name in self.outputs:
-            _check_name("output", name)
+            check_name("output", name)
         q, qd = set(self.coords), set(self.velocities)
         allowed = q | qd | set(self.params) | {t} | set(self.intermediates)
         for where, expr in self._input_expressions():
@@ -348,7 +348,7 @@ class Model:
             raise ModelError(f"model {self.name}: V depends on the velocit{'y' if len(moving) == 1 else 'ies'} "
                              f"{', '.join(moving)}; V is a function of q and t: velocity-dependent "
                              "potentials belong in T or in forces")
-        _check_rayleigh(self.name, expand_intermediates(self.dissipation), self.velocities)
+        check_rayleigh(self.name, expand_intermediates(self.dissipation), self.velocities)
         if self.symbols_of(self.dissipation) & {t}:
             raise ModelError(f"model {self.name}: dissipation depends on t")
         for i, c in enumerate(self.constraints):

@@ -90,7 +90,7 @@ def parameters(names, defaults=None):
     """
     names = _split_names(names)
     for n in names:
-        _check_name("parameter", n)
+        check_name("parameter", n)
     params = [Parameter(n, next(_declarations), _finite_default(n, v))
               for n, v in zip(names, _default_values(names, defaults))]
     return params[0] if len(params) == 1 else params
@@ -132,6 +132,6 @@ def _finite_default(name, value):
     return number
 
 
-def _check_name(kind, name):
+def check_name(kind, name):
     if not name.isidentifier() or keyword.iskeyword(name):
         raise ModelError(f"{kind} name {name!r} is not a valid Python identifier")

@@ -6,7 +6,7 @@
     ens.q            # (M, S, n)
     ens.failures()   # ["member 17: cart_pendulum, explicit_euler: step 312 of 1000 ..."]
 
-The members run in the generated module's ``ensemble_<method>`` (steppers/core/registry.py): one
+The members run in the generated module's ``ensemble_<method>`` (codegen/glue.py): one
 numba parallel loop over members, each member base.run_loop exactly as ``run_<method>`` runs it
 for simulate, so member i equals ``simulate(...)`` with member i's inputs (bitwise, as long as
 simulate runs in one chunk: fixed_run.CHUNK_STEPS steps). Fixed-step methods only. A member that
@@ -26,6 +26,7 @@ import numpy as np
 from . import checks as run_checks
 from ..codegen.keys import regeneration_command_for
 from .ensemble_inputs import grid, member_count, member_params, member_states
+from .ensemble_outputs import allocate_outputs, member_args, run_members
 from ..errors import LagrangeGenError, SimulationError
 from .failures import raise_for_status
 from .fixed_driver import ProgressBar, n_steps_to
@@ -102,12 +103,12 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     numba's cache holds it, else the portable ensemble glue, compiled once for every model
     (models with events: always the generated one); the Dask path runs the generated one.
     EnsembleResult.jit says which ran."""
-    from .simulate import _check_times, _element_method, load_module
+    from .simulate import check_times, element_method, load_module
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method)
-    method = _element_method(module, method)
+    method = element_method(module, method)
     from .consistent import check_method
     check_method(module, method)
     spec = registry.spec(method)
@@ -115,7 +116,7 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
         raise SimulationError(f"method {method!r} chooses its own steps; ensemble runs the "
                               f"fixed-step methods only (e.g. rk4, midpoint, verlet)")
     run = _ensemble_glue(module, method)
-    h = _check_times(spec, h, t0, t_end, save_every, None)
+    h = check_times(spec, h, t0, t_end, save_every, None)
     config = make_settings(spec, settings)
     M = member_count(module, q0, v0, params)
     q, v = member_states(module, "q0", q0, M), member_states(module, "v0", v0, M)
@@ -129,7 +130,7 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
                                                module.N_ELEMENTS)
     rows = run_checks.saved_rows(n_steps, save_every)
     check_ensemble_memory(module.NAME, M, n_steps, save_every, n, n_saved)
-    out = _allocate(M, rows, n, n_saved)
+    out = allocate_outputs(M, rows, n, n_saved)
     if spec.constraints:
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
     if client is None:
@@ -178,14 +179,6 @@ def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved):
                             what=f"an ensemble of {M} members saving {rows} states each")
 
 
-def _allocate(M, rows, n, n_saved):
-    """Outputs, NaN until written (rows after a member's failure stay NaN)."""
-    return dict(q=np.full((M, rows, n), np.nan), v=np.full((M, rows, n), np.nan),
-                stats=np.full((M, rows, N_STATS), np.nan),
-                extra=np.full((M, rows, n_saved), np.nan),
-                last=np.zeros((M, 2 * n + 3 + n_saved)), status=np.zeros((M, 3), np.int64))
-
-
 def _consistent_starts(module, q, v, p, t0, config, extra):
     """Each member's consistent (q0, v0), its multipliers and residuals in row 0 of ``extra``;
     one warning counting the members that were moved (instead of one per member)."""
@@ -205,22 +198,11 @@ def _consistent_starts(module, q, v, p, t0, config, extra):
     return q, v
 
 
-def _args(q, v, p, t0, h, n_steps, save_every, config, out, members):
-    """The arguments of ensemble_<method> for the members (a slice)."""
-    s = members
-    return (q[s], v[s], t0, h, n_steps, save_every, p[s], config, out["q"][s], out["v"][s],
-            out["stats"][s], out["extra"][s], out["last"][s], out["status"][s])
-
-
-def _call(run, q, v, p, t0, h, n_steps, save_every, config, out, members):
-    run(*_args(q, v, p, t0, h, n_steps, save_every, config, out, members))
-
-
 def _warm_up(choose, q, v, p, t0, h, save_every, config, out):
     """Choose the glue (``choose(args)`` -> (glue, what ran), portable.choose_ensemble) and
     compile or load it from numba's cache with zero members; (glue, what ran, seconds)."""
     start = time.perf_counter()
-    args = _args(q, v, p, t0, h, 0, save_every, config, out, slice(0, 0))
+    args = member_args(q, v, p, t0, h, 0, save_every, config, out, slice(0, 0))
     run, ran = choose(args)
     run(*args)
     return run, ran, time.perf_counter() - start
@@ -231,14 +213,14 @@ def _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress
     MEMBERS_PER_THREAD per thread)."""
     M = q.shape[0]
     if not progress:
-        _call(run, q, v, p, t0, h, n_steps, save_every, config, out, slice(0, M))
+        run_members(run, q, v, p, t0, h, n_steps, save_every, config, out, slice(0, M))
         return
     import numba
     batch = max(MEMBERS_PER_THREAD * numba.get_num_threads(), math.ceil(M / 50))
     bar = ProgressBar(M)
     for start in range(0, M, batch):
         members = slice(start, min(M, start + batch))
-        _call(run, q, v, p, t0, h, n_steps, save_every, config, out, members)
+        run_members(run, q, v, p, t0, h, n_steps, save_every, config, out, members)
         bar.update(members.stop)
     bar.close()
 
@@ -253,9 +235,9 @@ def _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time
     saved = {name: out["extra"][:, :, a:a + w] for name, a, w in layout}
     energy = out["stats"][:, :, STAT_ENERGY].copy()
     if "element_state" in saved:
-        from .simulate import _element_energy
+        from .simulate import element_energy
         for i in range(p.shape[0]):
-            energy[i] += _element_energy(module, p[i], saved["element_state"][i])
+            energy[i] += element_energy(module, p[i], saved["element_state"][i])
     messages = {int(i): _message(module, spec, int(status[i]), int(steps[i]), n_steps, last[i],
                                  h, p[i], max_iter) for i in np.flatnonzero(status != st.OK)}
     done = np.where(status == st.OK, steps, np.maximum(steps, 0))

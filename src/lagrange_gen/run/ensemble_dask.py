@@ -60,20 +60,20 @@ def import_on_worker(path, source, key):
 def run_chunk(path, source, key, method, q, v, p, t0, h, n_steps, save_every, settings, extra0,
               rows, worker_threads=1):
     """One task: the members (q, v, p) (K, ...) run by ensemble_<method>; returns the output
-    dict of ensemble_run._allocate (K members, ``rows`` rows), row 0 of extra from extra0
+    dict of ensemble_outputs.allocate_outputs (K members, ``rows`` rows), row 0 of extra from extra0
     (K, n_saved), the members' initial saved fields."""
     import numba
 
-    from .ensemble import _allocate, _call
+    from .ensemble_outputs import allocate_outputs, run_members
     module = import_on_worker(path, source, key)
     run = getattr(module, f"ensemble_{method}")
     K, n = q.shape
-    out = _allocate(K, rows, n, extra0.shape[1])
+    out = allocate_outputs(K, rows, n, extra0.shape[1])
     out["extra"][:, 0] = extra0
     before = numba.get_num_threads()
     numba.set_num_threads(max(1, min(worker_threads, numba.config.NUMBA_NUM_THREADS)))
     try:
-        _call(run, q, v, p, t0, h, n_steps, save_every, settings, out, slice(0, K))
+        run_members(run, q, v, p, t0, h, n_steps, save_every, settings, out, slice(0, K))
     finally:
         numba.set_num_threads(before)
     return {k: out[k] for k in ("q", "v", "stats", "extra", "last", "status")}
@@ -81,7 +81,7 @@ def run_chunk(path, source, key, method, q, v, p, t0, h, n_steps, save_every, se
 
 def run_on_client(client, module, method, q, v, p, t0, h, n_steps, save_every, settings, out,
                   progress, worker_threads=1):
-    """Fill ``out`` (ensemble_run._allocate, M members) through Dask tasks on ``client``."""
+    """Fill ``out`` (ensemble_outputs.allocate_outputs, M members) through Dask tasks on ``client``."""
     from .fixed_driver import ProgressBar
     path = str(Path(module.__file__).resolve())
     source = Path(path).read_text()

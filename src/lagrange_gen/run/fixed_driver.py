@@ -1,7 +1,7 @@
 """Drive a fixed-step method's glue from Python: chunks of steps, progress, failures, events.
 
 simulate (run/simulate.py) checks the inputs and builds the Trajectory; this module runs the
-generated ``run_<method>`` (steppers/core/registry.py, base.run_loop) chunk by chunk so that a
+generated ``run_<method>`` (codegen/glue.py, base.run_loop) chunk by chunk so that a
 progress bar can be shown, and turns a failure status into the exception naming the step
 (run/failures.py). run/adaptive_driver.py is the same for the adaptive methods.
 """

@@ -5,7 +5,7 @@
     traj.plot("traj.png"); traj.to_npz("traj.npz")
 
 The integration itself runs inside the generated module's jitted ``run_<method>`` (see
-steppers/core/registry.py), driven in chunks by run/fixed_driver.py or, for an adaptive method, by
+codegen/glue.py), driven in chunks by run/fixed_driver.py or, for an adaptive method, by
 run/adaptive_driver.py; this module only checks inputs (run_checks: element coefficients, step count,
 time resolution, memory; the method's settings by its spec), builds the Trajectory from the
 method's declared saved fields, and warns when a conservative run lost its energy
@@ -58,7 +58,7 @@ def load_module(module_or_path, out_dir="generated", method=None, force=False, o
     module = load(Path(module_or_path), out_dir=out_dir, options=options, force=force)
     if method is None or getattr(module, "KEY", None) is None:
         return module
-    runs = _element_method(module, method)
+    runs = element_method(module, method)
     if runs in registry.METHODS and not hasattr(module, f"run_{runs}"):
         module = load(Path(module_or_path), out_dir=out_dir, methods=[runs], options=options,
                       force=force)
@@ -75,7 +75,7 @@ def _runner(module, method):
     return run
 
 
-def _element_method(module, method):
+def element_method(module, method):
     """The method that actually runs: on a model with nonsmooth elements a method that a
     nonsmooth one stands in for (SPEC.stands_in_for) becomes it; a method that cannot treat
     them is refused, naming them."""
@@ -90,7 +90,7 @@ def _element_method(module, method):
         f"{', '.join(names)} (no silent regularization); use {use}")
 
 
-def _element_energy(module, p, state):
+def element_energy(module, p, state):
     """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
     coef = run_checks.element_coefficients(module, p)
     k = np.where(coef[:, 2] == 0.0, coef[:, 0], 0.0)
@@ -154,13 +154,13 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method, force)
-    method = _element_method(module, method)
+    method = element_method(module, method)
     from .consistent import check_method
     check_method(module, method)
     run = _runner(module, method)
     spec = registry.spec(method)
     n = module.N_COORDS
-    h = _check_times(spec, h, t0, t_end, save_every, t_eval)
+    h = check_times(spec, h, t0, t_end, save_every, t_eval)
     config = make_settings(spec, settings)
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
@@ -203,7 +203,7 @@ def _with_data(run, data):
     return lambda *args: run(*args, data)
 
 
-def _check_times(spec, h, t0, t_end, save_every, t_eval):
+def check_times(spec, h, t0, t_end, save_every, t_eval):
     """The step (float, or 0.0 for an adaptive method's automatic first step) after checking
     the time arguments; SimulationError naming the one that is wrong."""
     if spec.adaptive:
@@ -313,7 +313,7 @@ def _build(task, rows, out, steps, h, wall, compile_time):
     saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
     energy = rows["stats"][:, STAT_ENERGY].copy()
     if "element_state" in saved:
-        energy = energy + _element_energy(m, p, saved["element_state"])
+        energy = energy + element_energy(m, p, saved["element_state"])
     return Trajectory(t=rows["t"], q=rows["q"], v=rows["v"], energy=energy,
                       newton_iters=rows["stats"][:, STAT_ITERS].copy(),
                       newton_residual=rows["stats"][:, STAT_RESIDUAL].copy(), method=spec.name,

@@ -91,7 +91,7 @@ import numpy as np
 from ...jit.cache import njit
 
 from . import events
-from .base import FAST, STAT_WORK, _last, _save, check_state
+from .base import FAST, STAT_WORK, write_last, save_row, check_state
 from .status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 
 
@@ -137,7 +137,7 @@ def _save_row(kern, row, t, q, v, p, since, err, out_t, out_q, out_v, out_stats,
     energy = kern.energy(q, v, t, p)
     if not math.isfinite(energy):
         return False
-    _save(row, t, q, v, energy, since, err, out_t, out_q, out_v, out_stats, extra, out_extra)
+    save_row(row, t, q, v, energy, since, err, out_t, out_q, out_v, out_stats, extra, out_extra)
     out_stats[row, STAT_WORK] = 0.0          # the work W is tracked by fixed-step runs only
     return True
 
@@ -145,7 +145,7 @@ def _save_row(kern, row, t, q, v, p, since, err, out_t, out_q, out_v, out_stats,
 @njit(inline="always")
 def _stop(out_last, counters, t, q, v, since, err, extra, h):
     """Where a call ends: out_last = [t, q, v, since, err, extra], counters[0] = h."""
-    _last(out_last, t, q, v, since, err, extra)
+    write_last(out_last, t, q, v, since, err, extra)
     counters[0] = h
 
 
@@ -264,7 +264,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     if status == OK:
         status = method.prepare(kern, q, v, t0, p, settings, ws)
         counters[3] += 1
-    _last(out_last, t0, q, v, 0.0, 0.0, extra)
+    write_last(out_last, t0, q, v, 0.0, 0.0, extra)
     if status != OK:
         return status, 0, 0
     if not _save_row(kern, 0, t0, q, v, p, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra,

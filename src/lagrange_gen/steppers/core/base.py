@@ -22,7 +22,7 @@ The rules every method module (``steppers/methods/<method>.py``) follows:
   ``step`` advances (q, v, mom) from t to t + h in place. On failure ``step`` leaves q, v and
   mom at the start of the step, so the driver reports the state it could not step from.
 * No ``run`` function: the generated glue ``run_<method>`` calls ``run_loop`` with the method's
-  module and the stepping loop it binds for it (``stepping_loop``; see registry.py for why the
+  module and the stepping loop it binds for it (``stepping_loop``; see codegen/glue.py for why the
   glue exists); adaptive methods have their own loop (adaptive.py) and their own set of
   functions (see there). ``step`` is declared ``@njit(inline=inline_step, **FAST)``.
 * No allocation per step: the workspace is allocated once per run and passed to ``step``.
@@ -311,7 +311,7 @@ def _classify(q, v):
 
 
 @njit(cache=True, **FAST)
-def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, extra, out_extra):
+def save_row(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, extra, out_extra):
     out_t[row] = t
     for i in range(q.shape[0]):
         out_q[row, i] = q[i]
@@ -324,7 +324,7 @@ def _save(row, t, q, v, energy, iters, resid, out_t, out_q, out_v, out_stats, ex
 
 
 @njit(cache=True, **FAST)
-def _last(out_last, t, q, v, iters, resid, extra):
+def write_last(out_last, t, q, v, iters, resid, extra):
     n = q.shape[0]
     out_last[0] = t
     for i in range(n):
@@ -420,12 +420,12 @@ def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, s
     energy = kern.energy(q, v, t0, p)
     if status == OK and not math.isfinite(energy):
         status = NON_FINITE
-    _last(out_last, t0, q, v, 0.0, 0.0, extra)
+    write_last(out_last, t0, q, v, 0.0, 0.0, extra)
     if status != OK:
         return status, -1, 0
-    # row 0 as an int64, not the literal 0: numba compiles a separate _save for
+    # row 0 as an int64, not the literal 0: numba compiles a separate save_row for
     # Literal[int](0) (0.12 s more in every first compile of a glue)
-    _save(np.int64(0), t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra,
+    save_row(np.int64(0), t0, q, v, energy, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra,
           out_extra)
     out_stats[0, STAT_WORK] = W
     # The work workspace always exists (0-size arrays on a model without work): numba types the
@@ -501,7 +501,7 @@ def steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_ste
             # A changed input invalidates what prepare cached (verlet's acceleration).
             status = method.prepare(kern, q, v, mom, t, p, settings, ws, extra)
             if status != OK:
-                _last(out_last, t, q, v, iters_acc, 0.0, extra)
+                write_last(out_last, t, q, v, iters_acc, 0.0, extra)
                 return status, i, n_events
         if kern.WORK and kern.N_ELEMENTS > 0:
             work.elements_begin(kern, ww, q, p, extra)
@@ -509,12 +509,12 @@ def steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_ste
         iters_acc += iters
         resid_max = max(resid_max, resid)
         if status != OK:
-            _last(out_last, t, q, v, iters_acc, resid, extra)
+            write_last(out_last, t, q, v, iters_acc, resid, extra)
             return status, i, n_events
         t_new = t0 + (i + 1) * h
         status = check_state(q, v, bound)
         if status != OK:
-            _last(out_last, t_new, q, v, iters_acc, resid, extra)
+            write_last(out_last, t_new, q, v, iters_acc, resid, extra)
             return status, i, n_events
         if kern.WORK:
             P1, D1 = work.rate(kern, ww, q, v, t_new, p)
@@ -528,7 +528,7 @@ def steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_ste
                 n_events, stopped = events.locate(hermite, iw, kern, ew, p, t, t_new,
                                                   out_events, n_events)
                 if stopped:
-                    _last(out_last, ew.stop[0], ew.q, ew.v, iters_acc, resid_max, extra)
+                    write_last(out_last, ew.stop[0], ew.q, ew.v, iters_acc, resid_max, extra)
                     if out_last.shape[0] > 2 * n + 3 + n_saved:
                         out_last[out_last.shape[0] - 1] = W     # (W at the end of the step)
                     return OK, i, n_events
@@ -538,14 +538,14 @@ def steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_ste
             since = 0
             energy = kern.energy(q, v, t_new, p)
             if not math.isfinite(energy):      # e.g. log(x) at x <= 0: outside the model
-                _last(out_last, t_new, q, v, iters_acc, resid, extra)
+                write_last(out_last, t_new, q, v, iters_acc, resid, extra)
                 return NON_FINITE, i, n_events
-            _save((i + 1) // save_every, t_new, q, v, energy, iters_acc,
+            save_row((i + 1) // save_every, t_new, q, v, energy, iters_acc,
                   resid_max, out_t, out_q, out_v, out_stats, extra, out_extra)
             out_stats[(i + 1) // save_every, STAT_WORK] = W
             iters_acc = 0.0
             resid_max = 0.0
-    _last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max, extra)
+    write_last(out_last, t0 + n_steps * h, q, v, iters_acc, resid_max, extra)
     if out_last.shape[0] > 2 * n + 3 + n_saved:
         out_last[out_last.shape[0] - 1] = W
     return OK, n_steps, n_events

@@ -49,7 +49,7 @@ HEUN_C = np.array([0.0, 1.0])
 
 
 @njit(inline="always", **FAST)
-def _stage_state(A, i, q, v, h, stage_v, stage_a, qs, n):
+def stage_state(A, i, q, v, h, stage_v, stage_a, qs, n):
     """Q_i into qs (n,) and V_i into stage_v[i] (n,) from the stages j < i. Zero entries of A
     are skipped: no work for them, and a non-finite stage cannot leak through a 0 coefficient.
     n passed: kern.N_COORDS (base.py, "Loop bounds")."""
@@ -78,7 +78,7 @@ def rk_step(source, kern, ctx, A, b, c, q, v, t, h, stage_v, stage_a, qs, q_out,
     untouched."""
     n, s = kern.N_COORDS, b.shape[0]       # (n: base.py, "Loop bounds")
     for i in range(s):
-        _stage_state(A, i, q, v, h, stage_v, stage_a, qs, n)
+        stage_state(A, i, q, v, h, stage_v, stage_a, qs, n)
         if i == 0 and first_known:
             continue
         status = source.stage_acceleration(kern, ctx, qs, stage_v[i], t + c[i] * h, stage_a[i])

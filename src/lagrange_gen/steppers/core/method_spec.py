@@ -19,7 +19,7 @@ method names. A spec says:
   iterations and residual), in the order of its ``extra`` buffer, each with a width given as a
   count name (``"m"`` constraints, ``"ne"`` elements, ``"n"`` coordinates) or an int;
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
-  adaptive signature (registry.py).
+  adaptive signature (codegen/glue.py).
 
 The jitted side of the contract is in base.py (fixed step) and adaptive.py (adaptive).
 """

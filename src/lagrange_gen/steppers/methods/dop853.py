@@ -30,7 +30,7 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core.base import FAST, accel
-from ..core.explicit_rk import _stage_state, rk_step
+from ..core.explicit_rk import stage_state, rk_step
 from ..core.method_spec import Spec
 from ..core.status import OK
 
@@ -303,7 +303,7 @@ def dense(kern, q, v, t, h, p, ws):
     after accept, before advance. DENSE_EVALS evaluations; OK or SINGULAR_MASS."""
     ctx = (p, ws.H)
     for i in range(N_STAGES + 1, N_DENSE):
-        _stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, kern.N_COORDS)
+        stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, kern.N_COORDS)
         status = stage_acceleration(kern, ctx, ws.qs, ws.kv[i], t + C[i] * h, ws.ka[i])
         if status != OK:
             return status

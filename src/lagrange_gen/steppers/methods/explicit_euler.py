@@ -23,7 +23,7 @@ Workspace = namedtuple("Workspace", "a H")
 
 
 # No cache=True on functions that receive kernels: they are compiled (and cached) as part of
-# the generated module's run_<method> glue, see registry.py.
+# the generated module's run_<method> glue, see codegen/glue.py.
 @njit
 def workspace(kern, n):
     """Allocated once per run by base.run_loop."""

@@ -1,0 +1,27 @@
+"""The output arrays of an ensemble and the call of the glue ``ensemble_<method>`` on a slice of
+its members: what a local run (ensemble) and a Dask worker (ensemble_dask) share."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..steppers.core.base import N_STATS
+
+
+def allocate_outputs(M, rows, n, n_saved):
+    """Outputs, NaN until written (rows after a member's failure stay NaN)."""
+    return dict(q=np.full((M, rows, n), np.nan), v=np.full((M, rows, n), np.nan),
+                stats=np.full((M, rows, N_STATS), np.nan),
+                extra=np.full((M, rows, n_saved), np.nan),
+                last=np.zeros((M, 2 * n + 3 + n_saved)), status=np.zeros((M, 3), np.int64))
+
+
+def member_args(q, v, p, t0, h, n_steps, save_every, config, out, members):
+    """The arguments of ensemble_<method> for the members (a slice)."""
+    s = members
+    return (q[s], v[s], t0, h, n_steps, save_every, p[s], config, out["q"][s], out["v"][s],
+            out["stats"][s], out["extra"][s], out["last"][s], out["status"][s])
+
+
+def run_members(run, q, v, p, t0, h, n_steps, save_every, config, out, members):
+    run(*member_args(q, v, p, t0, h, n_steps, save_every, config, out, members))

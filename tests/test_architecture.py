@@ -1,0 +1,171 @@
+"""The package's shape (docs/ARCHITECTURE.md): its import graph has no circles, nothing imports
+another module's underscore names, the generator loads without numba and a cold simulate of a
+generated module without sympy. The graph is read from the source (every import statement, at
+any level of a file: a function-level import is a dependency too), not from a running process."""
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import lagrange_gen
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = Path(lagrange_gen.__file__).resolve().parent
+
+#: Circles that stay until the module named in the reason is split. The test fails when one of
+#: them goes (so that the entry is removed) or when another appears.
+KNOWN_CIRCLES = {
+    frozenset({"steppers.core.base", "steppers.core.events", "steppers.core.hermite",
+               "steppers.core.work"}):
+        "base.py holds the numba options (FAST), accel and copy_into that events, hermite and "
+        "work use, and its run loop calls them; splitting base.py by job (issue 29, part 4) "
+        "breaks the circle",
+}
+
+
+def _modules():
+    """{dotted name relative to lagrange_gen ("" for the package): (path, is a package)}."""
+    found = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = list(path.relative_to(PACKAGE).with_suffix("").parts)
+        is_package = parts[-1] == "__init__"
+        if is_package:
+            parts.pop()
+        found[".".join(parts)] = (path, is_package)
+    return found
+
+
+MODULES = _modules()
+
+
+def _absolute(name, is_package, node):
+    """The dotted name (relative to lagrange_gen) an ImportFrom refers to; None outside it."""
+    if node.level:
+        parts = name.split(".") if name else []
+        base = parts if is_package else parts[:-1]
+        base = base[:len(base) - (node.level - 1)] if node.level > 1 else base
+        return ".".join(base + (node.module.split(".") if node.module else []))
+    head, _, rest = (node.module or "").partition(".")
+    return rest if head == "lagrange_gen" else None
+
+
+def _module_of(dotted):
+    """The package module ``dotted`` names, or the closest package module above it."""
+    while dotted not in MODULES and "." in dotted:
+        dotted = dotted.rsplit(".", 1)[0]
+    return dotted if dotted in MODULES else ""
+
+
+def _imports(name):
+    """[(lineno, imported module, imported name or None)] of one package module."""
+    path, is_package = MODULES[name]
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.ImportFrom):
+            base = _absolute(name, is_package, node)
+            if base is None:
+                continue
+            for alias in node.names:
+                sub = f"{base}.{alias.name}" if base else alias.name
+                if sub in MODULES:
+                    out.append((node.lineno, sub, None))
+                else:
+                    out.append((node.lineno, _module_of(base), alias.name))
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                head, _, rest = alias.name.partition(".")
+                if head == "lagrange_gen":
+                    out.append((node.lineno, _module_of(rest), None))
+    return out
+
+
+def _graph():
+    return {name: {target for _, target, _ in _imports(name) if target != name} for name in MODULES}
+
+
+def _circles(graph):
+    """Strongly connected components of more than one module (Tarjan, iterative)."""
+    index, low, on_stack, stack, found, counter = {}, {}, set(), [], [], 0
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph[root])))]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is not None:
+                if child not in index:
+                    index[child] = low[child] = counter
+                    counter += 1
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(graph[child]))))
+                elif child in on_stack:
+                    low[node] = min(low[node], index[child])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[node])
+            if low[node] == index[node]:
+                component = set()
+                while True:
+                    member = stack.pop()
+                    on_stack.discard(member)
+                    component.add(member)
+                    if member == node:
+                        break
+                if len(component) > 1:
+                    found.append(frozenset(component))
+    return found
+
+
+def test_the_graph_sees_the_imports():
+    """The graph resolves relative, absolute and function-level imports (what the tests below
+    rely on)."""
+    graph = _graph()
+    assert "run.loader" in graph["run.simulate"]                  # from .loader import
+    assert "steppers.core.registry" in graph["codegen.generate"]  # in a function
+    assert "codegen.keys" in graph["run.loader"]                  # from ..codegen.keys import
+    assert _circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [frozenset("abc")]
+
+
+def test_no_import_circles():
+    circles = set(_circles(_graph()))
+    unexpected = sorted(sorted(c) for c in circles - set(KNOWN_CIRCLES))
+    assert not unexpected, f"import circles: {unexpected}"
+    gone = sorted(sorted(c) for c in set(KNOWN_CIRCLES) - circles)
+    assert not gone, f"no longer circles, remove them from KNOWN_CIRCLES: {gone}"
+
+
+def test_no_module_imports_another_modules_underscore_names():
+    offenders = [f"{name}:{line}: {target}.{imported}"
+                 for name in MODULES for line, target, imported in _imports(name)
+                 if imported and imported.startswith("_") and not imported.startswith("__")
+                 and target != name]
+    assert not offenders, "private names imported across modules: " + "; ".join(offenders)
+
+
+def _run(code):
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT,
+                          timeout=600)
+
+
+def test_the_generator_loads_without_numba():
+    out = _run("import lagrange_gen.codegen, lagrange_gen.derive; import sys; "
+               "assert 'numba' not in sys.modules, 'numba imported'")
+    assert out.returncode == 0, out.stderr
+
+
+def test_a_cold_simulate_of_a_generated_module_does_not_import_sympy():
+    out = _run("import sys\n"
+               "import lagrange_gen as lg\n"
+               "module = lg.import_generated('generated/cart_pendulum.py')\n"
+               "traj = lg.simulate(module, 'rk4', [0.1, 0.5], [0.0, 0.0], t_end=0.005, h=1e-3)\n"
+               "assert traj.q.shape == (6, 2), traj.q.shape\n"
+               "assert 'sympy' not in sys.modules, 'sympy imported'\n")
+    assert out.returncode == 0, out.stderr
