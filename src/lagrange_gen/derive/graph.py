@@ -72,7 +72,8 @@ class Graph:
         found = self._intern.get(expr)
         if found is not None:
             return found
-        calls = {f: self.node(f) for f in expr.atoms(se.Function) if f != expr}
+        # sorted: node numbers (and so the generated text) must not follow set order
+        calls = {f: self.node(f) for f in sorted(expr.atoms(se.Function), key=str) if f != expr}
         if calls:                       # each sin(q_3) computed once, wherever it is used
             expr = expr.xreplace(calls)
             found = self._intern.get(expr)

@@ -18,6 +18,7 @@ available (another sympy), the energies fall back to sympy's own ``kinetic_energ
 
 from __future__ import annotations
 
+import itertools
 import warnings
 from collections import deque
 
@@ -27,6 +28,10 @@ from ..errors import ModelError
 from .symbols import Coordinate, t
 
 __all__ = ["Intermediate", "kinetic_energy", "gravity_potential", "intermediates_of", "expand_intermediates"]
+
+
+#: Serial numbers of Intermediates (their names), in creation order.
+_serials = itertools.count(1)
 
 
 class Intermediate(sp.Symbol):
@@ -53,7 +58,7 @@ def intermediates_of(*exprs):
     the ones its definition uses."""
     order, seen = [], set()
     for expr in exprs:
-        stack = [(s, False) for s in sp.sympify(expr).atoms(Intermediate)]
+        stack = [(s, False) for s in _in_order(sp.sympify(expr).atoms(Intermediate))]
         while stack:
             sym, ready = stack.pop()
             if sym in seen:
@@ -63,8 +68,14 @@ def intermediates_of(*exprs):
                 order.append(sym)
                 continue
             stack.append((sym, True))
-            stack.extend((u, False) for u in sym.definition.atoms(Intermediate) if u not in seen)
+            stack.extend((u, False) for u in _in_order(sym.definition.atoms(Intermediate)) if u not in seen)
     return order
+
+
+def _in_order(intermediates):
+    """Intermediates in creation order (their names k<serial>): the derivation numbers its graph
+    nodes in this order, so the generated text must not follow a set's order."""
+    return sorted(intermediates, key=lambda s: int(s.name[1:]))
 
 
 def expand_intermediates(expr):
@@ -84,7 +95,6 @@ class _Tree:
 
     def __init__(self, frame):
         self.N = frame
-        self._count = 0
         self._R = {frame: sp.eye(3)}
         self._w = {frame: sp.zeros(3, 1)}
         self._r, self._v = {}, {}
@@ -111,12 +121,12 @@ class _Tree:
         return expr.xreplace(funcs) if funcs else expr
 
     def _name(self, expr):
-        """An Intermediate for ``expr`` (numbers and symbols stay as they are)."""
+        """An Intermediate for ``expr`` (numbers and symbols stay as they are), named k<serial>
+        in the order of creation in this process (what _in_order sorts by)."""
         expr = sp.sympify(expr)
         if expr.is_Number or expr.is_Symbol:
             return expr
-        self._count += 1
-        return Intermediate(f"k{self._count}", expr)
+        return Intermediate(f"k{next(_serials)}", expr)
 
     def _named(self, matrix):
         return matrix.applyfunc(self._name)
