@@ -52,11 +52,11 @@ def test_calls_on_arrays_or_literals_go_to_numba_unchanged():
 _ASM = """
 import hashlib, json, os, sys
 from lagrange_gen.jit import typing_memo as numba_typing_memo
-from lagrange_gen.run.loader import _kernel_args, import_generated
+from lagrange_gen.run.loader import kernel_call_args, import_generated
 h = hashlib.sha256()
 for stem in ("cart_pendulum", "double_pendulum"):
     mod = import_generated(os.path.join(sys.argv[1], "generated", stem + ".py"))
-    args = _kernel_args(mod)
+    args = kernel_call_args(mod)
     for name in tuple(mod.KERNELS) + ("forward_dynamics",):
         kernel = getattr(mod, name)
         kernel(*args[name])

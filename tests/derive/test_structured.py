@@ -147,6 +147,13 @@ def test_robot_kernels_invert_each_other(chain_module):
     assert np.allclose(b, g, rtol=1e-13, atol=1e-13)
 
 
+def test_compile_all_knows_every_kernel_of_a_body_model(chain_module):
+    """lagrange_gen's compile-everything-now (bench, warm-up) has call arguments for each kernel
+    a module from bodies lists (failed before: inverse_dynamics was unknown to it)."""
+    from lagrange_gen.run.loader import kernel_call_args
+    assert set(chain_module.KERNELS) <= set(kernel_call_args(chain_module))
+
+
 def test_forward_dynamics_jacobian_is_the_derivative_of_the_accelerations(chain_module):
     mod = chain_module
     n = mod.N_COORDS

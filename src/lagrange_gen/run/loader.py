@@ -129,7 +129,7 @@ def register_module(namespace):
             return
 
 
-def _kernel_args(module):
+def kernel_call_args(module):
     """{kernel name: arguments of a call on zeros} for every kernel a module may have."""
     import numpy as np
     n, m, ne = module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS
@@ -149,6 +149,8 @@ def _kernel_args(module):
         "elements_hessian": (q, we, p, A),
         "forward_dynamics": (q, q, 0.0, p, A, v),
         "events": (q, q, 0.0, p, np.empty(getattr(module, "N_EVENTS", 0))),
+        "inverse_dynamics": (q, q, q, 0.0, p, v), "gravity_forces": (q, 0.0, p, v),
+        "bias_forces": (q, q, 0.0, p, v),
     }
 
 
@@ -156,7 +158,7 @@ def compile_all(module):
     """Call every kernel a generated module has (its KERNELS, plus forward_dynamics) once on
     zeros so numba compiles (or loads from its cache) all of them now rather than inside the
     first simulation step. Kernels a module was generated without are skipped."""
-    args = _kernel_args(module)
+    args = kernel_call_args(module)
     for name in tuple(getattr(module, "KERNELS", ())) + ("forward_dynamics",):
         if name not in args:
             raise GenerationError(f"{module.__file__}: unknown kernel {name!r} (regenerate it)")
