@@ -22,7 +22,7 @@ from .spec import KernelSpec, Output
 #: Largest n whose forward dynamics is emitted as an unrolled LDL^T solve (module docstring).
 UNROLL_MAX = 4
 
-_GENERAL = '''@njit(cache=True, _nrt=False)
+_GENERAL = '''@njit(**KERNEL_OPTIONS)
 def forward_dynamics(q, qd, t, p, H, qdd):
     """Solve H(q) qdd = rhs by Cholesky; H (n, n) is workspace, qdd (n,) the output.
     Returns OK, or SINGULAR_MASS when H is not numerically positive definite."""
@@ -47,7 +47,7 @@ _CONSTANT = '''def _factor_mass_matrix(p):
 MASS_FACTOR = _factor_mass_matrix(DEFAULT_PARAMS)
 
 
-@njit(cache=True, _nrt=False)
+@njit(**KERNEL_OPTIONS)
 def forward_dynamics(q, qd, t, p, H, qdd):
     """Solve H qdd = rhs with the constant H: by MASS_FACTOR (no factorization) when the
     parameters H depends on have their default values, else by factoring H into the workspace
