@@ -1,18 +1,18 @@
-"""lagrange_gen.jit.compile_gc: while numba compiles, the young GC threshold is raised; after the
-outermost compile, failed ones included, the thresholds are what they were."""
+"""lagrange_gen.jit.compile_gc: while numba compiles a lagrange_gen function, the young GC
+threshold is raised; after the outermost compile, failed ones included, the thresholds are what
+they were."""
 
 import gc
 
 import pytest
 from numba.core import event
 
-from lagrange_gen.jit import compile_gc
+from lagrange_gen.jit import compile_gc, speedups
 from lagrange_gen.jit.cache import njit
 
 
 class _Seen(event.Listener):
-    """Records gc.get_threshold() at every numba:compile start (registered after compile_gc's
-    listener, so it sees what compile_gc set)."""
+    """Records gc.get_threshold() at every numba:compile start."""
 
     def __init__(self):
         self.thresholds = []
@@ -42,7 +42,7 @@ def test_the_threshold_is_raised_during_a_compile_and_restored_after():
     def caller(x):
         return callee(x) * 2.0
 
-    assert compile_gc.install()
+    assert speedups.enabled("compile_gc")
     before = gc.get_threshold()
     seen, result = _compile_with_listener(caller, 1.5)
     assert result == 5.0
@@ -63,16 +63,13 @@ def test_a_failed_compile_restores_the_thresholds():
     assert gc.get_threshold() == before
 
 
-def test_nested_starts_set_and_restore_once():
-    listener = compile_gc.CompileGcListener()
+def test_nested_scopes_set_and_restore_once():
     before = gc.get_threshold()
     try:
-        listener.on_start(None)
-        listener.on_start(None)
-        assert gc.get_threshold()[0] == max(compile_gc.COMPILE_THRESHOLD, before[0])
-        listener.on_end(None)
-        assert gc.get_threshold()[0] == max(compile_gc.COMPILE_THRESHOLD, before[0])
-        listener.on_end(None)
+        with speedups.compiling():
+            with speedups.compiling():
+                assert gc.get_threshold()[0] == max(compile_gc.COMPILE_THRESHOLD, before[0])
+            assert gc.get_threshold()[0] == max(compile_gc.COMPILE_THRESHOLD, before[0])
         assert gc.get_threshold() == before
     finally:
         gc.set_threshold(*before)

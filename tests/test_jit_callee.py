@@ -97,9 +97,7 @@ print(json.dumps([type(midpoint.step).__name__, [x.hex() for x in tr.q[-1]],
 
 @functools.lru_cache(maxsize=None)
 def _run(wrappers):
-    env = {k: v for k, v in os.environ.items() if k != "LAGRANGE_GEN_NUMBA_WRAPPERS"}
-    if wrappers:
-        env["LAGRANGE_GEN_NUMBA_WRAPPERS"] = "1"
+    env = dict(os.environ, LAGRANGE_GEN_SPEEDUPS="-callee" if wrappers else "all")
     done = subprocess.run([sys.executable, "-c", _RUN, str(ROOT)], capture_output=True,
                           text=True, env=env, timeout=600)
     assert done.returncode == 0, done.stderr

@@ -12,7 +12,7 @@ import numpy as np
 from numba.core import inline_closurecall, ir
 from numba.core.compiler import run_frontend
 
-import lagrange_gen.steppers  # noqa: F401  (installs the copier)
+import lagrange_gen.steppers  # noqa: F401
 from lagrange_gen.jit import inline_copy as numba_inline_copy
 from conftest import ROOT
 
@@ -27,9 +27,9 @@ def _branchy(x, n):
     return s
 
 
-def test_installed_by_the_steppers():
-    assert isinstance(inline_closurecall.copy, numba_inline_copy._BlockCopier)
-    assert numba_inline_copy.install()          # a second install keeps the first
+def test_supported_and_not_installed_outside_a_compile():
+    assert numba_inline_copy.unsupported() is None
+    assert inline_closurecall.copy is copy
 
 
 def test_block_copies_equal_numbas_own_and_share_one_scope_copy():
@@ -64,7 +64,7 @@ import json, sys
 import numpy as np
 sys.path.insert(0, sys.argv[1])
 import cart_pendulum as mod
-from numba.core import inline_closurecall
+from lagrange_gen.jit import inline_copy
 from lagrange_gen.steppers.core.base import N_STATS
 from lagrange_gen.steppers.core import registry
 from lagrange_gen.steppers.core.method_spec import make_settings
@@ -74,7 +74,7 @@ out = (np.empty(rows), np.empty((rows, n)), np.empty((rows, n)), np.empty((rows,
 status, done, _ = mod.run_symplectic_euler(
     np.array([0.1, 1.0]), np.array([0.3, -0.2]), 0.0, 0.01, 300, 300, mod.DEFAULT_PARAMS.copy(),
     make_settings(registry.spec("symplectic_euler"), {}), *out)
-print(json.dumps({"copier": type(inline_closurecall.copy).__name__, "status": int(status),
+print(json.dumps({"copier": inline_copy.stats["blocks"] > 0, "status": int(status),
                   "last": [float(x).hex() for x in out[5]]}))
 """
 
@@ -84,13 +84,13 @@ def test_a_stepper_compiled_with_and_without_it_runs_the_same_operations(tmp_pat
     an empty numba cache), numba's copy and ours: the final state must be equal bit for bit."""
     results = {}
     for setting in ("0", "1"):
-        env = dict(os.environ, LAGRANGE_GEN_NUMBA_INLINE_COPY=setting,
+        env = dict(os.environ, LAGRANGE_GEN_SPEEDUPS="all" if setting == "1" else "-inline_copy",
                    NUMBA_CACHE_DIR=str(tmp_path / f"cache{setting}"))
         done = subprocess.run([sys.executable, "-c", _RUN, str(ROOT / "generated")], env=env,
                               capture_output=True, text=True, timeout=600)
         assert done.returncode == 0, done.stderr[-2000:]
         results[setting] = json.loads(done.stdout.strip().splitlines()[-1])
-    assert results["0"]["copier"] == "module" and results["1"]["copier"] == "_BlockCopier"
+    assert results["0"]["copier"] is False and results["1"]["copier"] is True
     assert results["0"]["status"] == results["1"]["status"] == 0
     assert results["0"]["last"] == results["1"]["last"]
     assert np.isfinite([float.fromhex(x) for x in results["1"]["last"]]).all()

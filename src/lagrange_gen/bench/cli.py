@@ -79,6 +79,11 @@ def _stepapi(args):
     run_stepapi_bench(Path(args.reports) / "stepapi.md", models_dir=args.models, quick=args.quick)
 
 
+def _compile(args):
+    from .compile import run_compile_bench
+    print(run_compile_bench(Path(args.reports) / "compile.md", progress=not args.no_progress))
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -102,6 +107,8 @@ SUITES = {
                  _ensemble),
     "stepapi": ("us per Stepper.step call on the cart pole vs simulate per step; controller hook cost",
                 _stepapi),
+    "compile": ("first compile with each numba speedup on and off (LAGRANGE_GEN_SPEEDUPS)",
+                _compile),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

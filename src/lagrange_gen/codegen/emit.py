@@ -137,10 +137,10 @@ def _load_lines(used, order):
 
 
 def render_kernel(spec: KernelSpec, inputs) -> KernelText:
-    """One ``@njit(cache=True, _nrt=False, error_model="numpy")`` kernel (no allocation;
-    reference counting would cost every call from a stepper; with numpy's error model a division
-    by zero gives inf/NaN, which the steppers report as NON_FINITE, instead of raising
-    ZeroDivisionError inside the jitted loop).
+    """One ``@njit(**KERNEL_OPTIONS)`` kernel (lagrange_gen.jit.KERNEL_OPTIONS: cached, no
+    allocation, so no reference counting, which would cost every call from a stepper; numpy's
+    error model, so a division by zero gives inf/NaN, which the steppers report as NON_FINITE,
+    instead of raising ZeroDivisionError inside the jitted loop).
 
     inputs: codegen.printer.Inputs of the model (symbol -> placeholder and load statement).
     """
@@ -174,7 +174,7 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
     views = [f"    {o.name}_f = {o.name}.reshape({o.matrix.shape[0] * o.matrix.shape[1]})"
              for o in spec.outputs if _through_view(o) and not o.local]
     args = ", ".join(spec.signature)
-    lines = ['@njit(cache=True, _nrt=False, error_model="numpy")', f"def {spec.name}({args}):",
+    lines = ['@njit(**KERNEL_OPTIONS)', f"def {spec.name}({args}):",
              f'    """{_doc(spec, zeros, entries)}"""']
     lines += [f"    {line}" for line in spec.prologue]
     lines += _load_lines(used, inputs.loads(spec.args)) + body + views + stores + zero_lines
@@ -214,7 +214,7 @@ def render_column_kernel(spec: KernelSpec, inputs) -> KernelText:
         printed += [f"        {s} = {text(d)}" for s, d in inside]
         printed += [f"        {name}[{i}, k] = {text(se.sympify(e)) if e != 0 else '0.0'}" for i, e in enumerate(column)]
     args = ", ".join(spec.signature)
-    lines = ['@njit(cache=True, _nrt=False, error_model="numpy")', f"def {spec.name}({args}):",
+    lines = ['@njit(**KERNEL_OPTIONS)', f"def {spec.name}({args}):",
              f'    """{spec.doc}."""']
     lines += _load_lines(used, inputs.loads(spec.args)) + body + printed
     n_entries = sum(len(column) * len(column_seeds) for _, column_seeds, column in spec.columns)

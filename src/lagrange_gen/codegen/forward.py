@@ -22,7 +22,7 @@ from .spec import KernelSpec, Output
 #: Largest n whose forward dynamics is emitted as an unrolled LDL^T solve (module docstring).
 UNROLL_MAX = 4
 
-_GENERAL = '''@njit(cache=True, _nrt=False)
+_GENERAL = '''@njit(**KERNEL_OPTIONS)
 def forward_dynamics(q, qd, t, p, H, qdd):
     """Solve H(q) qdd = rhs by Cholesky; H (n, n) is workspace, qdd (n,) the output.
     Returns OK, or SINGULAR_MASS when H is not numerically positive definite."""
@@ -47,7 +47,7 @@ _CONSTANT = '''def _factor_mass_matrix(p):
 MASS_FACTOR = _factor_mass_matrix(DEFAULT_PARAMS)
 
 
-@njit(cache=True, _nrt=False)
+@njit(**KERNEL_OPTIONS)
 def forward_dynamics(q, qd, t, p, H, qdd):
     """Solve H qdd = rhs with the constant H: by MASS_FACTOR (no factorization) when the
     parameters H depends on have their default values, else by factoring H into the workspace
@@ -86,7 +86,7 @@ def accelerations(q, qd, t=0.0, params=None):
 
 _WITH_TORQUES = '''
 
-@njit(cache=True, _nrt=False)
+@njit(**KERNEL_OPTIONS)
 def forward_dynamics_torques(q, qd, tau, t, p, H, qdd):
     """Solve H(q) qdd = rhs + tau for generalized forces tau (n,) added to the model's own
     (joint torques); H (n, n) is workspace, qdd (n,) the output. Returns OK or SINGULAR_MASS."""
@@ -99,7 +99,7 @@ def forward_dynamics_torques(q, qd, tau, t, p, H, qdd):
     return OK
 
 
-@njit(cache=True, _nrt=False)
+@njit(**KERNEL_OPTIONS)
 def forward_dynamics_jacobian(q, qd, t, p, H, qdd, Jq, Jqd, W):
     """qdd (n,) = H^-1 rhs and its derivatives Jq = d qdd/dq, Jqd = d qdd/dqd (n, n):
     H Jq = d rhs/dq - d(H w)/dq at w = qdd, H Jqd = d rhs/dqd, solved with the factor of H.

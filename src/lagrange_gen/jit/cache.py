@@ -15,9 +15,16 @@ here. With ``cache=True`` it changes two things in numba's cache (numba.core.cac
   else) is a cache miss: the entry is removed, the function compiled again, and one warning line
   printed per source file.
 
+The closure key reaches into numba's cache (FunctionCache, its index file's ``_source_stamp``):
+``closure_cache_unsupported`` checks those on first use. When they are not as expected, a
+package function is compiled without numba's cache (numba's own key could serve a stale entry),
+with one warning line; any error while making the stamp is a cache miss, never a hit.
+
 An uncached function of the stepper library (CALLEE_MODULES) is compiled without numba's
 CPython and cfunc wrappers, which only a call from Python or a first-class function value would
-use; a call from Python still works, through a twin compiled on first use (jit_callee).
+use; a call from Python still works, through a twin compiled on first use (jit.callee).
+
+Every dispatcher made here compiles inside jit.speedups.compiling (the speedups' scope).
 
 numba is imported on first use, so importing this module costs nothing.
 """
@@ -27,35 +34,52 @@ from __future__ import annotations
 import functools
 import glob
 import json
-import os
 import sys
 from pathlib import Path
 
 from ..codegen.sources import module_name, source_closure, source_hashes
-from .typing_memo import install as install_typing_memo
+from . import speedups
 
 
 def njit(*args, **kwargs):
     """``numba.njit(**kwargs)``, usable as ``@njit`` or ``@njit(...)``; with ``cache=True`` the
     cache is keyed and guarded as the module docstring says, and an uncached function of the
-    stepper library is compiled for jitted callers only (compiled_for_jitted_callers, jit_callee).
-    The first call installs numba_typing_memo (faster typing of the kernels' scalar arithmetic)
-    and compile_gc (Python's garbage collector runs rarely while numba compiles)."""
+    stepper library is compiled for jitted callers only (compiled_for_jitted_callers, jit.callee).
+    The dispatcher compiles inside jit.speedups.compiling."""
     import numba
 
-    from .compile_gc import install as install_compile_gc
-    install_typing_memo()
-    install_compile_gc()
-
     def decorate(fn):
-        if compiled_for_jitted_callers(fn, kwargs):
+        options = dict(kwargs)
+        if compiled_for_jitted_callers(fn, options):
             from .callee import callee_dispatcher
-            return callee_dispatcher(fn, kwargs)
-        return _guard_cache(numba.njit(**kwargs)(fn))
+            return speedups.scope(callee_dispatcher(fn, options))
+        package = options.get("cache") and module_name(fn.__code__.co_filename) is not None
+        if package and closure_cache_unsupported() is not None:
+            speedups.fallback("closure_cache", closure_cache_unsupported())
+            options["cache"] = False
+        return speedups.scope(_guard_cache(numba.njit(**options)(fn)))
 
     if args:                                   # used as @njit without arguments
         return decorate(args[0])
     return decorate
+
+
+@functools.lru_cache(maxsize=None)
+def closure_cache_unsupported():
+    """None when numba's cache has what the closure key and the miss-on-error guard use, else
+    why not (then a package function is compiled uncached)."""
+    import inspect
+    try:
+        from numba.core import caching
+        if not all(hasattr(caching.FunctionCache, n) for n in ("load_overload", "save_overload")):
+            return "numba's FunctionCache lacks load_overload/save_overload"
+        if "self._cache_file" not in inspect.getsource(caching.Cache.__init__):
+            return "numba's Cache no longer keeps _cache_file"
+        if "_source_stamp" not in inspect.getsource(caching.IndexDataCacheFile._load_index):
+            return "numba's cache index no longer checks _source_stamp"
+    except Exception as exc:
+        return f"{type(exc).__name__}: {exc}".splitlines()[0]
+    return None
 
 
 #: Package modules (relative to lagrange_gen) whose uncached functions only jitted code calls.
@@ -65,17 +89,12 @@ CALLEE_MODULES = ("steppers.",)
 def compiled_for_jitted_callers(fn, options) -> bool:
     """Whether ``fn`` (decorated with numba ``options``) is compiled without numba's wrappers:
     it is defined in CALLEE_MODULES and not cached (a cached function is loaded through its
-    wrapper). $LAGRANGE_GEN_NUMBA_WRAPPERS=1 keeps the wrappers on every function."""
-    if options.get("cache") or os.environ.get(WRAPPERS_ENV) == "1":
+    wrapper). Only when $LAGRANGE_GEN_SPEEDUPS selects callee and numba takes its options."""
+    if options.get("cache"):
         return False
     name = module_name(fn.__code__.co_filename) or ""
     return any(name == module or (module.endswith(".") and name.startswith(module))
-               for module in CALLEE_MODULES)
-
-
-#: Environment variable: "1" compiles every function with numba's wrappers (the comparison of
-#: tests/test_jit_callee.py, and a way out should a numba release break jit_callee).
-WRAPPERS_ENV = "LAGRANGE_GEN_NUMBA_WRAPPERS"
+               for module in CALLEE_MODULES) and speedups.enabled("callee")
 
 
 def closure_stamp(path) -> str:
@@ -85,7 +104,10 @@ def closure_stamp(path) -> str:
 
 
 def _guard_cache(dispatcher):
-    from numba.core.caching import FunctionCache
+    try:
+        from numba.core.caching import FunctionCache
+    except ImportError:        # closure_cache_unsupported said so: package functions uncached
+        return dispatcher
     cache = getattr(dispatcher, "_cache", None)
     if type(cache) is not FunctionCache:       # not cached (NullCache), or already guarded
         return dispatcher
@@ -132,22 +154,32 @@ def closure_keyed_cache_class():
         # these functions without touching their caches.
         closure_source = None
 
-        def _stamp_closure(self):
-            if self.closure_source is not None:
-                # numba compares this stamp with the one stored in the index file: a mismatch
-                # drops every entry of the function (caching.IndexDataCacheFile._load_index).
-                cache_file = self._cache_file
-                cache_file._source_stamp = (cache_file._source_stamp,
-                                            closure_stamp(self.closure_source))
-                self.closure_source = None
+        # False once the stamp could not be made: then nothing is loaded or saved
+        stamped = None
+
+        def _stamp_closure(self) -> bool:
+            if self.stamped is None:
+                try:
+                    # numba compares this stamp with the one stored in the index file: a
+                    # mismatch drops every entry of the function (IndexDataCacheFile._load_index).
+                    cache_file = self._cache_file
+                    stamp = (cache_file._source_stamp, closure_stamp(self.closure_source))
+                    cache_file._source_stamp = stamp
+                    self.stamped = True
+                except Exception as exc:          # no stamp: no hit either
+                    self.stamped = False
+                    speedups.fallback("closure_cache", f"stamp of {self.closure_source}: "
+                                      f"{type(exc).__name__}: {exc}".splitlines()[0])
+            return self.stamped
 
         def load_overload(self, sig, target_context):
-            self._stamp_closure()
+            if not self._stamp_closure():
+                return None
             return super().load_overload(sig, target_context)
 
         def save_overload(self, sig, data):
-            self._stamp_closure()
-            super().save_overload(sig, data)
+            if self._stamp_closure():
+                super().save_overload(sig, data)
 
     return ClosureKeyedCache
 
@@ -158,15 +190,20 @@ _WARNED = set()
 def _discard_entry(cache, exc):
     """Delete one function's cache files (index and data; names as numba.core.caching makes
     them) and warn once per source file."""
-    directory, base = Path(cache.cache_path), cache._impl.filename_base
-    removed = 0
-    for entry in [directory / f"{base}.nbi", *directory.glob(f"{glob.escape(base)}.*.nbc")]:
+    removed, directory = 0, "?"
+    try:
+        directory, base = Path(cache.cache_path), cache._impl.filename_base
+        entries = [directory / f"{base}.nbi", *directory.glob(f"{glob.escape(base)}.*.nbc")]
+    except Exception:            # numba's names moved: the entry stays, the load still missed
+        entries = []
+    for entry in entries:
         try:
             entry.unlink()
             removed += 1
         except OSError:
             pass
-    source = cache._py_func.__code__.co_filename
+    source = getattr(getattr(cache, "_py_func", None), "__code__", None)
+    source = source.co_filename if source else "?"
     if source not in _WARNED:
         _WARNED.add(source)
         what = f"{type(exc).__name__}: {exc}".splitlines()[0]

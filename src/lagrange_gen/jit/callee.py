@@ -13,7 +13,7 @@ Measured (a new process with an empty NUMBA_CACHE_DIR and portable directory, fi
 10 steps with the portable glue, this 2-core machine), seconds with the wrappers -> without:
 cart pendulum midpoint 9.8 -> 8.1, verlet 13.5 -> 11.4, rk4 5.4 -> 3.9; Cartesian pendulum
 rattle 15.4 -> 12.7. The compiled steps are the same: tests/test_jit_callee.py compares a run's
-bits with and without ($LAGRANGE_GEN_NUMBA_WRAPPERS=1 keeps the wrappers, lagrange_gen.jit).
+bits with and without ($LAGRANGE_GEN_SPEEDUPS=-callee keeps the wrappers, jit.speedups).
 
 numba itself gives a function compiled without the CPython wrapper no safe Python entry: calling
 it from Python jumps to an entry point that does not exist (a segmentation fault, measured). A
@@ -30,6 +30,15 @@ from numba.core.registry import CPUDispatcher
 
 #: numba target options that drop the two wrappers.
 NO_WRAPPERS = dict(no_cpython_wrapper=True, no_cfunc_wrapper=True)
+
+
+def unsupported():
+    """None when numba's CPU target takes the NO_WRAPPERS options, else why not."""
+    options = CPUDispatcher.targetdescr.options
+    missing = [name for name in NO_WRAPPERS if not hasattr(options, name)]
+    if missing:
+        return f"numba's CPU target options lack {', '.join(missing)}"
+    return None
 
 
 class CalleeDispatcher(CPUDispatcher):

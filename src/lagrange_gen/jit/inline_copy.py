@@ -17,19 +17,15 @@ the same way: the inlining pass 4.8 -> 1.1 s, run_verlet's compile 12.7 -> 9.8 s
 code is the same: tests/test_numba_inline_copy.py compares the copies with numba's own, and a
 stepper compiled in two fresh processes, with and without it, bit for bit.
 
-It is installed by lagrange_gen.steppers (everything that compiles a stepper imports it) only
-when inline_closurecall still makes exactly that call (its source is checked), and not at all
-when $LAGRANGE_GEN_NUMBA_INLINE_COPY is "0".
+Active only while a lagrange_gen function compiles (jit.speedups.compiling), when
+$LAGRANGE_GEN_SPEEDUPS selects inline_copy and inline_closurecall still makes exactly that call
+(its source is checked, ``unsupported``).
 """
 
 from __future__ import annotations
 
 import copy
 import inspect
-import os
-
-#: Environment variable: "0" leaves numba's inliner as it is.
-ENV = "LAGRANGE_GEN_NUMBA_INLINE_COPY"
 
 #: The statement of numba's copy_ir this module speeds up; no install if the source lacks it.
 _EXPECTED_CALL = "copy.deepcopy(the_ir.blocks[block_label])"
@@ -52,6 +48,7 @@ class _BlockCopier:
         copies the blocks of one IR one after another, nothing in between)."""
         if memo is not None or not isinstance(x, self._ir.Block):
             return copy.deepcopy(x, memo)
+        stats["blocks"] += 1
         scope = x.scope
         size = len(scope.localvars._con)
         source, source_size, scope_copy = self._last
@@ -61,21 +58,29 @@ class _BlockCopier:
         return copy.deepcopy(x, {id(scope): scope_copy})
 
 
-def install() -> bool:
-    """Install the block copier into numba's inliner (once). True when it is installed."""
-    if os.environ.get(ENV) == "0":
-        return False
-    try:
-        from numba.core import inline_closurecall, ir
-        if isinstance(inline_closurecall.copy, _BlockCopier):
-            return True
-        if inline_closurecall.copy is not copy:
-            return False
-        if _EXPECTED_CALL not in inspect.getsource(inline_closurecall.InlineWorker.inline_ir):
-            return False
-        if not hasattr(ir.Scope(None, ir.Loc("", 0)).localvars, "_con"):
-            return False
-    except Exception:       # numba internals moved: leave them alone
-        return False
+def unsupported():
+    """None when numba's inliner copies blocks as the copier expects, else why not."""
+    from numba.core import inline_closurecall, ir
+    if not (inline_closurecall.copy is copy or isinstance(inline_closurecall.copy, _BlockCopier)):
+        return "numba.core.inline_closurecall.copy is not the copy module"
+    if _EXPECTED_CALL not in inspect.getsource(inline_closurecall.InlineWorker.inline_ir):
+        return "numba's InlineWorker.inline_ir no longer deep-copies block by block"
+    if not hasattr(ir.Scope(None, ir.Loc("", 0)).localvars, "_con"):
+        return "numba's ir.Scope.localvars has no _con"
+    return None
+
+
+#: Blocks copied by the copier in this process (the tests tell from it that it ran).
+stats = {"blocks": 0}
+
+
+def activate():
+    """Put the block copier in numba's inliner; returns the undo."""
+    from numba.core import inline_closurecall, ir
+    original = inline_closurecall.copy
     inline_closurecall.copy = _BlockCopier(ir)
-    return True
+
+    def restore():
+        inline_closurecall.copy = original
+
+    return restore

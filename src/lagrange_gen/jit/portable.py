@@ -240,11 +240,40 @@ def runner(module, method):
     return _bound(module, method, f"run_{method}_events" if module.N_EVENTS else f"run_{method}")
 
 
+@functools.lru_cache(maxsize=None)
+def unsupported():
+    """None when numba has what FunctionKernel uses (WrapperAddressProtocol, the cfunc
+    wrapper's name on a function descriptor), else why not: then every run takes the
+    specialized glue (one warning line)."""
+    try:
+        from numba.core.funcdesc import FunctionDescriptor
+        from numba.experimental.function_type import WrapperAddressProtocol
+        for name in ("__wrapper_address__", "signature"):
+            if not hasattr(WrapperAddressProtocol, name):
+                return f"numba's WrapperAddressProtocol lacks {name}"
+        if not hasattr(FunctionDescriptor, "llvm_cfunc_wrapper_name"):
+            return "numba's FunctionDescriptor lacks llvm_cfunc_wrapper_name"
+    except Exception as exc:
+        return f"{type(exc).__name__}: {exc}".splitlines()[0]
+    return None
+
+
+def _portable_off(jit) -> bool:
+    """Whether the portable glue cannot run (unsupported); warns once when a run wanted it."""
+    reason = unsupported()
+    if reason is not None and jit != "specialized":
+        from .speedups import fallback
+        fallback("portable", reason)
+    return reason is not None
+
+
 def choose(jit, specialized, module, method, args):
     """(glue, "specialized" or "portable") for a first call with ``args``: jit="specialized"
     the module's glue; "portable" the portable one; "auto" the module's glue when it runs
-    ``args`` without compiling (specialized_ready), else the portable one."""
-    if jit == "specialized" or (jit == "auto" and specialized_ready(specialized, args)):
+    ``args`` without compiling (specialized_ready), else the portable one. The module's glue
+    whenever numba lacks what the portable glue uses (unsupported)."""
+    if jit == "specialized" or _portable_off(jit) or (
+            jit == "auto" and specialized_ready(specialized, args)):
         return specialized, "specialized"
     return runner(module, method), "portable"
 
@@ -257,7 +286,7 @@ def choose_ensemble(jit, specialized, module, method, args):
         from ..errors import SimulationError
         raise SimulationError(f"{module.NAME}: the portable ensemble glue has no event code and "
                               f"this model has events; use jit='auto' or 'specialized'")
-    if jit == "specialized" or module.N_EVENTS or (
+    if jit == "specialized" or module.N_EVENTS or _portable_off(jit) or (
             jit == "auto" and specialized_ready(specialized, args)):
         return specialized, "specialized"
     return _bound(module, method, f"ensemble_{method}"), "portable"

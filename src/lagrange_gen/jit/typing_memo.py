@@ -22,43 +22,45 @@ assembly of every kernel of two models with and without the memo).
 The stepper glue hardly changes (run_verlet of the cart pendulum 10.4 s either way): its calls
 take arrays.
 
-Installed by lagrange_gen.jit.njit (through which everything the package compiles goes), not
-at all when $LAGRANGE_GEN_NUMBA_TYPING_MEMO is "0", or when numba's function types no longer
-look as expected.
+Active only while a lagrange_gen function compiles (jit.speedups.compiling), when
+$LAGRANGE_GEN_SPEEDUPS selects typing_memo and numba's get_call_type still records the
+implementation key as the memo expects (``unsupported``).
 """
 
 from __future__ import annotations
 
 import inspect
-import os
 
-#: Environment variable: "0" leaves numba's call typing as it is.
-ENV = "LAGRANGE_GEN_NUMBA_TYPING_MEMO"
+#: The statement of numba's get_call_type the memo stands for: a resolution records the
+#: template's implementation key, which the lowering looks up.
+_EXPECTED = "self._impl_keys[sig.args] = temp.get_impl_key(sig)"
 
-_state = {"installed": None, "hits": 0, "misses": 0}
+_state = {"hits": 0, "misses": 0}
+#: {(typing context, function type, argument types): (signature, implementation key)}: kept
+#: between compiles (the function types and contexts are numba's, alive for the process).
+_memo: dict = {}
 
 
-def install() -> bool:
-    """Wrap numba's BaseFunction.get_call_type with the memo (once). True when installed."""
-    if _state["installed"] is not None:
-        return _state["installed"]
-    _state["installed"] = False
-    if os.environ.get(ENV) == "0":
-        return False
-    try:
-        from numba.core import types
-        from numba.core.types.functions import BaseFunction
-        original = BaseFunction.get_call_type
-        # The memo stands for this statement of numba's: a resolution records the template's
-        # implementation key, which the lowering looks up.
-        if "self._impl_keys[sig.args] = temp.get_impl_key(sig)" not in inspect.getsource(original):
-            return False
-        plain = (types.Float, types.Integer, types.Boolean)
-        literal = types.Literal
-    except Exception:       # numba internals moved: leave them alone
-        return False
+def unsupported():
+    """None when numba's BaseFunction.get_call_type is as the memo expects, else why not."""
+    from numba.core import types
+    from numba.core.types.functions import BaseFunction
+    original = BaseFunction.get_call_type
+    if _EXPECTED not in inspect.getsource(original):
+        return "numba's BaseFunction.get_call_type no longer records _impl_keys as expected"
+    if not all(hasattr(types, n) for n in ("Float", "Integer", "Boolean", "Literal")):
+        return "numba.core.types lacks a scalar type class"
+    return None
 
-    memo = {}
+
+def activate():
+    """Wrap numba's BaseFunction.get_call_type with the memo; returns the undo."""
+    from numba.core import types
+    from numba.core.types.functions import BaseFunction
+    original = BaseFunction.__dict__["get_call_type"]
+    plain = (types.Float, types.Integer, types.Boolean)
+    literal = types.Literal
+    memo = _memo
 
     def get_call_type(self, context, args, kws):
         if kws or not all(isinstance(a, plain) and not isinstance(a, literal) for a in args):
@@ -78,10 +80,13 @@ def install() -> bool:
 
     get_call_type.__wrapped__ = original
     BaseFunction.get_call_type = get_call_type
-    _state["installed"] = True
-    return True
+
+    def restore():
+        BaseFunction.get_call_type = original
+
+    return restore
 
 
 def stats() -> dict:
-    """{"installed": bool or None (not tried yet), "hits": int, "misses": int} in this process."""
+    """{"hits": int, "misses": int} of the memo in this process."""
     return dict(_state)

@@ -8,10 +8,10 @@ a prescribed strain path this is the play (backlash) operator; the element force
 """
 
 import numpy as np
-from ..jit.cache import njit
+from ..jit import NO_REFCOUNT, njit
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def return_map(u, ds, eta):
     """u+ = clamp(u + ds, -eta, eta) (scalars)."""
     return min(max(u + ds, -eta), eta)

@@ -9,9 +9,3 @@ registry.py lists the methods (registry.METHODS, registry.INFO), codegen.glue wr
 ``run_<method>`` glue into generated modules; lagrange_gen.simulate is the Python driver.
 The steppers import jit and numpy, never sympy, derive or codegen.
 """
-
-from ..jit.inline_copy import install as _install_inline_copy
-
-# numba's inliner copies a callee's scope once per block; the steppers inline large functions
-# (lagrange_gen/numba_inline_copy.py measures it).
-_install_inline_copy()

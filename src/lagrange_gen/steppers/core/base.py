@@ -40,7 +40,7 @@ level into the glue): every separately compiled layer re-optimizes everything be
 0.5 s of compile time per layer, per method and per model (the stepping loop is one such layer,
 paid for its speed: see stepping_loop).
 
-Speed: everything called once or more per step is compiled with ``_nrt=False`` (numba's switch
+Speed: everything called once or more per step is compiled with jit.NO_REFCOUNT (numba's switch
 for "no reference counting"; none of these functions allocates). With reference counting on,
 numba increments and decrements an atomic counter for every array argument of every call and
 every array view that its pruning pass cannot prove redundant, which is most of them in
@@ -68,7 +68,7 @@ fields (empty for the unconstrained methods).
 import math
 
 import numpy as np
-from ...jit.cache import njit
+from ...jit import NO_REFCOUNT, njit
 
 from . import linalg
 from .status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
@@ -77,7 +77,7 @@ from .status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON, UNSTABLE
 #: error_model="numpy": a division by zero gives inf/NaN (caught as NON_FINITE by check_state or
 #: failed_solve_status) instead of raising ZeroDivisionError from inside the jitted loop, and
 #: numba drops its zero-divisor checks on every division.
-FAST = dict(_nrt=False, error_model="numpy")
+FAST = dict(**NO_REFCOUNT, error_model="numpy")
 
 # Columns of ``out_stats`` (n_saves, N_STATS), one row per saved state.
 STAT_ENERGY = 0     # E = T + V at the saved state

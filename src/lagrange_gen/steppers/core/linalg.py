@@ -1,6 +1,6 @@
 """Small dense linear algebra in numba, in place, no allocation (used by kernels and steppers).
 
-Compiled without numba's reference counting (``_nrt=False``): none of these functions allocates,
+Compiled without numba's reference counting (jit.NO_REFCOUNT): none of these functions allocates,
 and with it every call pays atomic increments per array argument (see steppers/core/base.py).
 
 2 x 2 systems (the cart pendulum, every two-coordinate model, and its Newton matrices) take a
@@ -23,14 +23,14 @@ variants were slower at n = 8 to 24 (/tmp/s2/ch.py: 424 against 522 and 672 ns a
 
 import math
 
-from ...jit.cache import njit
+from ...jit import NO_REFCOUNT, njit
 
 # Relative pivot threshold below which a matrix is reported singular instead of being factored
 # into garbage (e.g. the spherical pendulum's H at sin(q1) = 0).
 SINGULAR_RTOL = 1e-13
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def cholesky_inplace(A):
     """Overwrite the lower triangle of the SPD matrix A (n, n) with its Cholesky factor L.
 
@@ -41,7 +41,7 @@ def cholesky_inplace(A):
     return _cholesky_loops(A)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _cholesky_loops(A):
     """cholesky_inplace for any n."""
     n = A.shape[0]
@@ -66,7 +66,7 @@ def _cholesky_loops(A):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def cholesky_solve_inplace(L, b):
     """Solve (L L^T) x = b with L from cholesky_inplace; b (n,) is overwritten by x."""
     if L.shape[0] == 2:
@@ -81,7 +81,7 @@ def cholesky_solve_inplace(L, b):
         _cholesky_solve_loops(L, b)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _cholesky_solve_loops(L, b):
     """cholesky_solve_inplace for any n."""
     n = L.shape[0]
@@ -100,7 +100,7 @@ def _cholesky_solve_loops(L, b):
             b[k] -= L[i, k] * x
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _eliminate(A, piv, b):
     """Gaussian elimination with partial pivoting of A (n, n) in place, leaving its LU factors
     and the row permutation in piv (n,) int64; the swaps and eliminations are applied to b as
@@ -147,7 +147,7 @@ def _eliminate(A, piv, b):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _cholesky_2(A):
     """cholesky_inplace of a 2 x 2 A on scalars (same operations, same test)."""
     a00, a10, a11 = A[0, 0], A[1, 0], A[1, 1]
@@ -166,7 +166,7 @@ def _cholesky_2(A):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _lu_solve_system_2(A, piv, b):
     """lu_solve_system of a 2 x 2 A on scalars: the same pivot choice (swap only for a strictly
     larger entry), singularity test, factors left in A and permutation in piv."""
@@ -197,7 +197,7 @@ def _lu_solve_system_2(A, piv, b):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def lu_inplace(A, piv):
     """LU factorization with partial pivoting of A (n, n) in place; piv (n,) int64 receives the
     row permutation (solve with lu_solve_inplace). Returns False when a pivot is zero relative
@@ -205,7 +205,7 @@ def lu_inplace(A, piv):
     return _eliminate(A, piv, A[0, :0])
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def lu_solve_system(A, piv, b):
     """Solve A x = b in one pass: elimination with the right-hand side carried along (no
     separate forward substitution), then back substitution; A (n, n) is left holding its LU
@@ -216,7 +216,7 @@ def lu_solve_system(A, piv, b):
     return _lu_solve_system_loops(A, piv, b)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _lu_solve_system_loops(A, piv, b):
     """lu_solve_system for any n."""
     if not _eliminate(A, piv, b):
@@ -225,7 +225,7 @@ def _lu_solve_system_loops(A, piv, b):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _back_substitute(U, x):
     """Overwrite x (n,) by U^-1 x for the upper triangle of U (n, n), column by column: x_i is
     final once the rows below have been subtracted, then column i of U updates the entries
@@ -256,7 +256,7 @@ def cholesky_as_lu(A, piv, n):
         A[k, k] = d * d
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def lu_solve_inplace(LU, piv, b, work):
     """Solve A x = b from lu_inplace's output; b (n,) is overwritten by x, work (n,) is scratch."""
     if LU.shape[0] == 2:        # the loops' operations on scalars (see the module docstring)
@@ -269,7 +269,7 @@ def lu_solve_inplace(LU, piv, b, work):
         _lu_solve_inplace_loops(LU, piv, b, work)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, **NO_REFCOUNT)
 def _lu_solve_inplace_loops(LU, piv, b, work):
     """lu_solve_inplace for any n."""
     n = LU.shape[0]
