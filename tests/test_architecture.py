@@ -15,13 +15,7 @@ PACKAGE = Path(lagrange_gen.__file__).resolve().parent
 
 #: Circles that stay until the module named in the reason is split. The test fails when one of
 #: them goes (so that the entry is removed) or when another appears.
-KNOWN_CIRCLES = {
-    frozenset({"steppers.core.base", "steppers.core.events", "steppers.core.hermite",
-               "steppers.core.work"}):
-        "base.py holds the numba options (FAST), accel and copy_into that events, hermite and "
-        "work use, and its run loop calls them; splitting base.py by job (issue 29, part 4) "
-        "breaks the circle",
-}
+KNOWN_CIRCLES = {}
 
 
 def _modules():

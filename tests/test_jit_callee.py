@@ -79,19 +79,19 @@ def test_a_call_from_python_runs_a_twin_with_wrappers_and_the_same_result():
 
 # A first simulate in a fresh process with empty numba and portable caches; prints the class of
 # midpoint's step (to show which compile ran), the final state's bits, and the signatures
-# base.save_row was compiled for.
+# output.save_row was compiled for.
 _RUN = """
 import json, os, sys, tempfile
 os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp()
 os.environ["LAGRANGE_GEN_PORTABLE_DIR"] = tempfile.mkdtemp()
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.run.simulate import simulate
-from lagrange_gen.steppers.core import base
+from lagrange_gen.steppers.core import output
 from lagrange_gen.steppers.methods import midpoint
 mod = import_generated(os.path.join(sys.argv[1], "generated", "cart_pendulum.py"))
 tr = simulate(mod, "midpoint", [0.1, 1.0], [0.3, -0.2], t_end=0.2, h=1e-2)
 print(json.dumps([type(midpoint.step).__name__, [x.hex() for x in tr.q[-1]],
-                  [x.hex() for x in tr.v[-1]], [str(sig) for sig in base.save_row.signatures]]))
+                  [x.hex() for x in tr.v[-1]], [str(sig) for sig in output.save_row.signatures]]))
 """
 
 
@@ -111,7 +111,7 @@ def test_a_stepper_compiled_without_wrappers_gives_the_same_bits():
 
 
 def test_the_run_loop_compiles_one_save_per_glue():
-    """base.save_row is compiled separately (cached); run_loop's calls must agree on its argument
+    """output.save_row is compiled separately (cached); run_loop's calls must agree on its argument
     types, or each first compile of a glue pays for a second one (a literal row 0 did)."""
     signatures = _run(False)[3]
     assert len(signatures) == 1, signatures

@@ -65,7 +65,7 @@ import numpy as np
 sys.path.insert(0, sys.argv[1])
 import cart_pendulum as mod
 from lagrange_gen.jit import inline_copy
-from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core import registry
 from lagrange_gen.steppers.core.method_spec import make_settings
 n, rows = 2, 2

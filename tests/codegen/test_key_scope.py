@@ -134,10 +134,10 @@ def test_comment_in_a_glued_stepper_makes_the_module_stale(cart, package_copy, t
     first = generate_model(model, out)
     mod = import_generated(first.path)
     fields = [mod.KEY, mod.SOURCES, mod.MODEL_PATH, mod.OPTIONS, mod.TEXT_SHA]
-    _add_comment(package_copy / "steppers" / "core" / "base.py")          # shared by every stepper
-    with pytest.raises(StaleModuleError, match=r"steppers/core/base\.py changed since generation.*lagrange-gen"):
+    _add_comment(package_copy / "steppers" / "core" / "options.py")       # shared by every stepper
+    with pytest.raises(StaleModuleError, match=r"steppers/core/options\.py changed since generation.*lagrange-gen"):
         keys.check_current(first.path, *fields)
-    assert "stepper sources changed: steppers/core/base.py" in check_generated(model, out)[1]
+    assert "stepper sources changed: steppers/core/options.py" in check_generated(model, out)[1]
     second = generate_model(model, out)
     assert second.written and second.key != first.key
 

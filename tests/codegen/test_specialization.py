@@ -35,7 +35,7 @@ def _generate(tmp_path, model, **kwargs):
 
 
 def test_method_needs_are_read_from_the_stepper_sources():
-    # (N_COORDS: the loop bound of every step, steppers/core/base.py "Loop bounds")
+    # (N_COORDS: the loop bound of every step, steppers/core/options.py "Loop bounds")
     assert method_needs("explicit_euler", with_loop=False) == {"forward_dynamics", "N_COORDS"}
     # the run loop adds the energy of saved states and the event functions (and, to
     # interpolate a step with events, the forward dynamics and the model's counts)

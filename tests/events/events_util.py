@@ -15,7 +15,7 @@ from conftest import glue
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core import registry
-from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings
 
 MODELS = Path(__file__).resolve().parent / "models"

@@ -15,7 +15,7 @@ import pytest
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core import registry
-from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings
 from lagrange_gen.steppers.core.status import OK
 from conftest import glue

@@ -14,7 +14,7 @@ from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.needs import method_needs
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core import registry
-from lagrange_gen.steppers.core.base import N_STATS, STAT_ITERS, STAT_RESIDUAL
+from lagrange_gen.steppers.core.layout import N_STATS, STAT_ITERS, STAT_RESIDUAL
 from lagrange_gen.steppers.core.method_spec import make_settings
 from lagrange_gen.steppers.core.status import NON_FINITE, OK, UNSTABLE
 from lagrange_gen.steppers.core.status import STEP_TOO_SMALL, TOO_MANY_STEPS

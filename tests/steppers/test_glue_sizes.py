@@ -1,6 +1,6 @@
 """The glue refuses a state whose size is not the model's.
 
-The steps loop to kern.N_COORDS (steppers/core/base.py, "Loop bounds") and the kernels index q and
+The steps loop to kern.N_COORDS (steppers/core/options.py, "Loop bounds") and the kernels index q and
 qd by the model's coordinates, so a q0 or v0 of another length would be read past its end or
 integrated with its extra entries silently ignored: run_loop and run_adaptive raise instead,
 naming the sizes."""
@@ -10,7 +10,7 @@ import pytest
 
 from conftest import glue
 from lagrange_gen.steppers.core import registry
-from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from numba import njit
 
 from lagrange_gen.steppers.core import newton
-from lagrange_gen.steppers.core.base import FAST
+from lagrange_gen.steppers.core.options import FAST
 from lagrange_gen.steppers.core.status import NEWTON_DIVERGED, NON_FINITE, OK, SINGULAR_NEWTON
 
 ROOTS, SINGULAR, NAN_RESIDUAL, INF_JACOBIAN = 0, 1, 2, 3

@@ -95,7 +95,7 @@ def test_check_state_sorts_every_entry_and_bound(bound):
     """base.check_state, run after every step: NaN and +-inf in any entry of q or v are
     NON_FINITE, also under an infinite blow-up bound (its fast path compares |x| <= bound, which
     inf passes when bound is inf); a finite entry past a finite bound is UNSTABLE."""
-    from lagrange_gen.steppers.core.base import check_state
+    from lagrange_gen.steppers.core.state_checks import check_state
     from lagrange_gen.steppers.core.status import NON_FINITE, OK, UNSTABLE
     for bad, expected in ((math.nan, NON_FINITE), (math.inf, NON_FINITE),
                           (-math.inf, NON_FINITE),

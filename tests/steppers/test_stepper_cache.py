@@ -18,7 +18,7 @@ import json, sys
 import numpy as np
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core import registry
-from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings
 mod = import_generated(sys.argv[1])
 out = dict()

@@ -29,7 +29,7 @@ from ..errors import EnergyWarning, SimulationError
 from ..run.consistent import consistent_initial_state
 from ..run.simulate import simulate
 from .steppers import best_of
-from ..steppers.core.base import N_STATS
+from ..steppers.core.layout import N_STATS, events_size, last_size
 from ..steppers.core.method_spec import make_settings
 from ..steppers.core.registry import spec
 
@@ -106,7 +106,7 @@ def _glue_runner(mod, method, n_steps, q0, v0):
     if constrained:
         extra[0, :m] = consistent_initial_state(mod, q0, v0, mod.DEFAULT_PARAMS, warn=False).lam
     out = (np.empty(2), np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)), extra,
-           np.empty(2 * n + 3 + n_saved), np.empty((0, 3 + 2 * n)))
+           np.empty(last_size(n, n_saved)), np.empty((0, events_size(n))))
     settings = make_settings(spec(method), {})
     run = getattr(mod, f"run_{method}")
 

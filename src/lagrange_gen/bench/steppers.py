@@ -31,7 +31,7 @@ from ..jit.cache import njit
 
 from ..analysis.runs import unconstrained_methods
 from ..steppers.core import registry
-from ..steppers.core.base import N_STATS
+from ..steppers.core.layout import N_STATS, events_size, last_size
 from ..steppers.core.method_spec import make_settings
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -83,7 +83,7 @@ def hand_rk4(q0, v0, h, n, p):
 
 @njit(cache=True)
 def _converged(d0, d1, u0, u1, prev, tol):
-    """The library's Newton stopping rule (steppers.base.newton_converged) on 2-vectors."""
+    """The library's Newton stopping rule (steppers.core.newton.newton_converged) on 2-vectors."""
     size = tol * max(1.0, abs(u0), abs(u1))
     d = max(abs(d0), abs(d1))
     if d <= size:
@@ -259,7 +259,7 @@ def library_runner(mod, method, n_steps, run=None):
     n = mod.N_COORDS
     q0, v0 = np.array(Q0), np.array(V0)
     out = (np.empty(2), np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)),
-           np.empty((2, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
+           np.empty((2, 0)), np.empty(last_size(n, 0)), np.empty((0, events_size(n))))
     spec = registry.spec(method)
     settings = make_settings(spec, {"newton_tol": TOL} if "newton_tol" in spec.setting_names()
                              else {})
@@ -314,7 +314,7 @@ import numba  # noqa: F401
 t1 = time.perf_counter()
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core import registry
-from lagrange_gen.steppers.core.base import N_STATS
+from lagrange_gen.steppers.core.layout import N_STATS, events_size, last_size
 from lagrange_gen.steppers.core.method_spec import make_settings
 mod = import_generated(sys.argv[1])
 t2 = time.perf_counter()
@@ -323,7 +323,7 @@ n = mod.N_COORDS
 status, done, _ = run(np.array([0.1, 0.5]), np.zeros(n), 0.0, 1e-3, 1, 1, mod.DEFAULT_PARAMS,
                       make_settings(registry.spec(sys.argv[2]), {}), np.empty(2),
                       np.empty((2, n)), np.empty((2, n)), np.empty((2, N_STATS)),
-                      np.empty((2, 0)), np.empty(2 * n + 3), np.empty((0, 3 + 2 * n)))
+                      np.empty((2, 0)), np.empty(last_size(n, 0)), np.empty((0, events_size(n))))
 t3 = time.perf_counter()
 print(json.dumps({"imports": t1 - t0, "module_import": t2 - t1, "first_step": t3 - t2,
                   "status": int(status), "hits": sum(run.stats.cache_hits.values()),

@@ -30,7 +30,7 @@ def compositions(dyn, selected, needs) -> dict:
         return out
     if "mass_matvec_dq" in selected and "momentum_rate_jacobian" in selected:
         out["momentum_rate_jacobian"] = "d/dqd part = mass_matvec_dq(q, qd)^T + dQ/dqd"
-    # The steppers reach dynamics through the module function forward_dynamics (steppers/core/base.py
+    # The steppers reach dynamics through the module function forward_dynamics (steppers/core/legendre.py
     # accel): a method naming either calls it. (Counting only "dynamics" found no caller once the
     # steppers called forward_dynamics, and the verlet/midpoint module went back to the
     # symbolic dynamics: at 16 links 979 more lines; its kernels' first compile 12.3 s, 10.3 s

@@ -185,8 +185,12 @@ def _n_saved(method, dyn):
 
 def module_sources(methods) -> dict:
     """{package file: hash} of what a module gluing ``methods`` compiles: the stepper modules,
-    the package modules they import and the compiled imports of every module (linalg, status)."""
-    return source_hashes(source_closure([f"steppers.methods.{m}" for m in methods] + list(COMPILED_IMPORTS)))
+    the run loops their glue calls (registry.LOOPS), the package modules they import and the
+    compiled imports of every module (linalg, status)."""
+    from ..steppers.core.registry import LOOPS, spec
+    loops = sorted({f"steppers.core.{LOOPS[spec(m).adaptive][0]}" for m in methods})
+    return source_hashes(source_closure([f"steppers.methods.{m}" for m in methods] + loops
+                                        + list(COMPILED_IMPORTS)))
 
 
 def generate_text(model, out_dir="generated", methods=None, freeze=None):

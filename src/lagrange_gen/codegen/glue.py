@@ -2,7 +2,7 @@
 
 Why glue: numba caches a compiled function on disk only when it takes no function arguments.
 The cores in ``steppers/methods/<method>.py`` are generic over the kernels: they receive the generated
-module itself as their first argument (``kern``; see base.py for why a module and not the
+module itself as their first argument (``kern``; see steppers/core/run_loop.py for why a module and not the
 dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` lives in the
 generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
 and its compiled code, cores included, is loaded from numba's cache by the next process. The
@@ -25,8 +25,9 @@ Glue signature of the fixed-step methods::
                saved fields (multipliers and residuals, element states; none for most)
     out_last   (2 n + 3 + n_saved,)  [t, q, v, Newton iterations since the last save, Newton
                                  residual, saved fields] at the end, or at the failure
+               (steppers/core/layout.py)
     status     lagrange_gen.steppers.core.status code; steps_done = index of the failing step on failure, -1
-               when the initial state is refused (see base.run_loop)
+               when the initial state is refused (see run_loop.run_loop)
 
 Fixed-step methods also get ``ensemble_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
 out_q, out_v, out_stats, out_extra, out_last, out_status)``: the same loop for M members at once
@@ -99,7 +100,7 @@ def run_{method}_events(kern, n_saved, {wrapped}):
 ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
                       "out_q, out_v, out_stats, out_extra, out_last, out_status")
 
-# ensemble_<method> runs member i in _member_<method>: base.run_loop as run_<method> runs it, on
+# ensemble_<method> runs member i in _member_<method>: run_loop.run_loop as run_<method> runs it, on
 # the member's rows of the (M, S, ...) outputs. The member is a separate (cached) function
 # because numba parallelizes a prange loop only when its body has one exit, and run_loop, once
 # inlined, has several (early returns, a raise). S = saved_rows: the final state gets a row when
@@ -110,6 +111,7 @@ _ENSEMBLE_GLUE = '''import math as _math
 
 from numba import prange as _prange
 
+from lagrange_gen.steppers.core import layout as _layout
 from lagrange_gen.steppers.core.status import NON_FINITE as _NON_FINITE
 
 
@@ -119,22 +121,23 @@ def _member_{method}({member_args}):
     n = q0.shape[0]
     saves = n_steps // save_every + 1
     out_t = np.empty(saves)
-    events = np.empty((0, 3 + 2 * n))
+    events = np.empty((0, _layout.event_width(n)))
     status, steps, n_events = _run_loop(
         _stepper_{method}, {loop}{kern}, {n_saved}, {n_events}, q0, v0, t0, h, n_steps,
         save_every, p, settings, out_t, q[:saves], v[:saves], stats[:saves], extra[:saves],
         last, events)
     if status == 0 and (steps % save_every != 0 or steps < n_steps):
         row = steps // save_every + 1
+        v_at, e_at = _layout.v_at(n), _layout.extra_at(n)
         for k in range(n):
-            q[row, k] = last[1 + k]
-            v[row, k] = last[1 + n + k]
-        energy = {kern}.energy(q[row], v[row], last[0], p)
-        stats[row, 0] = energy
-        stats[row, 1] = last[1 + 2 * n]
-        stats[row, 2] = last[2 + 2 * n]
+            q[row, k] = last[_layout.Q + k]
+            v[row, k] = last[v_at + k]
+        energy = {kern}.energy(q[row], v[row], last[_layout.T], p)
+        stats[row, _layout.STAT_ENERGY] = energy
+        stats[row, _layout.STAT_ITERS] = last[_layout.iters_at(n)]
+        stats[row, _layout.STAT_RESIDUAL] = last[_layout.resid_at(n)]
         for k in range(extra.shape[1]):
-            extra[row, k] = last[3 + 2 * n + k]
+            extra[row, k] = last[e_at + k]
         if not _math.isfinite(energy):
             status, steps = _NON_FINITE, steps - 1
     return status, steps, n_events
@@ -179,7 +182,7 @@ def glue_source(method: str, n_saved: int, n_events: int) -> str:
 
 def _stepping_loop_text(method, kern, n_events):
     """The parts of a glue block that bind a fixed-step method's stepping loop
-    (base.stepping_loop) to the generated module (kern "_THIS_MODULE") and its n_events event
+    (run_loop.stepping_loop) to the generated module (kern "_THIS_MODULE") and its n_events event
     functions and pass it to run_loop; the portable glue (kern None) passes None (run_loop
     runs the steps itself), an adaptive method nothing (its loop is adaptive.run_adaptive)."""
     if spec(method).adaptive:
@@ -190,9 +193,9 @@ def _stepping_loop_text(method, kern, n_events):
         # workspaces (ew, iw None), which it could not type
         return dict(loop_import="", loop_def="", loop_arg="None, ", events="1")
     return dict(
-        loop_import="\nfrom lagrange_gen.steppers.core.base import stepping_loop as _stepping_loop",
+        loop_import="\nfrom lagrange_gen.steppers.core.run_loop import stepping_loop as _stepping_loop",
         loop_arg=f"_loop_{method}, ",
-        loop_def=(f"\n\n# run_loop's steps, {method}'s step inlined (base.stepping_loop)"
+        loop_def=(f"\n\n# run_loop's steps, {method}'s step inlined (run_loop.stepping_loop)"
                   f"\n_loop_{method} = _stepping_loop(_stepper_{method}, {kern}, {n_events})"))
 
 

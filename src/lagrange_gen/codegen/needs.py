@@ -1,9 +1,9 @@
 """Which generated kernels a stepper method needs, read from the steppers' source (AST).
 
-A stepper core reaches the generated module only as ``kern`` (see steppers/core/base.py), so the
+A stepper core reaches the generated module only as ``kern`` (see steppers/core/run_loop.py), so the
 kernels a method needs are the attributes ``kern.<name>`` accessed by the functions of
 ``steppers/methods/<method>.py`` and, transitively, by every function of the package they call
-(``from .base import accel``, ``verlet.step`` through ``from . import verlet``, ...). Reading
+(``from ..core.legendre import accel``, ``verlet.step`` through ``from . import verlet``, ...). Reading
 the source instead of keeping a table means a newly added method (rattle, spook, ...) is
 specialized correctly without touching the generator. The analysis is conservative: a kernel
 used on any branch counts (numba types every branch, so it must exist to compile).
@@ -18,14 +18,14 @@ from .sources import module_path, relative_module
 
 _KERN = "kern"                                         # the parameter naming the generated module
 
-#: What a loop function reaches besides its own calls: base.run_loop calls the stepping loop it
-#: is passed (base.stepping_loop, a closure the glue binds), whose body is base.steps.
-_PASSED_IN = {("steppers.core.base", "run_loop"): [("steppers.core.base", "steps")]}
+#: What a loop function reaches besides its own calls: run_loop.run_loop calls the stepping loop
+#: it is passed (run_loop.stepping_loop, a closure the glue binds), whose body is run_loop.steps.
+_PASSED_IN = {("steppers.core.run_loop", "run_loop"): [("steppers.core.run_loop", "steps")]}
 
 
 def method_needs(method: str, with_loop: bool = True) -> frozenset:
     """Names ``kern.<name>`` used by ``steppers/methods/<method>.py`` and everything it calls, and
-    (with_loop) by the run loop its glue calls (base.run_loop or adaptive.run_adaptive: the
+    (with_loop) by the run loop its glue calls (run_loop.run_loop or adaptive.run_adaptive: the
     energy, events, ...). SPEC.kernels declares the method's own (with_loop=False)."""
     from ..steppers.core.registry import LOOPS, spec
     module = f"steppers.methods.{method}"

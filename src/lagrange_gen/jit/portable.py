@@ -3,7 +3,7 @@
 The generated ``run_<method>`` (codegen/glue.py) reaches the model's kernels through the
 generated module, a numba compile-time constant: numba inlines the kernels into the stepper and
 compiles the whole stepper library again for every model (seconds to tens of seconds on first
-use). The portable glue ``run_<method>(kern, n_saved, ...)`` is the same loop (base.run_loop or
+use). The portable glue ``run_<method>(kern, n_saved, ...)`` is the same loop (run_loop.run_loop or
 adaptive.run_adaptive) with the same method module, but ``kern`` is a named tuple of
 first-class functions (the addresses of the model's compiled kernels, typed by numba as
 ``FunctionType(signature)``) and of the module constants the method reads. Its numba type is

@@ -183,7 +183,7 @@ def _kick(module, hk, q, v, u, t, p):
 
 
 def _newton_path(module, stepper):
-    """True when the partitioned method took its Newton path (base.explicit_path is false),
+    """True when the partitioned method took its Newton path (options.explicit_path is false),
     so its workspace holds the Newton solutions."""
     return not (module.MASS_IS_CONSTANT and module.FORCES_VELOCITY_FREE
                 and not stepper.settings.newton_always)

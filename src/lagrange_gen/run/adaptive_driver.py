@@ -18,7 +18,7 @@ from .failures import raise_for_status
 from .fixed_driver import EVENT_ROWS, ProgressBar
 from ..jit.compile_notice import first_use_notice
 from ..steppers.core import status as st
-from ..steppers.core.base import N_STATS
+from ..steppers.core.layout import N_STATS, events_size, last_size, read_last
 
 #: Rows per call into the jitted loop when every accepted step is saved.
 CHUNK_ROWS = 50_000
@@ -36,9 +36,9 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
     n_events, last, counters (4,)}. Raises the exception of a failure status."""
     m, n, t0 = task.module, task.module.N_COORDS, task.t0
     n_saved = initial.shape[0]
-    last = np.empty(2 * n + 3 + n_saved)
+    last = np.empty(last_size(n, n_saved))
     counters = np.array([task.h or 0.0, 0.0, 0.0, 0.0])
-    events = np.zeros((EVENT_ROWS if getattr(m, "N_EVENTS", 0) else 0, 3 + 2 * n))
+    events = np.zeros((EVENT_ROWS if getattr(m, "N_EVENTS", 0) else 0, events_size(n)))
     wanted = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=np.float64)
     run, compile_time = _warm_up(task, q, v, initial, last.copy(), events[:0])
     parts, n_events, t, start = [], 0, t0, time.perf_counter()
@@ -60,8 +60,9 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
                              task.max_iter, counters[C_H], task.p)
         keep = slice(0 if not parts else 1, filled)
         parts.append({k: a[keep] for k, a in buf.items()})
-        q, v, t = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy(), float(last[0])
-        extra0 = last[3 + 2 * n:].copy()
+        final = read_last(last, n)
+        q, v, t = final.q.copy(), final.v.copy(), float(final.t)
+        extra0 = final.extra.copy()
         if len(wanted):
             wanted = wanted[filled - 1:]
         if bar:

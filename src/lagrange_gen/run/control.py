@@ -2,7 +2,7 @@
 
 A model's inputs (``Model(inputs=[u1, ...])``) are the last N_INPUTS entries of its parameter
 vector p, so every generated kernel reads them without a change of signature. Before each step
-(and once at t0) the run loop (steppers/base.run_loop, argument ``control``) calls a jitted
+(and once at t0) the run loop (steppers/run_loop.run_loop, argument ``control``) calls a jitted
 ``apply(data, t, q, v, p) -> changed`` that writes them: a zero-order hold over each step (a
 changed input re-runs the method's prepare, which may have cached forces). Supplied by
 
@@ -27,7 +27,7 @@ from numba.extending import overload
 
 from ..errors import SimulationError
 from .params import resolve_params
-from ..steppers.core.base import FAST
+from ..steppers.core.options import FAST
 
 __all__ = ["Signal", "input_slots", "make_apply", "controlled_run", "resolve_inputs",
            "attach_inputs_outputs"]
@@ -141,7 +141,7 @@ def controlled_run(module, method, apply):
     ``apply`` (compiled on first use in this process, then kept)."""
     import importlib
     from ..steppers.core import registry
-    from ..steppers.core.base import run_loop, stepping_loop
+    from ..steppers.core.run_loop import run_loop, stepping_loop
     key = (module.__name__, module.KEY, method, apply)
     if key not in _RUNS:
         stepper = importlib.import_module(f"lagrange_gen.steppers.methods.{method}")

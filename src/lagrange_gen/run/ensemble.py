@@ -7,7 +7,7 @@
     ens.failures()   # ["member 17: cart_pendulum, explicit_euler: step 312 of 1000 ..."]
 
 The members run in the generated module's ``ensemble_<method>`` (codegen/glue.py): one
-numba parallel loop over members, each member base.run_loop exactly as ``run_<method>`` runs it
+numba parallel loop over members, each member run_loop.run_loop exactly as ``run_<method>`` runs it
 for simulate, so member i equals ``simulate(...)`` with member i's inputs (bitwise, as long as
 simulate runs in one chunk: fixed_run.CHUNK_STEPS steps). Fixed-step methods only. A member that
 fails (blow-up, Newton failure, singular matrix) stops alone: its status, step, time and state are
@@ -33,7 +33,8 @@ from .fixed_driver import ProgressBar, n_steps_to
 from ..jit.portable import choose_ensemble, jit_mode
 from ..steppers.core import status as st
 from ..steppers.core import registry
-from ..steppers.core.base import N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL
+from ..steppers.core.layout import (N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, T,
+                                    last_size, state_slice)
 from ..steppers.core.method_spec import make_settings
 
 __all__ = ["ensemble", "grid", "EnsembleResult"]
@@ -245,7 +246,7 @@ def _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time
         t=t, q=out["q"], v=out["v"], energy=energy,
         newton_iters=out["stats"][:, :, STAT_ITERS].copy(),
         newton_residual=out["stats"][:, :, STAT_RESIDUAL].copy(), saved=saved, status=status,
-        steps_done=done, fail_time=last[:, 0].copy(), fail_state=last[:, 1:1 + 2 * n].copy(),
+        steps_done=done, fail_time=last[:, T].copy(), fail_state=last[:, state_slice(n)].copy(),
         params=p, param_names=tuple(module.PARAMS), coords=tuple(module.COORDS),
         model=module.NAME, method=spec.name, h=h, n_steps=n_steps, wall_time=wall,
         compile_time=compile_time, messages=messages)

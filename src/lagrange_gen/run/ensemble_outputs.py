@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..steppers.core.base import N_STATS
+from ..steppers.core.layout import N_STATS, last_size
 
 
 def allocate_outputs(M, rows, n, n_saved):
@@ -13,7 +13,7 @@ def allocate_outputs(M, rows, n, n_saved):
     return dict(q=np.full((M, rows, n), np.nan), v=np.full((M, rows, n), np.nan),
                 stats=np.full((M, rows, N_STATS), np.nan),
                 extra=np.full((M, rows, n_saved), np.nan),
-                last=np.zeros((M, 2 * n + 3 + n_saved)), status=np.zeros((M, 3), np.int64))
+                last=np.zeros((M, last_size(n, n_saved))), status=np.zeros((M, 3), np.int64))
 
 
 def member_args(q, v, p, t0, h, n_steps, save_every, config, out, members):

@@ -1,6 +1,6 @@
 """Turn a stepper's status code into the exception that names the step, time, state and residual.
 
-The run loop (steppers/core/base.py) stops on a status and leaves in ``last`` the state the failing
+The run loop (steppers/core/run_loop.py) stops on a status and leaves in ``last`` the state the failing
 step started from (Newton failure, singular matrix) or the offending state after it (NON_FINITE,
 UNSTABLE), with steps_done = -1 when the initial state itself was refused. Non-finite values
 anywhere (state, energy, Newton matrix or residual: a division by zero or log of 0 in the model)
@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import BlowUp, NewtonDivergence, SimulationError, SingularMass, SingularNewtonMatrix
 from ..steppers.core import status as st
 from ..steppers.core import registry
+from ..steppers.core.layout import read_last
 
 _DOMAIN = "(division by zero, or log/sqrt outside its domain, in the model's expressions?)"
 
@@ -31,7 +32,7 @@ def raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
     """Raise the exception of status ``code``; step is 1-based, 0 for the initial state;
     n_steps None for an adaptive run (its step count is not known in advance)."""
     n = module.N_COORDS
-    t, q, v, resid = last[0], last[1:1 + n], last[1 + n:1 + 2 * n], last[2 + 2 * n]
+    t, q, v, _, resid = read_last(last, n)[:5]
     state = format_state(module.COORDS, q, v)
     at = "the initial state" if step == 0 else f"step {step}" + (f" of {n_steps}" if n_steps else "")
     where = f"{module.NAME}, {method}: {at} (t = {t:.9g}, h = {h:g})"

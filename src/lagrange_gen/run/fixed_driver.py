@@ -1,7 +1,7 @@
 """Drive a fixed-step method's glue from Python: chunks of steps, progress, failures, events.
 
 simulate (run/simulate.py) checks the inputs and builds the Trajectory; this module runs the
-generated ``run_<method>`` (codegen/glue.py, base.run_loop) chunk by chunk so that a
+generated ``run_<method>`` (codegen/glue.py, run_loop.run_loop) chunk by chunk so that a
 progress bar can be shown, and turns a failure status into the exception naming the step
 (run/failures.py). run/adaptive_driver.py is the same for the adaptive methods.
 """
@@ -17,7 +17,7 @@ import numpy as np
 from .failures import raise_for_status
 from ..jit.compile_notice import first_use_notice
 from ..steppers.core import status as st
-from ..steppers.core.base import N_STATS, STAT_ITERS
+from ..steppers.core.layout import N_STATS, STAT_ITERS, events_size, last_size, read_last
 
 #: Steps per call into the jitted loop (a multiple of save_every is used): large enough that the
 #: Python overhead per chunk (a few microseconds) is negligible, small enough for a progress bar.
@@ -51,7 +51,7 @@ def allocate(rows, n, n_saved, initial, n_events):
     has events, else 0."""
     out = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
                stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)),
-               events=np.zeros((EVENT_ROWS if n_events else 0, 3 + 2 * n)), n_events=0)
+               events=np.zeros((EVENT_ROWS if n_events else 0, events_size(n))), n_events=0)
     if n_saved:
         out["extra"][0] = initial
     return out
@@ -65,7 +65,7 @@ def integrate_fixed(task, q, v, out, progress):
     remaining time passes SPECIALIZE_AFTER_S (task.ran records it). Returns (compile seconds,
     integration seconds). Raises the exception of a failure status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
-    last = np.zeros(2 * n + 4 + out["extra"].shape[1])     # the last entry: W (base.run_loop)
+    last = np.zeros(last_size(n, out["extra"].shape[1], with_work=True))
     args = warm_up_args(q, v, t0, h, task.p, task.settings, out["extra"][:1].copy(),
                         last.copy(), out["events"][:0])
     label = f"run_{task.method} for {m.NAME}"
@@ -91,7 +91,8 @@ def integrate_fixed(task, q, v, out, progress):
         if code != st.OK:
             raise_for_status(code, m, task.method, done + steps + 1, task.n_steps, last,
                              task.max_iter, h, task.p)
-        q, v = last[1:1 + n].copy(), last[1 + n:1 + 2 * n].copy()
+        final = read_last(last, n, with_work=True)
+        q, v = final.q.copy(), final.v.copy()
         if steps < k:                    # a terminal event stopped the run inside this chunk
             done += steps
             row += steps // task.save_every

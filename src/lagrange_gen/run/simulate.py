@@ -34,7 +34,7 @@ from .fixed_driver import allocate, integrate_fixed, n_steps_to
 from ..jit.portable import choose, jit_mode
 from ..steppers.core import status as st
 from ..steppers.core import registry
-from ..steppers.core.base import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK
+from ..steppers.core.layout import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK, read_last
 from ..steppers.core.method_spec import make_settings
 from .trajectory import Trajectory
 
@@ -120,7 +120,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         energy then includes the elastic energy k u^2 / 2 stored in Saint-Venant elements.
     settings: the method's settings by name (its SPEC.settings record; a name the method does
         not have is refused): blowup_bound (BlowUp when |q| or |v| exceeds it) for every method;
-        newton_tol (relative to max(1, |unknown|), see steppers.base.newton_converged) and
+        newton_tol (relative to max(1, |unknown|), see steppers.core.newton.newton_converged) and
         max_iter for the implicit ones; newton_always (the Newton path of the partitioned
         methods even when the model allows the explicit one); spook's compliance (epsilon >= 0)
         and relaxation (d > 0); index1's baumgarte = (alpha, beta); dop853's rtol, atol, h_max.
@@ -267,14 +267,15 @@ def _trajectory(task, out, wall, compile_time):
     steps = out["steps"]
     if steps % task.save_every or steps < task.n_steps:
         row += 1
-        q, v = last[1:1 + n], last[1 + n:1 + 2 * n]
-        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v), float(last[0]), p)
+        final = read_last(last, n, with_work=True)
+        q, v = final.q, final.v
+        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v), float(final.t), p)
         if not math.isfinite(energy):
             raise_for_status(st.NON_FINITE, m, task.method, steps, task.n_steps, last,
                              task.max_iter, h, p)
-        out["t"][row], out["q"][row], out["v"][row] = last[0], q, v
-        out["stats"][row] = (energy, last[1 + 2 * n], last[2 + 2 * n], last[-1])
-        out["extra"][row] = last[3 + 2 * n:-1]
+        out["t"][row], out["q"][row], out["v"][row] = final.t, q, v
+        out["stats"][row] = (energy, final.iters, final.resid, final.work)
+        out["extra"][row] = final.extra
     rows = slice(0, row + 1)
     traj = _build(task, {k: out[k][rows] for k in ("t", "q", "v", "stats", "extra")},
                   out, steps, h, wall, compile_time)

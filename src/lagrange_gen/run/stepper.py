@@ -28,7 +28,8 @@ from .failures import raise_for_status
 from ..linear.linearize import parameter_vector
 from ..steppers.core import status as st
 from ..steppers.core import registry
-from ..steppers.core.base import check_state, fast_loop
+from ..steppers.core.options import fast_loop
+from ..steppers.core.state_checks import check_state
 from ..steppers.core.method_spec import make_settings
 
 __all__ = ["Stepper"]
@@ -51,7 +52,7 @@ def _core_class(module, method, settings_type, ws_type):
     def _advance(q, v, mom, p, settings, ws, extra, clock, info, h, k):
         """k steps; clock = [t0, steps done, t]; info = [iterations, residual]. A function
         of its own without reference counting: jitclass methods count references on every
-        attribute read, which cost as much as the step itself (steppers/core/base.py)."""
+        attribute read, which cost as much as the step itself (steppers/core/options.py)."""
         for _ in range(k):
             t = clock[0] + clock[1] * h
             status, iters, resid = stepper.step(kern, q, v, mom, t, h, p, settings, ws, extra)

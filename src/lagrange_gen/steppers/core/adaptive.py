@@ -10,7 +10,7 @@ The generated glue of an adaptive method (codegen.glue.ADAPTIVE_GLUE_ARGS) calls
     t_eval      (E,) output times, monotone in the direction of integration; E = 0: output at
                 every accepted step
     out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_saved);
-                S >= 2 (ValueError otherwise, like the buffer check of base.run_loop)
+                S >= 2 (ValueError otherwise, like the buffer check of run_loop.run_loop)
     out_last    (2n + 3 + n_saved,) [t, q, v, accepted steps since the last row, last accepted
                 error norm, saved fields] of the state reached (see below)
     out_events  (E', 3 + 2n): located events (see "Events" below)
@@ -83,6 +83,10 @@ direction, p, settings, ws) -> (status, |h|), attempt(kern, q, v, t, h, p, setti
 (status, err) into ws.q_new, ws.v_new, accept(kern, t_new, p, ws) -> status, dense(kern, q, v,
 t, h, p, ws) -> status, interpolate(ws, t, q_out, v_out), advance(q, v, ws), and the constants
 ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS.
+
+Over 300 lines with this contract: the loop, its step-size control and its two ways of saving
+(t_eval rows, events) share the loop's state (t, h, the counters, the rows written), so they
+stay in one module, the contract beside the code it describes.
 """
 
 import math
@@ -90,8 +94,11 @@ import math
 import numpy as np
 from ...jit.cache import njit
 
-from . import events
-from .base import FAST, STAT_WORK, write_last, save_row, check_state
+from . import events, layout
+from .layout import STAT_WORK
+from .options import FAST
+from .output import save_row, write_last
+from .state_checks import check_state
 from .status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 
 
@@ -248,10 +255,11 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     branches are pruned before compiling)."""
     n = q0.shape[0]
     size = out_t.shape[0]
-    if n != kern.N_COORDS or v0.shape[0] != n:      # (the steps loop to N_COORDS: base.py)
+    if n != kern.N_COORDS or v0.shape[0] != n:      # (the steps loop to N_COORDS: options.py)
         raise ValueError("run_<method>: q0 and v0 need N_COORDS entries (the model's "
                          "coordinates)")
-    if out_extra.shape[1] != n_saved or out_last.shape[0] != 2 * n + 3 + n_saved or size < 2:
+    if (out_extra.shape[1] != n_saved or out_last.shape[0] != layout.work_at(n, n_saved)
+            or size < 2):
         raise ValueError("run_<method>: out_extra needs n_saved columns, out_last 2 n + 3 + "
                          "n_saved entries and the outputs at least 2 rows")
     q = q0.copy()

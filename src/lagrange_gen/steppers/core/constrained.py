@@ -9,7 +9,7 @@ and the velocity constraint J v + dPhi/dt = 0 (generated ``constraint_rate``; dP
 and not evaluated, when the constraints are scleronomic, kern.CONSTRAINTS_RHEONOMIC False).
 
 Every constrained method saves the same fields (SPEC.saved), so its ``extra`` buffer (see
-base.run_loop) is, with m = kern.N_CONSTRAINTS::
+run_loop.run_loop) is, with m = kern.N_CONSTRAINTS::
 
     extra[0:m]      lam, the constraint forces (multipliers) at the end of the last step
     extra[m]        max_i |Phi_i(q)|   at the end of the last step
@@ -20,13 +20,15 @@ starts from the multiplier it stopped with. The driver fills row 0 (consistent l
 initial residuals, lagrange_gen.run.consistent). Scratch lives in each method's workspace.
 
 Linear algebra: the augmented (KKT) systems [[A, -B^T], [C, 0]] of the Newton iterations are
-indefinite and go through newton.solve (LU with partial pivoting, base.newton_solve). The
+indefinite and go through newton.solve (LU with partial pivoting, solve.newton_solve). The
 velocity projections use the SPD Schur complement J H^-1 J^T (Cholesky).
 """
 
 from ...jit.cache import njit
 
-from .base import FAST, subtract_transport
+from .legendre import subtract_transport
+
+from .options import FAST
 from .linalg import cholesky_inplace, cholesky_solve_inplace
 from .status import OK, SINGULAR_MASS
 

@@ -5,7 +5,7 @@ the generated module has the kernel ``events(q, v, t, p, out)`` (out (N_EVENTS,)
 constants N_EVENTS, EVENT_NAMES, EVENT_TERMINAL (bool), EVENT_DIRECTION (+1 rising, -1 falling,
 0 both), also when the model has none (N_EVENTS = 0, an empty kernel).
 
-How a step loop uses this module (base.run_loop for the fixed-step methods; the adaptive loop
+How a step loop uses this module (run_loop.run_loop for the fixed-step methods; the adaptive loop
 the same way with its dense output as ``interp``), everything under ``if kern.N_EVENTS > 0``,
 so that on a model without events LLVM removes it from the loop (no work, no allocation)::
 
@@ -37,7 +37,8 @@ from collections import namedtuple
 import numpy as np
 from ...jit.cache import njit
 
-from .base import FAST
+from . import layout
+from .options import FAST
 
 #: Relative (to the step) width of the bracket the crossing time is refined to.
 ROOT_RTOL = 1e-12
@@ -142,12 +143,13 @@ def record(kern, ew, k, t, out_events, n_events):
     is room; returns n_events + 1."""
     if n_events < out_events.shape[0]:
         n = ew.q.shape[0]
-        out_events[n_events, 0] = t
-        out_events[n_events, 1] = k
-        out_events[n_events, 2] = ew.sense[k]
+        out_events[n_events, layout.EV_T] = t
+        out_events[n_events, layout.EV_INDEX] = k
+        out_events[n_events, layout.EV_DIRECTION] = ew.sense[k]
+        v0 = layout.ev_v_at(n)
         for i in range(n):
-            out_events[n_events, 3 + i] = ew.q[i]
-            out_events[n_events, 3 + n + i] = ew.v[i]
+            out_events[n_events, layout.EV_Q + i] = ew.q[i]
+            out_events[n_events, v0 + i] = ew.v[i]
     return n_events + 1
 
 
@@ -197,9 +199,6 @@ def events_table(module, out_events, n_events):
     dtype = [("t", np.float64), ("name", f"U{max([1] + [len(s) for s in names])}"),
              ("direction", np.int8), ("q", np.float64, (n,)), ("v", np.float64, (n,))]
     table = np.zeros(rows.shape[0], dtype=dtype)
-    table["t"] = rows[:, 0]
-    table["name"] = [names[int(k)] for k in rows[:, 1]]
-    table["direction"] = rows[:, 2]
-    table["q"] = rows[:, 3:3 + n]
-    table["v"] = rows[:, 3 + n:3 + 2 * n]
+    table["t"], index, table["direction"], table["q"], table["v"] = layout.event_rows(rows, n)
+    table["name"] = [names[int(k)] for k in index]
     return table

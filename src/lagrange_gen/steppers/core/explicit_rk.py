@@ -10,7 +10,7 @@ module-level numpy constants: numba freezes a global array into the compiled cod
 nothing to pass and keep the glue cacheable.
 
 Where the acceleration comes from is the caller's business: ``source`` is a module (a compile-time
-constant for numba, like the ``method`` of base.run_loop) defining
+constant for numba, like the ``method`` of run_loop.run_loop) defining
 
     stage_acceleration(kern, ctx, q, v, t, a) -> status      (jitted, writes a (n,), no allocation)
 
@@ -22,7 +22,7 @@ index1 the KKT solve of the acceleration-level constrained system.
 import numpy as np
 from ...jit.cache import njit
 
-from .base import FAST
+from .options import FAST
 from .status import OK
 
 #: The classical fourth-order method (Kutta 1901).
@@ -52,7 +52,7 @@ HEUN_C = np.array([0.0, 1.0])
 def stage_state(A, i, q, v, h, stage_v, stage_a, qs, n):
     """Q_i into qs (n,) and V_i into stage_v[i] (n,) from the stages j < i. Zero entries of A
     are skipped: no work for them, and a non-finite stage cannot leak through a 0 coefficient.
-    n passed: kern.N_COORDS (base.py, "Loop bounds")."""
+    n passed: kern.N_COORDS (core/options.py, "Loop bounds")."""
     vi = stage_v[i]
     for k in range(n):
         sq = 0.0
@@ -76,7 +76,7 @@ def rk_step(source, kern, ctx, A, b, c, q, v, t, h, stage_v, stage_a, qs, q_out,
     q_out, v_out (n,) may be q, v themselves (each entry k is written after its last read).
     Returns OK or the first non-OK status of source.stage_acceleration; then q_out, v_out are
     untouched."""
-    n, s = kern.N_COORDS, b.shape[0]       # (n: base.py, "Loop bounds")
+    n, s = kern.N_COORDS, b.shape[0]       # (n: options.py, "Loop bounds")
     for i in range(s):
         stage_state(A, i, q, v, h, stage_v, stage_a, qs, n)
         if i == 0 and first_known:

@@ -7,7 +7,7 @@ its dense output the same signature)::
     interpolate(ws, t, q_out, v_out)     q_out, v_out (n,) <- the state at time t of the step
 
 With the accelerations a = H^-1 rhs at both ends (models without constraints or nonsmooth
-elements; base.accel), q is the quintic Hermite polynomial through (q, v, a) at both ends and v
+elements; legendre.accel), q is the quintic Hermite polynomial through (q, v, a) at both ends and v
 its derivative: local error O(h^6) in q and O(h^5) in v, below the global error of every
 fixed-step method, so the located event times converge at the order of the method. On a
 constrained model (multiplier forces) or one with elements (element forces), H^-1 rhs is not the
@@ -24,7 +24,11 @@ from collections import namedtuple
 import numpy as np
 from ...jit.cache import njit
 
-from .base import FAST, accel, copy_into
+from .legendre import accel
+
+from .options import FAST
+
+from .solve import copy_into
 from .status import OK
 
 #: The data of one step: span (2,) = [t at the start, step h]; the states (q0, v0) at the

@@ -1,7 +1,7 @@
 """Small dense linear algebra in numba, in place, no allocation (used by kernels and steppers).
 
 Compiled without numba's reference counting (jit.NO_REFCOUNT): none of these functions allocates,
-and with it every call pays atomic increments per array argument (see steppers/core/base.py).
+and with it every call pays atomic increments per array argument (see steppers/core/options.py).
 
 2 x 2 systems (the cart pendulum, every two-coordinate model, and its Newton matrices) take a
 path on scalars: the same operations in the same order as the loops, so bitwise the same
@@ -245,8 +245,8 @@ def cholesky_as_lu(A, piv, n):
     L D^-1 below the diagonal, U = D L^T on and above it (D = diag(L)), piv (n,) the identity;
     lu_solve_inplace then solves with them (the partitioned methods keep the factors of H this
     way as the first matrix of their simplified Newton, steppers/core/partitioned.py). Inlined, with
-    n = A.shape[0] passed: base.factor_mass passes kern.N_COORDS, a compile-time constant in a
-    generated module's glue (steppers/core/base.py, "Loop bounds")."""
+    n = A.shape[0] passed: solve.factor_mass passes kern.N_COORDS, a compile-time constant in a
+    generated module's glue (steppers/core/options.py, "Loop bounds")."""
     for k in range(n):
         piv[k] = k
         d = A[k, k]

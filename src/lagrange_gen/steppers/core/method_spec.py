@@ -21,7 +21,8 @@ method names. A spec says:
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
   adaptive signature (codegen/glue.py).
 
-The jitted side of the contract is in base.py (fixed step) and adaptive.py (adaptive).
+The jitted side of the contract is in run_loop.py (fixed step; the rules: steppers/methods)
+and adaptive.py (adaptive).
 """
 
 from __future__ import annotations

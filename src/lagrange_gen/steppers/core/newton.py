@@ -7,13 +7,13 @@ attribute ``assemble`` of the module it passes as ``problem``, the jitted assemb
 
 ``args`` is a tuple of whatever the assembly reads (the state at the start of the step, h, the
 parameters, its scratch arrays). ``solve`` then owns everything else: the non-finite check of the
-residual, the LU solve of J dx = -F (base.newton_solve: SINGULAR_NEWTON or NON_FINITE when J
-cannot be factored), the update x += dx and the one stopping rule (base.newton_converged),
+residual, the LU solve of J dx = -F (solve.newton_solve: SINGULAR_NEWTON or NON_FINITE when J
+cannot be factored), the update x += dx and the one stopping rule (newton_converged),
 counting iterations. ``solve_simplified`` is the same iteration keeping J's factors while the
 iteration contracts fast; its problem gives the residual and the Jacobian as two functions.
 
 Why a module and not the assembly function itself: like ``kern`` and ``run_loop``'s ``method``
-(see base.py), numba types a module as a compile-time constant with no runtime value, so
+(see run_loop.py), numba types a module as a compile-time constant with no runtime value, so
 ``problem.assemble`` is a direct call and the glue of a generated module stays cacheable. A
 dispatcher passed as a value, even between jitted functions, is lowered as a process-specific
 address: numba then refuses to cache the glue ("uses dynamic globals"; measured on the cart
@@ -33,9 +33,49 @@ import types
 
 from ...jit.cache import njit
 
-from .base import increment_converged, max_abs_of, newton_converged, newton_solve
+from .options import FAST
+from .solve import max_abs, max_abs_of, newton_solve
 from .linalg import lu_solve_inplace
 from .status import NEWTON_DIVERGED, NON_FINITE, OK
+
+# The stopping rules of every Newton iteration (solve, solve_simplified, the partitioned and
+# nonsmooth methods' own loops).
+
+
+@njit(cache=True, **FAST)
+def increment_small(dx, x, tol):
+    """Newton stopping test on the increment, relative to the size of the unknown."""
+    return max_abs(dx) <= tol * max(1.0, max_abs(x))
+
+
+@njit(cache=True, **FAST)
+def increment_converged(d, xmax, prev, tol):
+    """The stopping rule of newton_converged on precomputed norms: d = max|dx| of this
+    iteration, xmax = max|x| after the update, prev = d of the previous iteration (0 on the
+    first)."""
+    size = tol * max(1.0, xmax)
+    if d <= size:
+        return True
+    if prev > 0.0:
+        theta = d / prev
+        if theta < 1.0 and theta / (1.0 - theta) * d <= size:
+            return True
+    return False
+
+
+@njit(inline="always")
+def newton_converged(dx, x, prev, tol, n):
+    """Newton stopping test after the update x += dx (both (n,); n passed, options.py, "Loop bounds");
+    returns (converged, max|dx|).
+
+    ``prev`` is max|dx| of the previous iteration (0 on the first). Converged when the increment
+    is small relative to the unknown, max|dx| <= tol max(1, max|x|), or when the observed
+    contraction theta = |dx| / |prev| < 1 bounds the error left in x by theta / (1 - theta) |dx|
+    below that (Hairer-Wanner, Solving ODEs II, sec. IV.8): in the quadratic regime this saves
+    the last iteration, which would only confirm convergence."""
+    d = max_abs_of(dx, n)
+    return increment_converged(d, max_abs_of(x, n), prev, tol), d
+
 
 #: solve_simplified keeps its factored Jacobian while each increment is at most this fraction of
 #: the previous one; a slower contraction re-assembles and re-factors J at the current iterate.
@@ -58,7 +98,7 @@ def solve(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, size):
     """Newton on problem.assemble's F(x) = 0; x (N,) holds the initial guess and on return the
     last iterate. F, scratch (N,), J (N, N), piv (N,) int64 are workspace. size: N (a method
     whose N is kern.N_COORDS passes that, a compile-time constant in a generated module's glue:
-    base.py, "Loop bounds"; the others x.shape[0]).
+    options.py, "Loop bounds"; the others x.shape[0]).
 
     Returns (status, iterations, residual): OK when the stopping rule accepted the last update,
     NON_FINITE (F not finite), SINGULAR_NEWTON or NON_FINITE (J could not be factored), or
@@ -101,7 +141,7 @@ def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, 
     with them, and the first Jacobian is assembled only if they contract slowly.
 
     size: N, the length of x (the partitioned steps pass kern.N_COORDS, a compile-time constant
-    in a generated module's glue, so that the loops here unroll: base.py, "Loop bounds")."""
+    in a generated module's glue, so that the loops here unroll: options.py, "Loop bounds")."""
     resid = prev = 0.0
     fresh = not factored
     for it in range(1, max_iter + 1):

@@ -21,7 +21,7 @@ explicit kick(h/2). Both unknowns are velocities, which keeps the Newton stoppin
 Both are solved by simplified Newton (newton.solve_simplified) that starts from the factors
 of the mass matrix H(q): the Jacobians of both systems are H plus O(h) terms, so H's factors
 contract the iteration by O(h) per step, and H(q) was factored anyway at the end of the
-previous step for v = H^-1 p (base.factor_mass keeps those factors, in LU layout, for the next
+previous step for v = H^-1 p (solve.factor_mass keeps those factors, in LU layout, for the next
 kick; the drift starts from what the kick used). Only when that contraction is slower than
 newton.THETA_REFRESH (stiff velocity-dependent forces, h far beyond the time scale of the
 Coriolis terms) is the exact Jacobian assembled (d f/d v from ``momentum_rate_jacobian``,
@@ -48,7 +48,9 @@ import numpy as np
 from ...jit.cache import njit
 
 from . import newton
-from .base import FAST, factor_mass, velocity_from_factors
+from .legendre import velocity_from_factors
+from .options import FAST
+from .solve import factor_mass
 from .status import OK, SINGULAR_MASS
 
 
@@ -79,7 +81,7 @@ def jacobian_kick(kern, args, u, A):
 
 
 # solve_kick and solve_drift are inlined into the step (and with it into the stepping loop), as
-# are base.factor_mass and base.velocity_from_factors: as separate functions each call passes
+# are solve.factor_mass and legendre.velocity_from_factors: as separate functions each call passes
 # about a dozen arrays, each as its own pointer, shape and strides. Measured on the cart pendulum
 # (best of 7 runs of 1e5 steps, taskset to one core): symplectic_euler 128 -> 98 ns per step,
 # verlet 248 -> 180, composition 835 -> 663; the 16-link chain's verlet 5580 -> 4996 ns. The
@@ -91,7 +93,7 @@ def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, 
                contraction_stop):
     """Solve H(q) u + b(q, t) = mom + hk f(q, u, t) for u (n,); u holds the initial guess on
     entry (b: the T1 = b . v term of T, zero on most models). On entry H holds H(q, t) and A,
-    piv its factors (base.factor_mass), the first Newton matrix. contraction_stop: the stopping
+    piv its factors (solve.factor_mass), the first Newton matrix. contraction_stop: the stopping
     rule (newton.solve_simplified; False in the compositions).
 
     On return H still holds H(q), A the factors last used, u the solution.
@@ -163,7 +165,7 @@ def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R,
 def begin_step(kern, q, v, t, p, H, A, piv, u, history, carried):
     """Start of a Newton-path step of symplectic_euler or verlet at (q, v, t).
 
-    Makes sure H (n, n) holds H(q, t) and A, piv its factors (base.factor_mass; carried[0] = 1
+    Makes sure H (n, n) holds H(q, t) and A, piv its factors (solve.factor_mass; carried[0] = 1
     when the previous step left them) and writes the kick's initial guess into u (n,), which
     holds the previous kick's solution u_k on entry (the steps of the sequence have one size).
     u_k goes to the front of history (GUESS_DEGREE + 1, n), the earlier solutions behind it
@@ -189,7 +191,7 @@ def begin_step(kern, q, v, t, p, H, A, piv, u, history, carried):
 @njit(inline="always")
 def push(history, x, n):
     """Shift the rows of history (GUESS_DEGREE + 1, n) down by one (the last drops out) and put
-    x (n,) first; n passed (kern.N_COORDS: base.py, "Loop bounds")."""
+    x (n,) first; n passed (kern.N_COORDS: options.py, "Loop bounds")."""
     for i in range(n):
         for j in range(GUESS_DEGREE, 0, -1):
             history[j, i] = history[j - 1, i]

@@ -65,4 +65,4 @@ def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
 
 
 #: The jitted loop each kind of method runs in: (module, function).
-LOOPS = {False: ("base", "run_loop"), True: ("adaptive", "run_adaptive")}
+LOOPS = {False: ("run_loop", "run_loop"), True: ("adaptive", "run_adaptive")}

@@ -30,7 +30,7 @@ from collections import namedtuple
 import numpy as np
 from ...jit.cache import njit
 
-from .base import FAST
+from .options import FAST
 
 Workspace = namedtuple("Workspace", "pw H a s0 u0 s1 G coef")
 

@@ -30,7 +30,8 @@ import numpy as np
 from ...jit.cache import njit
 
 from . import verlet
-from ..core.base import FAST, copy_into, explicit_path, inline_step
+from ..core.options import FAST, explicit_path, inline_step
+from ..core.solve import copy_into
 from ..core.method_spec import PartitionedSettings, Spec
 from ..core.partitioned import GUESS_DEGREE
 from ..core.status import OK
@@ -73,7 +74,7 @@ def allocate(kern, n, substeps):
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     return allocate(kern, n, len(COEFFS))
 
 
@@ -91,7 +92,7 @@ def _substep_newton(kern, q, v, mom, t, h, p, settings, ws, j):
     """verlet's Newton-path step as substep j, with the guesses of substep j's own sequence."""
     vw, mine = ws.verlet, ws.guesses[j]
     depth = GUESS_DEGREE + 1            # the rows of verlet's histories
-    for i in range(kern.N_COORDS):      # (base.py, "Loop bounds")
+    for i in range(kern.N_COORDS):      # (core/options.py, "Loop bounds")
         vw.u[i] = mine[0, i]
         for k in range(depth):
             vw.history[k, i], vw.drifts[k, i] = mine[1 + k, i], mine[1 + depth + k, i]

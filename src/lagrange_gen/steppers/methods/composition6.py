@@ -30,7 +30,7 @@ from ...jit.cache import njit
 
 from .composition import (Workspace, allocate, composed_step, linear_radius,  # noqa: F401
                           palindrome, prepare)
-from ..core.base import FAST, inline_step
+from ..core.options import FAST, inline_step
 from ..core.method_spec import PartitionedSettings, Spec
 
 #: (g1, ..., g5, ..., g1), see the module docstring.
@@ -41,7 +41,7 @@ COEFFS = palindrome(0.39216144400731413927925056, 0.33259913678935943859974864,
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop (composition's, for these nine substeps)."""
+    """Allocated once per run by run_loop.run_loop (composition's, for these nine substeps)."""
     return allocate(kern, n, len(COEFFS))
 
 

@@ -34,7 +34,7 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import newton
-from ..core.base import FAST, inline_step
+from ..core.options import FAST, inline_step
 from ..core.constrained import SAVED, constraint_rate, record, velocity_projection
 from ..core.method_spec import NewtonSettings, Spec
 from ..core.status import OK
@@ -50,7 +50,7 @@ Workspace = namedtuple("Workspace", "x F s piv K q1 dv rhs vp H Jq Jqd dHw DJ ph
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     m = kern.N_CONSTRAINTS
     N = n + m
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N, np.int64),
@@ -129,7 +129,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return OK, iters, resid
 
 
-# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

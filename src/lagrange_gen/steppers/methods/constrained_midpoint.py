@@ -34,7 +34,8 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import newton
-from ..core.base import FAST, momentum_from_velocity, inline_step
+from ..core.legendre import momentum_from_velocity
+from ..core.options import FAST, inline_step
 from ..core.constrained import SAVED, finish_momentum_step
 from ..core.method_spec import NewtonSettings, Spec
 from ..core.status import OK
@@ -49,7 +50,7 @@ Workspace = namedtuple("Workspace", "x F s piv K qb q1 v1 f pt H Jq Jqd dHw phi 
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     m = kern.N_CONSTRAINTS
     N = n + m
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(N, np.int64),
@@ -135,7 +136,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return status, iters, resid
 
 
-# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

@@ -29,7 +29,8 @@ from typing import NamedTuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core.base import FAST, accel
+from ..core.legendre import accel
+from ..core.options import FAST
 from ..core.explicit_rk import stage_state, rk_step
 from ..core.method_spec import Spec
 from ..core.status import OK
@@ -347,7 +348,7 @@ def advance(q, v, ws):
         ws.ka[0, i] = ws.ka[N_STAGES, i]
 
 
-# This module as a value for rk_step (see base.py: modules, not dispatchers, are passed).
+# This module as a value for rk_step (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

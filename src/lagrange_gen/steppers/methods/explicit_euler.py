@@ -14,7 +14,9 @@ from collections import namedtuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core.base import FAST, accel, inline_step
+from ..core.legendre import accel
+
+from ..core.options import FAST, inline_step
 from ..core.method_spec import ExplicitSettings, Spec
 from ..core.status import OK
 
@@ -26,7 +28,7 @@ Workspace = namedtuple("Workspace", "a H")
 # the generated module's run_<method> glue, see codegen/glue.py.
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     return Workspace(np.zeros(n), np.zeros((n, n)))
 
 
@@ -43,7 +45,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     status = accel(kern, q, v, t, p, ws.H, a)
     if status != OK:
         return status, 0, 0.0
-    for i in range(kern.N_COORDS):         # (base.py, "Loop bounds")
+    for i in range(kern.N_COORDS):         # (core/options.py, "Loop bounds")
         q[i] += h * v[i]
         v[i] += h * a[i]
     return OK, 0, 0.0

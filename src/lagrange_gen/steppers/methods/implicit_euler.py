@@ -21,7 +21,7 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import newton
-from ..core.base import FAST, inline_step
+from ..core.options import FAST, inline_step
 from ..core.method_spec import NewtonSettings, Spec
 from ..core.status import OK
 
@@ -32,7 +32,7 @@ Workspace = namedtuple("Workspace", "v1 q1 dv rhs R s piv H A Jq Jqd dHw")
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n, np.int64), np.zeros((n, n)), np.zeros((n, n)),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)))
@@ -48,7 +48,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def assemble(kern, args, v1, R, A):
     """Newton system of the step (newton.solve): R (n,) <- R(v+), A (n, n) <- dR/dv+."""
     q, v, t1, h, p, q1, dv, rhs, H, Jq, Jqd, dHw = args
-    n = kern.N_COORDS       # (base.py, "Loop bounds")
+    n = kern.N_COORDS       # (core/options.py, "Loop bounds")
     for i in range(n):
         q1[i] = q[i] + h * v1[i]
         dv[i] = v1[i] - v[i]
@@ -66,7 +66,7 @@ def assemble(kern, args, v1, R, A):
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Newton iterations, residual)."""
-    n = kern.N_COORDS       # (base.py, "Loop bounds")
+    n = kern.N_COORDS       # (core/options.py, "Loop bounds")
     v1 = ws.v1
     for i in range(n):
         v1[i] = v[i]
@@ -80,7 +80,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return status, iters, resid
 
 
-# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 def linear_radius(tau):

@@ -30,7 +30,7 @@ from typing import NamedTuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core.base import FAST, inline_step
+from ..core.options import FAST, inline_step
 from ..core.constrained import SAVED, constraint_rate, record, solve_rows
 from ..core.explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 from ..core.linalg import cholesky_inplace, cholesky_solve_inplace
@@ -53,7 +53,7 @@ class Index1Settings(NamedTuple):
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     m = kern.N_CONSTRAINTS
     return Workspace(np.zeros(n), np.zeros((4, n)), np.zeros((4, n)), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros((n, n)), np.zeros(m), np.zeros(m), np.zeros(m),
@@ -135,7 +135,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return OK, 0, 0.0
 
 
-# This module as a value for explicit_rk.rk_step (see base.py: modules, not dispatchers).
+# This module as a value for explicit_rk.rk_step (see core/run_loop.py: modules, not dispatchers).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

@@ -30,7 +30,8 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import newton
-from ..core.base import FAST, momentum_from_velocity, velocity_from_momentum, inline_step
+from ..core.legendre import momentum_from_velocity, velocity_from_momentum
+from ..core.options import FAST, inline_step
 from ..core.method_spec import NewtonSettings, Spec
 from ..core.status import OK
 
@@ -41,7 +42,7 @@ Workspace = namedtuple("Workspace", "vb qb R f s piv q_new v_new p_new H A Jq Jq
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
@@ -59,7 +60,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 def assemble(kern, args, vb, R, A):
     """Newton system of the step (newton.solve): R (n,) <- R(vb), A (n, n) <- dR/dvb."""
     q, mom, tm, hh, p, qb, f, H, Jq, Jqd, dHw = args
-    n = kern.N_COORDS       # (base.py, "Loop bounds")
+    n = kern.N_COORDS       # (core/options.py, "Loop bounds")
     for i in range(n):
         qb[i] = q[i] + hh * vb[i]
     kern.mass_matrix(qb, tm, p, H)
@@ -81,7 +82,7 @@ def assemble(kern, args, vb, R, A):
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
-    n = kern.N_COORDS       # (base.py, "Loop bounds")
+    n = kern.N_COORDS       # (core/options.py, "Loop bounds")
     vb, qb, f = ws.vb, ws.qb, ws.f
     q_new, v_new, p_new = ws.q_new, ws.v_new, ws.p_new
     tm = t + 0.5 * h
@@ -106,7 +107,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return OK, iters, resid
 
 
-# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 def linear_radius(tau):

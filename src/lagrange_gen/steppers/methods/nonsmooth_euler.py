@@ -44,7 +44,8 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import newton
-from ..core.base import FAST, failed_solve_status, max_abs, inline_step
+from ..core.options import FAST, inline_step
+from ..core.solve import failed_solve_status, max_abs
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import NewtonSettings, Spec
 from ..core.status import OK, SINGULAR_NEWTON
@@ -64,7 +65,7 @@ Workspace = namedtuple("Workspace", "v1 q1 dv rhs F s X piv H A Jq Jqd dHw Hw "
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     ne = kern.N_ELEMENTS
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n, np.int64), np.zeros((n, n)),
@@ -233,7 +234,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return OK, iters, resid
 
 
-# This module as a value for newton.solve (see base.py: modules, not dispatchers, are passed).
+# This module as a value for newton.solve (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 SPEC = Spec(

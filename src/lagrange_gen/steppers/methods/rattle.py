@@ -43,7 +43,8 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import newton
-from ..core.base import FAST, explicit_path, momentum_from_velocity, subtract_transport, inline_step
+from ..core.legendre import momentum_from_velocity, subtract_transport
+from ..core.options import FAST, explicit_path, inline_step
 from ..core.constrained import SAVED, constraint_rate, finish_momentum_step, project, record, solve_rows
 from ..core.linalg import cholesky_inplace, cholesky_solve_inplace
 from ..core.method_spec import PartitionedSettings, Spec
@@ -65,7 +66,7 @@ Workspace = namedtuple("Workspace", "kap Fk acc vh z x F s piv K pt M H1 Jq Jqd 
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     m = kern.N_CONSTRAINTS
     N = 2 * n + m
     return Workspace(np.zeros(m), np.zeros(m), np.zeros(n), np.zeros(n), np.zeros(n),

@@ -20,7 +20,9 @@ from collections import namedtuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core.base import FAST, accel, inline_step
+from ..core.legendre import accel
+
+from ..core.options import FAST, inline_step
 from ..core.explicit_rk import RK4_A, RK4_B, RK4_C, rk_step
 from ..core.method_spec import ExplicitSettings, Spec
 from ..core.status import OK
@@ -32,7 +34,7 @@ Workspace = namedtuple("Workspace", "stage_v stage_a qs H")
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     s = RK4_B.shape[0]
     return Workspace(np.zeros((s, n)), np.zeros((s, n)), np.zeros(n), np.zeros((n, n)))
 
@@ -58,7 +60,7 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     return status, 0, 0.0
 
 
-# This module as a value for rk_step (see base.py: modules, not dispatchers, are passed).
+# This module as a value for rk_step (see core/run_loop.py: modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
 
 def linear_radius(tau):

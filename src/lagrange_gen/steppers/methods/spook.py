@@ -12,7 +12,7 @@ start of the step and nu = h lam the impulse:
 
     Sigma = 4 epsilon / (h^2 (1 + 4 d)),   Upsilon = 1 / (1 + 4 d),   q+ = q + h v+
 
-solved as one system in x = (v+, nu), (n + m), by base.newton_solve (LU with partial pivoting;
+solved as one system in x = (v+, nu), (n + m), by solve.newton_solve (LU with partial pivoting;
 SINGULAR_NEWTON when it is singular, e.g. redundant constraints at epsilon = 0). One linear
 solve per step, no Newton.
 
@@ -36,7 +36,9 @@ from typing import NamedTuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core.base import FAST, newton_solve, inline_step
+from ..core.options import FAST, inline_step
+
+from ..core.solve import newton_solve
 from ..core.constrained import SAVED, constraint_rate, record
 from ..core.method_spec import Spec
 from ..core.status import OK
@@ -57,7 +59,7 @@ class SpookSettings(NamedTuple):
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     m = kern.N_CONSTRAINTS
     N = n + m
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),

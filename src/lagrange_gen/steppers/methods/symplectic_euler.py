@@ -10,7 +10,7 @@ up to the Newton tolerance), not symmetric. Nonconservative forces enter as the 
 Euler-Lagrange equations (h Q added to the momentum update).
 
 When H is constant and forces are velocity-free (the generated flags MASS_IS_CONSTANT and
-FORCES_VELOCITY_FREE, and settings.newton_always off: base.explicit_path) it reduces to the
+FORCES_VELOCITY_FREE, and settings.newton_always off: options.explicit_path) it reduces to the
 explicit kick-drift v+ = v + h a(q, t), q+ = q + h v+: one force evaluation per step, no Newton.
 """
 
@@ -20,7 +20,9 @@ import numpy as np
 from ...jit.cache import njit
 
 from . import verlet
-from ..core.base import FAST, accel, explicit_path, matvec, momentum_from_velocity, inline_step
+from ..core.legendre import accel, momentum_from_velocity
+from ..core.options import FAST, explicit_path, inline_step
+from ..core.solve import matvec
 from ..core.method_spec import PartitionedSettings, Spec
 from ..core.partitioned import GUESS_DEGREE, begin_step, best_degree, end_step, solve_kick
 from ..core.status import OK
@@ -35,7 +37,7 @@ Workspace = namedtuple("Workspace", "u R f s piv q_new v_new p_new H A Jq Jqd hi
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)), np.zeros((n, n)),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((GUESS_DEGREE + 1, n)),
@@ -54,7 +56,7 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v, mom) at t, in place. Returns (status, Newton iterations, residual)."""
-    n = kern.N_COORDS       # a compile-time constant in the module's glue (base.py, "Loop bounds")
+    n = kern.N_COORDS       # a compile-time constant in the module's glue (core/options.py, "Loop bounds")
     if explicit_path(kern, settings):
         a = ws.f
         status = accel(kern, q, v, t, p, ws.H, a)

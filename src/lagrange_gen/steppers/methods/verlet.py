@@ -14,7 +14,7 @@ eigenvalues on the unit circle for tau = h omega < 2 (rho = 1) and a real pair w
 beyond: Verlet is stable only for tau < 2.
 
 When H is constant and forces are velocity-free (generated MASS_IS_CONSTANT and
-FORCES_VELOCITY_FREE, settings.newton_always off: base.explicit_path) both implicit parts are
+FORCES_VELOCITY_FREE, settings.newton_always off: options.explicit_path) both implicit parts are
 linear and the scheme is exactly velocity Verlet, run explicitly with one force evaluation per
 step (the acceleration at the end of a step is cached, workspace ``acc``, for the next):
 
@@ -27,7 +27,11 @@ from collections import namedtuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core.base import FAST, accel, explicit_path, matvec, momentum_from_velocity, inline_step
+from ..core.legendre import accel, momentum_from_velocity
+
+from ..core.options import FAST, explicit_path, inline_step
+
+from ..core.solve import matvec
 from ..core.method_spec import PartitionedSettings, Spec
 from ..core.partitioned import (GUESS_DEGREE, begin_step, best_degree, end_step, extrapolate, push,
                           solve_drift, solve_kick)
@@ -46,7 +50,7 @@ Workspace = namedtuple("Workspace",
 
 @njit
 def workspace(kern, n):
-    """Allocated once per run by base.run_loop."""
+    """Allocated once per run by run_loop.run_loop."""
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
@@ -94,7 +98,7 @@ def step_newton(kern, q, v, mom, t, h, p, settings, ws, contraction_stop):
     8.90 iterations per step with the last difference alone): ws holds a sequence of steps of
     one size (composition.py gives each of its substeps its own). contraction_stop: the Newton
     stopping rule (newton.solve_simplified): True for verlet's own step, False in a composition."""
-    n = kern.N_COORDS       # a compile-time constant in the module's glue (base.py, "Loop bounds")
+    n = kern.N_COORDS       # a compile-time constant in the module's glue (core/options.py, "Loop bounds")
     tol, max_iter = settings.newton_tol, settings.max_iter
     u, w, f, q_new, v_new, p_half = ws.u, ws.w, ws.f, ws.q_new, ws.v_new, ws.p_half
     status, kept = begin_step(kern, q, v, t, p, ws.H, ws.A, ws.piv, u, ws.history, ws.carried)
