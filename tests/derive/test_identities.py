@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import MODEL_FILES
+from conftest import MODEL_FILES, ROBOT_MODELS
 
-STEMS = [f.stem for f in MODEL_FILES]
+STEMS = [f.stem for f in MODEL_FILES if f.stem not in ROBOT_MODELS]
 
 
 def random_state(rng, n):
