@@ -6,13 +6,13 @@ the pelvis (hip yaw, roll, pitch, knee, ankle pitch, roll). Adult-sized link len
 size turned by a few degrees, so every tensor is full.
 
 URDF style (origins and axes in the parent joint's frame, every frame parallel to the world's
-at q = 0, z up): lagrange_gen.bench.robot_trees builds the 30 RigidBodies from TREE with
+at q = 0, z up): lagrange_gen.model.joint_tree builds the 30 RigidBodies from TREE with
 sympy.physics.mechanics, Pinocchio the same tree (lagrange_gen.bench.robots_peers). The
 `robots` bench suite (`lagrange-gen bench robots`) generates it; build() only, no `model`:
 running the file derives nothing until asked.
 """
 import lagrange_gen as lg
-from lagrange_gen.bench.robot_trees import tree_bodies, tree_potential
+from lagrange_gen.model.joint_tree import tree_bodies
 
 #: joint: parent joint (-1: the fixed pelvis), axis and origin in the parent's frame (m);
 #: mass (kg), com (m) in the body frame; inertia (ixx, iyy, izz, ixy, iyz, izx) about the com
@@ -84,6 +84,6 @@ def build():
     g = lg.parameters("g", defaults=(9.81,))
     N, O, q, links = tree_bodies(TREE)          # world frame N (z up), pelvis point O
     T = lg.kinetic_energy(N, links)
-    V = tree_potential(N, O, links, g)
+    V = lg.gravity_potential(N, -g * N.z, links)  # sum of m g z of the mass centres
     return lg.Model("humanoid", coords=q, T=T, V=V, frame=N,
                     description="30-DoF humanoid tree: waist, neck, two 7-DoF arms, two 6-DoF legs.")

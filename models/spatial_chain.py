@@ -8,14 +8,14 @@ kinetic energy does not stay a short sum of cosines of angle differences.
 Written as a robotics engineer writes a robot: the joint table TREE (URDF style: the joint's
 origin and axis in the parent link's frame; mass, com and inertia (ixx, iyy, izz, ixy, iyz, izx)
 about the com in the link's frame), built into sympy.physics.mechanics frames, points and
-RigidBodies (lagrange_gen.bench.robot_trees.tree_bodies), T = lg.kinetic_energy(N, links) and
+RigidBodies (lagrange_gen.model.joint_tree.tree_bodies), T = lg.kinetic_energy(N, links) and
 gravity -g N.z as the potential. The same TREE builds the chain in Pinocchio
 (lagrange_gen.bench.robots_peers). build() only: running the file derives nothing.
 """
 import math
 
 import lagrange_gen as lg
-from lagrange_gen.bench.robot_trees import tree_bodies, tree_potential
+from lagrange_gen.model.joint_tree import tree_bodies
 
 
 def chain_tree(n=12):
@@ -51,6 +51,6 @@ def build(n=12):
     g = lg.parameters("g", defaults=(9.81,))
     N, O, q, links = tree_bodies(tree)          # base frame N (z up), base point O, n angles
     T = lg.kinetic_energy(N, links)
-    V = tree_potential(N, O, links, g)           # sum of m g z of the mass centres
+    V = lg.gravity_potential(N, -g * N.z, links)  # sum of m g z of the mass centres
     return lg.Model(f"spatial_chain_{n}", coords=q, T=T, V=V, frame=N,
                     description=f"Spatial {n}-link chain, joint axes alternating z/y, full inertias.")

@@ -11,12 +11,12 @@ the URDF's cylinders turned by a few degrees, so that every tensor is full (prod
 nonzero) as on the real links.
 
 Each joint angle is a ``me.dynamicsymbols`` coordinate; T is the kinetic energy of the six
-RigidBodies (lagrange_gen.bench.robot_trees builds them from TREE with orientnew/locatenew),
+RigidBodies (lagrange_gen.model.joint_tree builds them from TREE with orientnew/locatenew),
 gravity -g N.z a potential. Pinocchio builds the same arm from TREE
 (lagrange_gen.bench.robots_peers.pinocchio_model).
 """
 import lagrange_gen as lg
-from lagrange_gen.bench.robot_trees import tree_bodies, tree_potential
+from lagrange_gen.model.joint_tree import tree_bodies
 
 #: joint: parent joint (-1: the base), axis and origin in the parent's frame (m); mass (kg),
 #: com (m) in the body frame; inertia (ixx, iyy, izz, ixy, iyz, izx) about the com (kg m^2)
@@ -40,6 +40,6 @@ def build():
     g = lg.parameters("g", defaults=(9.81,))
     N, O, q, links = tree_bodies(TREE)          # base frame N (z up), base point O, 6 angles
     T = lg.kinetic_energy(N, links)
-    V = tree_potential(N, O, links, g)           # sum of m g z of the mass centres
+    V = lg.gravity_potential(N, -g * N.z, links)  # sum of m g z of the mass centres
     return lg.Model("ur5", coords=q, T=T, V=V, frame=N,
                     description="UR5-like 6-DoF arm, full inertia tensors, gravity -g z.")

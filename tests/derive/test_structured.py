@@ -14,7 +14,7 @@ import lagrange_gen as lg
 from lagrange_gen import Model, ModelError, parameters
 from lagrange_gen.derive import derive
 from lagrange_gen.derive.structured import graph_model
-from lagrange_gen.model.bodies import Intermediate, expand_intermediates
+from lagrange_gen.model.intermediates import Intermediate, expand_intermediates
 
 
 def chain(n, v2pt=False, constraint=False):

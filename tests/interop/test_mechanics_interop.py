@@ -15,7 +15,7 @@ import sympy.physics.mechanics as me
 
 import lagrange_gen as lg
 from lagrange_gen import Model, ModelError, PointForce, parameters
-from lagrange_gen.model.bodies import expand_intermediates
+from lagrange_gen.model.intermediates import expand_intermediates
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.derive import derive
 from lagrange_gen.run.loader import import_generated

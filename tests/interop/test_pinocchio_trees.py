@@ -1,6 +1,6 @@
 """Random spatial trees (issue 28, item 4) built both ways from one joint table, against Pinocchio.
 
-Each tree (lagrange_gen.bench.robot_trees.random_tree: random parents, unit axes, offsets,
+Each tree (lagrange_gen.analysis.random_trees.random_tree: random parents, unit axes, offsets,
 masses, positive definite full inertia tensors; 3 to 6 bodies, revolute and prismatic joints)
 is written to a model file that builds it with sympy.physics.mechanics (model_from_tree), and
 given to Pinocchio (bench/robots_peers.pinocchio_model). At random states our generated module
@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from lagrange_gen.bench.robot_trees import random_tree
+from lagrange_gen.analysis.random_trees import random_tree
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.run.loader import import_generated
 
@@ -43,7 +43,7 @@ def _rel(a, b):
 
 
 def _model_file(path, name, tree):
-    path.write_text("from lagrange_gen.bench.robot_trees import model_from_tree\n\n"
+    path.write_text("from lagrange_gen.model.joint_tree import model_from_tree\n\n"
                     f"TREE = {json.dumps(tree, indent=1)}\n\n"
                     f"model = model_from_tree({name!r}, TREE, g=9.81)\n")
     return path

@@ -1,7 +1,7 @@
 """Pinocchio (the ``pin`` package, ``peers`` extra) on the same kinematic trees as our models.
 
 ``pinocchio_model(TREE)`` builds a ``pin.Model`` joint by joint from the table of
-lagrange_gen.bench.robot_trees: placement = (identity rotation, origin) in the parent joint's
+lagrange_gen.model.joint_tree: placement = (identity rotation, origin) in the parent joint's
 frame, RX/RY/RZ (PX/PY/PZ) for a coordinate axis, RevoluteUnaligned (PrismaticUnaligned)
 otherwise, ``pin.Inertia(mass, com, I)`` with I the full tensor about the com in the body frame,
 gravity (0, 0, -g). The helpers return numpy arrays (copies: Pinocchio reuses its Data):

@@ -28,7 +28,7 @@ import numpy as np
 import symengine as se
 import sympy as sp
 
-from ..model.bodies import Intermediate, expand_intermediates
+from ..model.intermediates import Intermediate, expand_intermediates
 from ..errors import ModelError
 from ..model.symbols import Parameter, t
 from .backend import Mat, Ops, backend_for

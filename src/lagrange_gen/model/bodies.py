@@ -18,74 +18,16 @@ available (another sympy), the energies fall back to sympy's own ``kinetic_energ
 
 from __future__ import annotations
 
-import itertools
 import warnings
 from collections import deque
 
 import sympy as sp
 
 from ..errors import ModelError
+from .intermediates import new_intermediate
 from .symbols import Coordinate, t
 
-__all__ = ["Intermediate", "kinetic_energy", "gravity_potential", "intermediates_of", "expand_intermediates"]
-
-
-#: Serial numbers of Intermediates (their names), in creation order.
-_serials = itertools.count(1)
-
-
-class Intermediate(sp.Symbol):
-    """A symbol standing for ``definition`` (a sympy expression of coordinates, velocities,
-    parameters, t and other Intermediates). The definition is part of the symbol's identity, as
-    a Parameter's declaration is, so sympy's cache never mixes two of the same name."""
-
-    __slots__ = ("definition",)
-
-    def __new__(cls, name, definition):
-        obj = sp.Symbol.__xnew__(cls, name, real=True)
-        obj.definition = sp.sympify(definition)
-        return obj
-
-    def __getnewargs_ex__(self):
-        return ((self.name, self.definition), {})
-
-    def _hashable_content(self):
-        return super()._hashable_content() + (self.definition,)
-
-
-def intermediates_of(*exprs):
-    """[Intermediate] that ``exprs`` use, directly or through other definitions, each after
-    the ones its definition uses."""
-    order, seen = [], set()
-    for expr in exprs:
-        stack = [(s, False) for s in _in_order(sp.sympify(expr).atoms(Intermediate))]
-        while stack:
-            sym, ready = stack.pop()
-            if sym in seen:
-                continue
-            if ready:
-                seen.add(sym)
-                order.append(sym)
-                continue
-            stack.append((sym, True))
-            stack.extend((u, False) for u in _in_order(sym.definition.atoms(Intermediate)) if u not in seen)
-    return order
-
-
-def _in_order(intermediates):
-    """Intermediates in creation order (their names k<serial>): the derivation numbers its graph
-    nodes in this order, so the generated text must not follow a set's order."""
-    return sorted(intermediates, key=lambda s: int(s.name[1:]))
-
-
-def expand_intermediates(expr):
-    """``expr`` with every Intermediate replaced by its definition, recursively (exponential on
-    deep trees: for models whose derivation cannot use the graph, and for tests)."""
-    expr = sp.sympify(expr)
-    values = {}
-    for sym in intermediates_of(expr):
-        values[sym] = sym.definition.xreplace({u: values[u] for u in sym.definition.atoms(Intermediate)})
-    return expr.xreplace(values) if values else expr
+__all__ = ["kinetic_energy", "gravity_potential", "is_constant_force", "constant_force_potential"]
 
 
 class _Tree:
@@ -126,7 +68,7 @@ class _Tree:
         expr = sp.sympify(expr)
         if expr.is_Number or expr.is_Symbol:
             return expr
-        return Intermediate(f"k{next(_serials)}", expr)
+        return new_intermediate(expr)
 
     def _named(self, matrix):
         return matrix.applyfunc(self._name)

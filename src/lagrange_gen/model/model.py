@@ -3,19 +3,20 @@
 A model file under ``models/`` builds a :class:`Model` from SymPy expressions and assigns it to a
 variable named ``model`` (optionally it also defines ``build(**options)`` returning a Model, for
 families such as the n-link pendulum). :func:`lagrange_gen.model.model_file.load_model` executes such
-a file; Model validates what it is given.
+a file; Model converts what it is given (model/validation.py checks it). The module is over 300
+lines because Model's docstring is the reference of every argument a model file may pass.
 """
 
 from __future__ import annotations
 
 import sympy as sp
 
-from .bodies import expand_intermediates, intermediates_of
+from .intermediates import expand_intermediates, intermediates_of
 from .drawing import Drawing, check_drawing
+from .validation import check_model
 from ..errors import ModelError
-from .expressions import (Event, check_rayleigh, convert_dynamicsymbols, equation_as_expr, named_events,
-                          mechanics_speeds, prescriptions, sympify_scalar, is_mechanics_load,
-                          unknown_symbols_hint)
+from .expressions import (Event, convert_dynamicsymbols, equation_as_expr, is_mechanics_load,
+                          mechanics_speeds, named_events, prescriptions, sympify_scalar)
 from .loads import DryFriction, PointForce, SaintVenant
 from .symbols import Coordinate, Parameter, Velocity, check_name, coordinates, parameters, t
 
@@ -100,7 +101,7 @@ class Model:
         self.source_path = None      # set by load_model
         self.source_text = ""
         self.build_options = {}
-        self._validate()
+        check_model(self)
         # A drawing may show a prescribed coordinate (the driven pivot): substituted like the rest.
         sub = getattr(self, "_prescribed_sub", {})
         self.draw = check_drawing(self, draw, lambda e, what: self._scalar(e, what, replace).xreplace(sub))
@@ -244,7 +245,7 @@ class Model:
         for name, y in self.outputs.items():
             yield f"output {name}", y
 
-    def _input_expressions(self):
+    def input_expressions(self):
         """Everything whose symbols must be known: _all_expressions, the events, the outputs
         and the definitions of the Intermediates they use (bodies.py). The events stay out of
         _all_expressions, which chooses the derivation backend (derive/backend.py): an event is
@@ -298,7 +299,7 @@ class Model:
         """The parameters in PARAMS order: ``explicit`` (params=), or the used ones in
         declaration order. Fills param_defaults {name: default or None}."""
         found = {}
-        for where, expr in self._input_expressions():
+        for where, expr in self.input_expressions():
             for s in expr.free_symbols:
                 if isinstance(s, Parameter) and found.setdefault(s.name, s) != s:
                     raise ModelError(f"model {self.name}: parameter {s.name} is declared twice (two "
@@ -320,61 +321,6 @@ class Model:
         params = params + list(self.inputs)
         self.param_defaults = {s.name: s.default for s in params}
         return params
-
-    def _validate(self):
-        names = {}
-        for kind, syms in (("coordinate", self.coords), ("velocity", self.velocities),
-                           ("parameter", self.params)):
-            for s in syms:
-                check_name(kind, s.name)
-                if s.name in names or s.name == "t":
-                    other = names.get(s.name, "time")
-                    raise ModelError(f"model {self.name}: duplicate name {s.name!r} ({other} and {kind})")
-                names[s.name] = kind
-        for name in self.outputs:
-            check_name("output", name)
-        q, qd = set(self.coords), set(self.velocities)
-        allowed = q | qd | set(self.params) | {t} | set(self.intermediates)
-        for where, expr in self._input_expressions():
-            unknown = sorted(str(s) for s in expr.free_symbols - allowed)
-            if unknown:
-                raise ModelError(f"model {self.name}: {where} uses symbol(s) {', '.join(unknown)} "
-                                 "that are neither coordinates, velocities, parameters nor t"
-                                 + unknown_symbols_hint(expr.free_symbols - allowed))
-            if expr.has(sp.Derivative) or expr.atoms(sp.core.function.AppliedUndef):
-                raise ModelError(f"model {self.name}: {where} contains an undefined function or derivative: {expr}")
-        moving = [f"{v} ({c}.d)" for c, v in zip(self.coords, self.velocities) if v in self.symbols_of(self.V)]
-        if moving:
-            raise ModelError(f"model {self.name}: V depends on the velocit{'y' if len(moving) == 1 else 'ies'} "
-                             f"{', '.join(moving)}; V is a function of q and t: velocity-dependent "
-                             "potentials belong in T or in forces")
-        check_rayleigh(self.name, expand_intermediates(self.dissipation), self.velocities)
-        if self.symbols_of(self.dissipation) & {t}:
-            raise ModelError(f"model {self.name}: dissipation depends on t")
-        for i, c in enumerate(self.constraints):
-            bad = sorted(str(s) for s in self.symbols_of(c) & qd)
-            if bad:
-                raise ModelError(f"model {self.name}: constraint {i} ({c}) depends on {', '.join(bad)}; "
-                                 "only holonomic constraints Phi(q, t) = 0 are supported")
-        self._validate_elements(qd)
-        if not (self.symbols_of(self.T) & qd):
-            raise ModelError(f"model {self.name}: T does not depend on any velocity")
-
-    def _validate_elements(self, qd):
-        for e in self.elements:
-            bad = sorted(str(s) for s in self.symbols_of(e.strain) & (qd | {t}))
-            if bad:
-                raise ModelError(f"model {self.name}: element {e.name}: the strain {e.strain} depends on "
-                                 f"{', '.join(bad)}; a strain must be a function s(q) of the coordinates")
-            for label, c in zip(("stiffness/bound", "threshold"), e.coefficients()):
-                if c.free_symbols - set(self.params):
-                    raise ModelError(f"model {self.name}: element {e.name}: {label} {c} must depend on parameters only")
-                value = c.xreplace({p: sp.Float(p.default) for p in c.free_symbols
-                                    if isinstance(p, Parameter) and p.default is not None})
-                if e.kind == "dry_friction" and label == "threshold":
-                    continue
-                if value.is_number and not float(value) > 0:
-                    raise ModelError(f"model {self.name}: element {e.name}: {label} must be > 0, got {c} = {float(value):g}")
 
     def defaults(self):
         """Default parameter values in PARAMS order (None where a value is required)."""

@@ -28,7 +28,11 @@ from __future__ import annotations
 
 import sympy as sp
 
-__all__ = ["tree_bodies", "tree_potential", "model_from_tree", "check_tree", "n_dof", "random_tree"]
+from .bodies import gravity_potential, kinetic_energy
+from .model import Model
+from .symbols import parameters
+
+__all__ = ["tree_bodies", "model_from_tree", "check_tree", "n_dof"]
 
 KINDS = ("revolute", "prismatic")
 
@@ -104,50 +108,12 @@ def tree_bodies(tree, q=None):
     return N, O, q, bodies
 
 
-def tree_potential(N, O, bodies, g):
-    """V of uniform gravity -g N.z: lg.gravity_potential when this lagrange_gen has it, else
-    sum m g z_G (the height of each mass centre above O)."""
-    import lagrange_gen as lg
-    if hasattr(lg, "gravity_potential"):
-        return lg.gravity_potential(N, -g * N.z, bodies)
-    return sum(b.mass * g * b.masscenter.pos_from(O).dot(N.z) for b in bodies)
-
-
 def model_from_tree(name, tree, g=9.81, description=None):
     """The lagrange_gen Model of a tree: T = lg.kinetic_energy(N, bodies), V = gravity, the one
     parameter g (default ``g``)."""
-    import lagrange_gen as lg
-    g_sym = lg.parameters("g", defaults=(float(g),))
+    g_sym = parameters("g", defaults=(float(g),))
     N, O, q, bodies = tree_bodies(tree)
-    T = lg.kinetic_energy(N, bodies)
-    V = tree_potential(N, O, bodies, g_sym)
-    return lg.Model(name, coords=q, T=T, V=V,
-                    description=description or f"{len(tree)}-joint tree, mechanics bodies, gravity -g z")
-
-
-def random_tree(rng, n, prismatic=0.3, aligned=0.0):
-    """A random tree of ``n`` joints for the differential tests: random parents, unit axes
-    (a coordinate axis with probability ``aligned``), offsets, masses and positive definite
-    full inertia tensors (R diag(d) R^T with principal moments obeying the triangle
-    inequality). ``rng`` a numpy Generator."""
-    import numpy as np
-    tree = []
-    for i in range(n):
-        if rng.random() < aligned:
-            axis = np.eye(3)[rng.integers(3)]
-        else:
-            axis = rng.normal(size=3)
-            axis /= np.linalg.norm(axis)
-        d = rng.uniform(0.02, 0.2, size=3)
-        d[2] = rng.uniform(abs(d[0] - d[1]) + 0.005, d[0] + d[1] - 0.005)
-        R, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        I = R @ np.diag(d) @ R.T
-        tree.append({"name": f"j{i}", "parent": int(rng.integers(-1, i)) if i else -1,
-                     "type": "prismatic" if rng.random() < prismatic else "revolute",
-                     "axis": [round(float(a), 12) for a in axis],
-                     "origin": [round(float(c), 12) for c in rng.uniform(-0.5, 0.5, size=3)],
-                     "mass": round(float(rng.uniform(0.5, 3.0)), 12),
-                     "com": [round(float(c), 12) for c in rng.uniform(-0.3, 0.3, size=3)],
-                     "inertia": [round(float(c), 12) for c in
-                                 (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[2, 0])]})
-    return tree
+    T = kinetic_energy(N, bodies)
+    V = gravity_potential(N, -g_sym * N.z, bodies)
+    return Model(name, coords=q, T=T, V=V,
+                 description=description or f"{len(tree)}-joint tree, mechanics bodies, gravity -g z")
