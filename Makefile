@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test generate check bench clean
+.PHONY: demo test test-lowest-numba generate check bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -25,5 +25,23 @@ demo: generate
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
+# The smoke job on the lowest numba pyproject.toml allows (and the numpy it supports), in a venv
+# and caches of its own: generate, every method once (against the portable glue), the jit
+# layer's tests, the import rules.
+LOWEST_VENV := .venv-lowest-numba
+SMOKE_TESTS := tests/test_portable.py tests/test_jit_cache.py tests/test_jit_callee.py \
+	tests/test_jit_speedups.py tests/test_numba_inline_copy.py tests/test_numba_typing_memo.py \
+	tests/test_compile_gc.py tests/test_compile_message.py tests/test_architecture.py
+
+$(LOWEST_VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(LOWEST_VENV)
+	$(LOWEST_VENV)/bin/pip install --quiet --upgrade pip
+	$(LOWEST_VENV)/bin/pip install --quiet "numba==0.59.1" "numpy<2" -e '.[test]'
+	touch $@
+
+test-lowest-numba: $(LOWEST_VENV)/.installed
+	NUMBA_CACHE_DIR=$(LOWEST_VENV)/numba-cache LAGRANGE_GEN_PORTABLE_DIR=$(LOWEST_VENV)/portable \
+		$(LOWEST_VENV)/bin/python -m pytest -q -n 2 --dist loadfile -p no:cacheprovider $(SMOKE_TESTS)
+
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) $(LOWEST_VENV) out .pytest_cache

@@ -1,7 +1,8 @@
 """The package's shape (docs/ARCHITECTURE.md): its import graph has no circles, nothing imports
-another module's underscore names, the generator loads without numba and a cold simulate of a
-generated module without sympy. The graph is read from the source (every import statement, at
-any level of a file: a function-level import is a dependency too), not from a running process."""
+another module's underscore names, the generator loads without numba, a cold simulate of a
+generated module without sympy, and only the jit layer imports numba. The graph is read from
+the source (every import statement, at any level of a file: a function-level import is a
+dependency too), not from a running process."""
 
 import ast
 import subprocess
@@ -142,6 +143,49 @@ def test_no_module_imports_another_modules_underscore_names():
                  if imported and imported.startswith("_") and not imported.startswith("__")
                  and target != name]
     assert not offenders, "private names imported across modules: " + "; ".join(offenders)
+
+
+def _private_reads(name):
+    """[(lineno, "module.attribute")] where a package module reads an underscore attribute of
+    another package module it imported (``from . import precision; precision._ours``)."""
+    path, _ = MODULES[name]
+    tree = ast.parse(path.read_text(), str(path))
+    modules = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith("lagrange_gen")):
+            modules |= {a.asname or a.name for a in node.names}
+        elif isinstance(node, ast.Import):
+            modules |= {(a.asname or a.name).split(".")[0] for a in node.names if a.name.startswith("lagrange_gen")}
+    return [(node.lineno, f"{node.value.id}.{node.attr}") for node in ast.walk(tree)
+            if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name)
+            and node.value.id in modules and node.attr.startswith("_") and not node.attr.startswith("__")]
+
+
+def test_no_module_reads_another_modules_underscore_attributes():
+    offenders = [f"{name}:{line}: {what}" for name in MODULES for line, what in _private_reads(name)]
+    assert not offenders, "private attributes read across modules: " + "; ".join(offenders)
+
+
+def _numba_imports(name):
+    """[(lineno, what)] of the numba imports of one package module."""
+    path, _ = MODULES[name]
+    out = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.ImportFrom) and not node.level and (node.module or "").split(".")[0] == "numba":
+            out.append((node.lineno, node.module))
+        elif isinstance(node, ast.Import):
+            out += [(node.lineno, a.name) for a in node.names if a.name.split(".")[0] == "numba"]
+    return out
+
+
+def test_only_the_jit_layer_imports_numba():
+    """Every contact with numba goes through jit/ (docs/ARCHITECTURE.md), so a numba release is
+    answered there; bench/ is outside the rule because it times numba's own import and compiles."""
+    offenders = [f"{name}:{line}: {what}" for name in MODULES
+                 if name.split(".")[0] not in ("jit", "bench")
+                 for line, what in _numba_imports(name)]
+    assert not offenders, "numba imported outside jit/: " + "; ".join(offenders)
+    assert _numba_imports("jit.api"), "the check sees imports"
 
 
 def _run(code):

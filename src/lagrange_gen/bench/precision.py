@@ -199,7 +199,7 @@ def _peer_list(mod, case, p, model_file, settings):
     return out
 
 
-def _reference(mod, case, p, settings):
+def reference_for_case(mod, case, p, settings):
     t_check = np.linspace(0.0, case.t_end, case.samples + 1)
     q0, v0 = np.array(case.q0, float), np.array(case.v0, float)
     if case.constrained:
@@ -212,8 +212,8 @@ def run_case(case, models_dir, gen_dir, settings, methods=None, progress=None):
     progress = progress or common.Progress(1, "", enabled=False)
     mod = runs.load_module(models_dir, case.stem, gen_dir)
     p = runs.params_of(mod)
-    reference = _reference(mod, case, p, settings)
-    wanted = _ours(case, methods)
+    reference = reference_for_case(mod, case, p, settings)
+    wanted = methods_for_case(case, methods)
     points = []
     for method in wanted:
         sweep = sweep_adaptive if registry.spec(method).adaptive else sweep_ours
@@ -255,7 +255,7 @@ def run_precision(models_dir="models", gen_dir="generated", reports_dir="reports
     return {"results": results, "report": path}
 
 
-def _ours(case, methods):
+def methods_for_case(case, methods):
     """Our methods for a case: the constrained ones, or the fixed-step unconstrained ones and
     the adaptive ones; restricted to ``methods`` when given."""
     pool = runs.constrained_methods() if case.constrained else \
@@ -271,7 +271,7 @@ def _has_pydy():
 def _n_runs(case, settings, methods):
     """Runs of a case for the progress bar (sweeps that stop early count what they skip)."""
     ours = sum(len(settings.dop_rtols) if registry.spec(m).adaptive else settings.k_max + 1
-               for m in _ours(case, methods))
+               for m in methods_for_case(case, methods))
     dop, radau = len(settings.dop_rtols), len(settings.radau_rtols)
     return ours + (dop if case.constrained else (3 if _has_pydy() else 2) * dop + radau)
 

@@ -53,9 +53,9 @@ def measure_precision(models_dir, gen_dir, quick, progress):
     settings = replace(precision.QUICK if quick else precision.FULL, floor=common.TARGET / 10)
     mod = runs.load_module(models_dir, CASE.stem, gen_dir)
     p = runs.params_of(mod)
-    reference = precision._reference(mod, CASE, p, settings)
+    reference = precision.reference_for_case(mod, CASE, p, settings)
     ours = {}
-    for method in precision._ours(CASE, None):
+    for method in precision.methods_for_case(CASE, None):
         sweep = precision.sweep_adaptive if registry.spec(method).adaptive else \
             precision.sweep_ours
         ours[method] = common.time_at(sweep(mod, method, CASE, p, reference, settings,

@@ -109,7 +109,7 @@ ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
 # events are per-member scratch (the times are the same for every member; events are counted).
 _ENSEMBLE_GLUE = '''import math as _math
 
-from numba import prange as _prange
+from lagrange_gen.jit.api import prange as _prange
 
 from lagrange_gen.steppers.core import layout as _layout
 from lagrange_gen.steppers.core.status import NON_FINITE as _NON_FINITE

@@ -22,10 +22,9 @@ saved row) and, with outputs, ``saved["output_<name>"]`` (the generated ``output
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
-
 from ..errors import SimulationError
+from ..jit import njit
+from ..jit.api import overload, types
 from .params import resolve_params
 from ..steppers.core.options import FAST
 

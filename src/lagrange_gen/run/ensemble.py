@@ -216,8 +216,8 @@ def _run_batches(run, q, v, p, t0, h, n_steps, save_every, config, out, progress
     if not progress:
         run_members(run, q, v, p, t0, h, n_steps, save_every, config, out, slice(0, M))
         return
-    import numba
-    batch = max(MEMBERS_PER_THREAD * numba.get_num_threads(), math.ceil(M / 50))
+    from ..jit.api import get_num_threads
+    batch = max(MEMBERS_PER_THREAD * get_num_threads(), math.ceil(M / 50))
     bar = ProgressBar(M)
     for start in range(0, M, batch):
         members = slice(start, min(M, start + batch))

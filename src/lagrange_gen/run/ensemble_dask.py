@@ -62,20 +62,19 @@ def run_chunk(path, source, key, method, q, v, p, t0, h, n_steps, save_every, se
     """One task: the members (q, v, p) (K, ...) run by ensemble_<method>; returns the output
     dict of ensemble_outputs.allocate_outputs (K members, ``rows`` rows), row 0 of extra from extra0
     (K, n_saved), the members' initial saved fields."""
-    import numba
-
+    from ..jit.api import get_num_threads, max_threads, set_num_threads
     from .ensemble_outputs import allocate_outputs, run_members
     module = import_on_worker(path, source, key)
     run = getattr(module, f"ensemble_{method}")
     K, n = q.shape
     out = allocate_outputs(K, rows, n, extra0.shape[1])
     out["extra"][:, 0] = extra0
-    before = numba.get_num_threads()
-    numba.set_num_threads(max(1, min(worker_threads, numba.config.NUMBA_NUM_THREADS)))
+    before = get_num_threads()
+    set_num_threads(max(1, min(worker_threads, max_threads())))
     try:
         run_members(run, q, v, p, t0, h, n_steps, save_every, settings, out, slice(0, K))
     finally:
-        numba.set_num_threads(before)
+        set_num_threads(before)
     return {k: out[k] for k in ("q", "v", "stats", "extra", "last", "status")}
 
 

@@ -19,11 +19,10 @@ from __future__ import annotations
 import importlib
 
 import numpy as np
-from numba import njit, typeof
-from numba.experimental import jitclass
-
 from .control import input_slots
 from ..errors import SimulationError
+from ..jit import njit
+from ..jit.api import jitclass, typeof
 from .failures import raise_for_status
 from ..linear.linearize import parameter_vector
 from ..steppers.core import status as st
