@@ -60,8 +60,8 @@ def test_sweep_without_a_gpu_says_so_in_one_line():
     if _gpu_here():
         pytest.skip("a CUDA GPU is present")
     out = _python("from lagrange_gen.cli.main import main\n"
-                  f"main(['sweep', {CART!r}, '--grid', 'k=5:10:2', '--h', '1e-3', "
-                  "'--t-end', '0.002', '--device', 'cuda'])")
+                  f"raise SystemExit(main(['sweep', {CART!r}, '--grid', 'k=5:10:2', "
+                  "'--h', '1e-3', '--t-end', '0.002', '--device', 'cuda']))")
     assert out.returncode != 0
     assert "Traceback" not in out.stderr
     lines = [line for line in out.stderr.splitlines() if line.strip()]
