@@ -128,3 +128,15 @@ def test_a_model_with_events_is_refused():
     assert refusal(model, "rk4") == ("bouncing: events are not located on the GPU yet (the "
                                      "model has 1); use device='cpu'")
     assert refusal(SimpleNamespace(NAME="plain", N_EVENTS=0), "rk4") == ""
+
+
+def test_bench_gpu_measures_and_reports():
+    """`lagrange-gen bench gpu`'s measurement and report on 2 members and 3 steps (here the
+    simulator's figures: the bench itself refuses to report the simulator as a GPU)."""
+    from lagrange_gen.bench.gpu import measure, report_lines
+    row = measure(lg.import_generated(CART), 2, n_steps=3)
+    assert row["failed"] == row["cpu_failed"] == 0
+    assert row["diff"] <= 1e-13 and 0 < row["f32_diff"] < 1e-5
+    lines = report_lines([("cart pendulum", row)], "test device")
+    assert lines[6].startswith("| cart pendulum | 2 | ") and "GPU: test device." in lines[2]
+    assert lines[-1] == "Every member of every run reached t_end."

@@ -69,7 +69,6 @@ def run_gpu_bench(report, models_dir="models", quick=False, gen_dir="generated")
     if not present:
         print(f"bench gpu: no GPU found, nothing measured ({what})")
         return None
-    import numba
     from ..run.simulate import load_module
     rows = []
     for label, stem, options, log2, log2_quick in WORK:
@@ -77,6 +76,16 @@ def run_gpu_bench(report, models_dir="models", quick=False, gen_dir="generated")
         M = 2 ** (log2_quick if quick else log2)
         print(f"bench gpu: {label}, {M} members ...", flush=True)
         rows.append((label, measure(module, M)))
+    lines = report_lines(rows, what, quick)
+    path = write_report(report, lines)
+    print("\n".join(lines))
+    print(f"wrote {path}")
+    return rows
+
+
+def report_lines(rows, device, quick=False):
+    """The report's lines (markdown) for rows [(label, measure(...))] measured on ``device``."""
+    import numba
     lines = [
         "# GPU ensembles against the CPU ensemble",
         "",
@@ -85,7 +94,7 @@ def run_gpu_bench(report, models_dir="models", quick=False, gen_dir="generated")
         f"the kernel run (without the copies to and from the GPU; the whole GPU call in "
         f"brackets) and of the CPU ensemble on {numba.get_num_threads()} threads "
         f"({os.cpu_count()} CPUs, {platform.processor() or platform.machine()}), best of 2 "
-        f"CPU runs. GPU: {what}. Difference: the largest |q_gpu - q_cpu| at the last state "
+        f"CPU runs. GPU: {device}. Difference: the largest |q_gpu - q_cpu| at the last state "
         f"over all members, relative to max(1, |q|).",
         "",
         "| model | members | GPU member-steps/s | CPU member-steps/s | GPU / CPU | "
@@ -101,7 +110,4 @@ def run_gpu_bench(report, models_dir="models", quick=False, gen_dir="generated")
     failed = [f"{label}: {r['failed']} GPU / {r['cpu_failed']} CPU members failed"
               for label, r in rows if r["failed"] or r["cpu_failed"]]
     lines += ["", *(failed or ["Every member of every run reached t_end."])]
-    path = write_report(report, lines)
-    print("\n".join(lines))
-    print(f"wrote {path}")
-    return rows
+    return lines

@@ -7,8 +7,6 @@ np.vstack) before the import, only when it is missing.
 
 from __future__ import annotations
 
-import os
-
 from ..errors import SimulationError
 
 #: What to install for device="cuda".
@@ -20,11 +18,6 @@ def restore_row_stack():
     import numpy as np
     if not hasattr(np, "row_stack"):
         np.row_stack = np.vstack
-
-
-def simulator_requested() -> bool:
-    """True when numba's CUDA simulator is asked for (NUMBA_ENABLE_CUDASIM=1)."""
-    return os.environ.get("NUMBA_ENABLE_CUDASIM", "0") not in ("", "0")
 
 
 def import_cuda():
