@@ -207,3 +207,23 @@ def test_a_cold_simulate_of_a_generated_module_does_not_import_sympy():
                "assert traj.q.shape == (6, 2), traj.q.shape\n"
                "assert 'sympy' not in sys.modules, 'sympy imported'\n")
     assert out.returncode == 0, out.stderr
+
+
+def test_gpu_sits_below_run():
+    """gpu/ (ensemble(device="cuda")) imports neither run/ nor cli/: run calls it."""
+    above = ("run", "cli", "linear", "viz", "analysis", "bench", "identify")
+    offenders = [f"{name} -> {target}" for name, targets in _graph().items()
+                 if name.split(".")[0] == "gpu"
+                 for target in targets if target.split(".")[0] in above]
+    assert not offenders, "gpu/ imports a stage above it: " + "; ".join(offenders)
+
+
+def test_a_cpu_ensemble_does_not_import_numba_cuda():
+    out = _run("import sys\n"
+               "import lagrange_gen as lg\n"
+               "ens = lg.ensemble('generated/cart_pendulum.py', 'rk4', q0=[[0.1, 0.5]], "
+               "t_end=0.003, h=1e-3)\n"
+               "assert ens.ok.all() and ens.device == 'cpu'\n"
+               "loaded = [m for m in ('numba.cuda', 'lagrange_gen.gpu') if m in sys.modules]\n"
+               "assert not loaded, loaded\n")
+    assert out.returncode == 0, out.stderr

@@ -74,6 +74,11 @@ def _ensemble(args):
     run_ensemble_bench(Path(args.reports) / "ensemble.md", models_dir=args.models, quick=args.quick)
 
 
+def _gpu(args):
+    from .gpu import run_gpu_bench
+    run_gpu_bench(Path(args.reports) / "gpu.md", models_dir=args.models, quick=args.quick)
+
+
 def _stepapi(args):
     from .stepapi import run_stepapi_bench
     run_stepapi_bench(Path(args.reports) / "stepapi.md", models_dir=args.models, quick=args.quick)
@@ -105,6 +110,8 @@ SUITES = {
                "derivatives against Pinocchio (pin)", _robots),
     "ensemble": ("members per second of lagrange_gen.ensemble on 1 and 2 threads vs a simulate loop",
                  _ensemble),
+    "gpu": ("member-steps/s of ensemble(device='cuda') vs the CPU ensemble, max difference, "
+            "compile time; says so when no GPU is present", _gpu),
     "stepapi": ("us per Stepper.step call on the cart pole vs simulate per step; controller hook cost",
                 _stepapi),
     "compile": ("first compile with each numba speedup on and off (LAGRANGE_GEN_SPEEDUPS)",

@@ -4,8 +4,9 @@
         --q0 0.1 0.5 --t-end 10 --h 1e-3 --save-every 100 --out sweep.npz --plot sweep.png \\
         --scalar max_amplitude --coord theta
 
-Runs lagrange_gen.ensemble over the Cartesian product of the --grid axes (START:STOP:COUNT, the
-ends included, or a comma list), writes the ensemble (npz: t, q, v, energy, status, steps_done,
+Runs lagrange_gen.ensemble (on every core; with --device cuda one GPU thread per member) over
+the Cartesian product of the --grid axes (START:STOP:COUNT, the ends included, or a comma
+list), writes the ensemble (npz: t, q, v, energy, status, steps_done,
 params, the grid axes and the scalar) and a picture of one scalar per member over the grid (a
 curve for one axis, an image for two). Failed members are listed on stderr, one line each, and
 are NaN in the scalar. Options shared with `simulate` (q0, v0, --param, the method settings)
@@ -63,6 +64,11 @@ def add_parser(subparsers):
     p.add_argument("--gen-dir", default="generated", metavar="DIR",
                    help="where model files are generated (default: generated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
+    p.add_argument("--device", default="cpu", choices=("cpu", "cuda"),
+                   help="cpu: every core; cuda: one GPU thread per member (needs numba-cuda, "
+                        "the gpu extra, and a GPU)")
+    p.add_argument("--dtype", default="float64", choices=("float64", "float32"),
+                   help="arithmetic of the members on --device cuda (default float64)")
     add_setting_options(p)
     return p
 
@@ -112,7 +118,8 @@ def run(args) -> int:
         result = ensemble(model, args.method, q0=args.q0, v0=args.v0,
                           params={**shared, **grid(**axes)}, t_end=args.t_end, h=args.h,
                           save_every=args.save_every, progress=args.progress,
-                          out_dir=args.gen_dir, **given_settings(args))
+                          out_dir=args.gen_dir, device=args.device, dtype=args.dtype,
+                          **given_settings(args))
     coord = _coord_index(result, args.coord)
     scalar = SCALARS[args.scalar][1](result, coord)
     scalar = np.where(result.ok, scalar, np.nan)
@@ -120,7 +127,8 @@ def run(args) -> int:
         print(f"lagrange-gen: failed: {line}", file=sys.stderr)
     print(f"{result.model}, {result.method}: {len(result.status)} members over "
           f"{' x '.join(f'{k} ({len(v)})' for k, v in axes.items())}, "
-          f"{int((~result.ok).sum())} failed, {result.wall_time:.3g} s")
+          f"{int((~result.ok).sum())} failed, {result.wall_time:.3g} s"
+          + (f" on {result.device}" if result.device != "cpu" else ""))
     if args.out:
         _write_npz(args.out, result, axes, args.scalar, scalar)
         print(f"wrote {args.out}")

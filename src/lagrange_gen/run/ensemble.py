@@ -76,6 +76,7 @@ class EnsembleResult:
     compile_time: float
     messages: dict = field(default_factory=dict)    # {member: one-line failure message}
     jit: str = ""       # the glue that ran: "specialized" or "portable" (ensemble(jit=))
+    device: str = "cpu"     # where the members ran: "cpu", or the GPU's name (device="cuda")
 
     @property
     def ok(self):
@@ -89,7 +90,7 @@ class EnsembleResult:
 
 def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
              save_every=1, t0=0.0, progress=False, out_dir="generated", client=None,
-             worker_threads=1, jit=None, **settings):
+             worker_threads=1, jit=None, device="cpu", dtype="float64", **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
     q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
@@ -103,7 +104,12 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     jit: as simulate's (lagrange_gen.jit.portable): "auto" runs the generated ensemble_<method> when
     numba's cache holds it, else the portable ensemble glue, compiled once for every model
     (models with events: always the generated one); the Dask path runs the generated one.
-    EnsembleResult.jit says which ran."""
+    EnsembleResult.jit says which ran.
+    device: "cpu", or "cuda": one GPU thread per member (lagrange_gen.gpu; needs numba-cuda, the
+    ``gpu`` extra), the same EnsembleResult; the methods registry.GPU_METHODS, models without
+    events; dtype "float64" or "float32" (GPU only: state, parameters and outputs in float32,
+    returned as float64 arrays); no progress bar. Anything the GPU path cannot run, and a
+    missing numba-cuda, driver or GPU, is one SimulationError line."""
     from .simulate import check_times, element_method, load_module
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
@@ -116,9 +122,13 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if spec.adaptive:
         raise SimulationError(f"method {method!r} chooses its own steps; ensemble runs the "
                               f"fixed-step methods only (e.g. rk4, midpoint, verlet)")
-    run = _ensemble_glue(module, method)
+    on_gpu = _check_device(device, dtype, client)
+    run = None if on_gpu else _ensemble_glue(module, method)
     h = check_times(spec, h, t0, t_end, save_every, None)
     config = make_settings(spec, settings)
+    if on_gpu:
+        from ..gpu.launch import check_gpu_request
+        check_gpu_request(module, method, dtype, config)
     M = member_count(module, q0, v0, params)
     q, v = member_states(module, "q0", q0, M), member_states(module, "v0", v0, M)
     p = member_params(module, params, M)
@@ -134,6 +144,14 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     out = allocate_outputs(M, rows, n, n_saved)
     if spec.constraints:
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
+    if on_gpu:
+        from ..gpu.launch import run_on_gpu
+        compile_time, wall, where = run_on_gpu(module, method, q, v, p, t0, h, n_steps,
+                                               save_every, config, out, dtype)
+        result = _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time,
+                         getattr(config, "max_iter", 0))
+        result.jit, result.device = f"cuda {dtype}", where
+        return result
     if client is None:
         run, ran, compile_time = _warm_up(
             lambda args: choose_ensemble(jit, run, module, method, args),
@@ -152,6 +170,18 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
                      getattr(config, "max_iter", 0))
     result.jit = ran
     return result
+
+
+def _check_device(device, dtype, client):
+    """True for device="cuda"; one-line SimulationError for what does not go together."""
+    if device not in ("cpu", "cuda"):
+        raise SimulationError(f"device {device!r}: expected 'cpu' or 'cuda'")
+    if device == "cpu" and dtype != "float64":
+        raise SimulationError(f"dtype {dtype!r} runs on device='cuda' only; the CPU ensemble "
+                              f"is float64")
+    if device == "cuda" and client is not None:
+        raise SimulationError("device='cuda' runs on this machine's GPU: pass no Dask client")
+    return device == "cuda"
 
 
 def _ensemble_glue(module, method):

@@ -28,6 +28,12 @@ NONSMOOTH_METHODS = tuple(m for m in METHODS if INFO[m].elements)
 #: Methods that choose their own steps (adaptive glue signature, simulate's rtol/atol/t_eval).
 ADAPTIVE_METHODS = tuple(m for m in METHODS if INFO[m].adaptive)
 
+#: Methods lagrange_gen.ensemble(..., device="cuda") runs (lagrange_gen.gpu): numba-cuda compiles
+#: their prepare and step, the run loop's steps and the generated kernels for the GPU as they are
+#: (tests/gpu lowers each for the CUDA target). Not yet: the compositions (their workspaces are
+#: built by jitted helpers), dop853 (adaptive), the nonsmooth and constrained methods.
+GPU_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4")
+
 #: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
 ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}
 
