@@ -180,9 +180,10 @@ def _numba_imports(name):
 
 def test_only_the_jit_layer_imports_numba():
     """Every contact with numba goes through jit/ (docs/ARCHITECTURE.md), so a numba release is
-    answered there; bench/ is outside the rule because it times numba's own import and compiles."""
+    answered there; gpu/ is the same layer for the CUDA target (numba-cuda), and bench/ is
+    outside the rule because it times numba's own import and compiles."""
     offenders = [f"{name}:{line}: {what}" for name in MODULES
-                 if name.split(".")[0] not in ("jit", "bench")
+                 if name.split(".")[0] not in ("jit", "gpu", "bench")
                  for line, what in _numba_imports(name)]
     assert not offenders, "numba imported outside jit/: " + "; ".join(offenders)
     assert _numba_imports("jit.api"), "the check sees imports"
