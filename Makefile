@@ -36,7 +36,7 @@ SMOKE_TESTS := tests/test_portable.py tests/test_jit_cache.py tests/test_jit_cal
 $(LOWEST_VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(LOWEST_VENV)
 	$(LOWEST_VENV)/bin/pip install --quiet --upgrade pip
-	$(LOWEST_VENV)/bin/pip install --quiet "numba==0.59.1" "numpy<2" -e '.[test]'
+	$(LOWEST_VENV)/bin/pip install --quiet "numba==0.59.1" "numpy<2" -e '.[test-base]'
 	touch $@
 
 test-lowest-numba: $(LOWEST_VENV)/.installed
