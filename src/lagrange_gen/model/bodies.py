@@ -267,15 +267,16 @@ def kinetic_energy(frame, *bodies):
     me = _me()
     try:
         tree = _Tree(frame)
-        total = sp.S.Zero
+        total, inertias = sp.S.Zero, []
         for body in bodies:
             v = tree.velocity(body.masscenter)
             total += body.mass * v.dot(v) / 2
             if isinstance(body, me.RigidBody):
                 w = tree.w(body.frame)
                 inertia = tree._coords(body.central_inertia.to_matrix(body.frame))
+                inertias.append(inertia)
                 total += (w.T * inertia * w)[0, 0] / 2
-        remember(total, frame, bodies, tree)
+        remember(total, frame, bodies, tree, inertias)
         return total
     except _NoRecords as exc:
         _fallback("kinetic_energy", exc)

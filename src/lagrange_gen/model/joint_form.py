@@ -57,9 +57,10 @@ class Link:
     inertia: sp.Matrix
 
 
-def remember(T, frame, bodies, tree):
-    """Record how kinetic_energy built ``T`` (read back, on demand, by joint_form)."""
-    _RECORDS[T] = (frame, tuple(bodies), tree)
+def remember(T, frame, bodies, tree, inertias):
+    """Record how kinetic_energy built ``T`` (read back, on demand, by joint_form); inertias:
+    the central inertia (3, 3) of each RigidBody in its frame, as T used it."""
+    _RECORDS[T] = (frame, tuple(bodies), tree, tuple(inertias))
     _RECORDS.move_to_end(T)
     while len(_RECORDS) > _KEEP:
         _RECORDS.popitem(last=False)
@@ -81,9 +82,9 @@ class _DoesNotFit(Exception):
     """The bodies do not form a tree of joints this module can describe."""
 
 
-def _links(frame, bodies, tree):
+def _links(frame, bodies, tree, inertias):
     import sympy.physics.mechanics as me
-    if not all(isinstance(b, me.RigidBody) for b in bodies):
+    if not all(isinstance(b, me.RigidBody) for b in bodies) or len(inertias) != len(bodies):
         raise _DoesNotFit("a Particle")
     of_frame = {}
     for i, body in enumerate(bodies):
@@ -126,7 +127,7 @@ def _links(frame, bodies, tree):
         if S.free_symbols & set(rates) or v_joint.xreplace({s: 0 for s in rates}) != sp.zeros(6, 1):
             raise _DoesNotFit("joint velocity not linear in its rates")
         links.append(Link(str(body.name), index[p] if p >= 0 else -1, coords, constant_folded(S), E, r,
-                          sp.sympify(body.mass), com, tree.coords(body.central_inertia.to_matrix(body.frame))))
+                          sp.sympify(body.mass), com, inertias[i]))
     return links
 
 
@@ -161,10 +162,15 @@ def _parent_first(parent):
 
 
 def _body_fixed_origin(tree, body, candidates):
-    """(origin, com (3, 1)): the first point of ``candidates`` (from the parent's origin out to
-    the mass centre) from which the mass centre is fixed in the body's frame."""
-    for point in candidates:
+    """(origin, com (3, 1)): the point of ``candidates`` (from the parent's origin out to the
+    mass centre) nearest the parent from which, and from every point after it, the mass
+    centre is fixed in the body's frame (walked back from the mass centre: short vectors)."""
+    found = None
+    for point in reversed(candidates):
         com = tree.coords(body.masscenter.pos_from(point).to_matrix(body.frame))
-        if not any(isinstance(s, (Coordinate, Velocity)) or s == t for s in com.free_symbols):
-            return point, com
-    raise _DoesNotFit("no body-fixed origin")
+        if any(isinstance(s, (Coordinate, Velocity)) or s == t for s in com.free_symbols):
+            break
+        found = (point, com)
+    if found is None:
+        raise _DoesNotFit("no body-fixed origin")
+    return found
