@@ -7,6 +7,11 @@ Three variants, chosen from the model:
   LDL^T factorization written out for this n, with the same singularity test as
   linalg.cholesky_inplace. No array is written but qdd.
 * H(q) depends on q, larger n: every call fills H and factors it (Cholesky, in numba).
+* H(q) depends on q and the kinetic energy is a tree of joints (derive/recursive.py), and the
+  articulated-body algorithm takes fewer operations than H and rhs: forward_dynamics is ABA
+  written out for this tree, O(n), with no H; forward_dynamics_torques too, and
+  forward_dynamics_jacobian is d qdd/dx = -H^-1 d(inverse dynamics)/dx at the solved qdd, the
+  inverse dynamics (RNEA) differentiated one column at a time.
 * H is constant: it is factored once, at import, for the default values of the parameters it
   depends on (MASS_FACTOR, lower Cholesky factor L with H = L L^T); a call evaluates only
   rhs = Q - h - g and does two triangular solves, unless the caller passes other values for
@@ -15,7 +20,11 @@ Three variants, chosen from the model:
 
 from __future__ import annotations
 
-from .emit import local_name, render_kernel
+import symengine as se
+
+from ..derive.recursive import operation_count
+from ..derive.structured import SEED_PREFIX
+from .emit import local_name, render_column_kernel, render_kernel
 from .printer import Inputs
 from .spec import KernelSpec, Output
 
@@ -125,6 +134,89 @@ def forward_dynamics_jacobian(q, qd, t, p, H, qdd, Jq, Jqd, W):
 '''
 
 
+_RECURSIVE_JACOBIAN = '''
+
+@njit(**KERNEL_OPTIONS)
+def forward_dynamics_jacobian(q, qd, t, p, H, qdd, Jq, Jqd, W):
+    """qdd (n,) by ABA and its derivatives Jq = d qdd/dq, Jqd = d qdd/dqd (n, n): with tau the
+    inverse dynamics, H J = -d tau/dx at the solved qdd (tau(q, qd, qdd(q, qd)) is the model's
+    own force, constant). H and W (n, n) are workspace. Returns OK or SINGULAR_MASS."""
+    status = forward_dynamics(q, qd, t, p, H, qdd)
+    if status != OK:
+        return status
+    mass_matrix(q, t, p, H)
+    if not cholesky_inplace(H):
+        return SINGULAR_MASS
+    inverse_dynamics_jacobian(q, qd, qdd, t, p, Jq, Jqd)
+    column = W[0]
+    for J in (Jq, Jqd):
+        for j in range(N_COORDS):
+            for i in range(N_COORDS):
+                column[i] = -J[i, j]
+            cholesky_solve_inplace(H, column)
+            for i in range(N_COORDS):
+                J[i, j] = column[i]
+    return OK
+'''
+
+
+def pivot_check_lines(count, name="D"):
+    """Statements returning SINGULAR_MASS unless every ABA pivot (locals D_0 ...) is positive
+    beyond SINGULAR_RTOL times the largest (the test of linalg.cholesky_inplace), else OK."""
+    if count == 0:
+        return ["return OK"]
+    pivots = [local_name(name, i) for i in range(count)]
+    scale = f"max({', '.join(f'abs({d})' for d in pivots)})" if count > 1 else f"abs({pivots[0]})"
+    return [f"scale = {scale}", "if not (scale > 0.0 and scale < math.inf):", "    return SINGULAR_MASS",
+            "tiny = SINGULAR_RTOL * scale",
+            f"if not ({' and '.join(f'{d} > tiny' for d in pivots)}):", "    return SINGULAR_MASS", "return OK"]
+
+
+def aba_text(dyn, torques=False) -> str:
+    """forward_dynamics (or forward_dynamics_torques, tau (n,) added to the model's forces) as
+    the articulated-body algorithm of dyn.recursive, written out."""
+    o, rec = dyn.ops, dyn.recursive
+    tau = o.symbols(dyn.aux["w"]) if torques else None
+    qdd, pivots = rec.forward_dynamics(tau)
+    name = "forward_dynamics_torques" if torques else "forward_dynamics"
+    args = ["q", "qd", "tau", "t", "p"] if torques else ["q", "qd", "t", "p"]
+    what = "rhs + tau for generalized forces tau (n,) added to the model's own (joint torques)" if torques else "rhs"
+    spec = KernelSpec(
+        name, args, [Output("qdd", o.column(qdd)), Output("D", o.column(pivots), local=True)],
+        doc=(f"Solve H(q) qdd = {what} by the articulated-body algorithm written out for this "
+             "tree (no H is formed); H (n, n) is not used (kept for the common signature), qdd (n,) "
+             "the output. Returns OK, or SINGULAR_MASS when a joint's articulated inertia D is not "
+             "numerically positive"),
+        out_args=["H", "qdd"], epilogue=pivot_check_lines(len(pivots)))
+    return render_kernel(spec, Inputs(dyn)).function
+
+
+def inverse_dynamics_jacobian_text(dyn) -> str:
+    """inverse_dynamics_jacobian(q, qd, qdd, t, p, Jq, Jqd): d tau/dq and d tau/dqd (n, n) of
+    the inverse dynamics (RNEA) at given accelerations, one tangent pass per column."""
+    o, rec, graph = dyn.ops, dyn.recursive, dyn.ops.graph
+    tau = rec.inverse_dynamics(o.symbols(dyn.aux["qdd"]))
+    seeds = [se.Symbol(f"{SEED_PREFIX}{i}") for i in range(dyn.n)]
+    columns = [(name, seeds, graph.tangents(tau, dict(zip(xs, seeds))))
+               for name, xs in (("Jq", o.symbols(dyn.q)), ("Jqd", o.symbols(dyn.qd)))]
+    spec = KernelSpec("inverse_dynamics_jacobian", ["q", "qd", "qdd", "t", "p"],
+                      doc="d tau/dq and d tau/dqd (n, n) of the inverse dynamics tau = H qdd + h + g - Q "
+                          "at accelerations qdd (n,), column by column",
+                      out_args=["Jq", "Jqd"], columns=columns)
+    return render_column_kernel(spec, Inputs(dyn)).function
+
+
+def uses_aba(dyn) -> bool:
+    """True when forward dynamics is the articulated-body algorithm: a tree of joints whose ABA
+    has fewer operations than H and rhs (what forward_dynamics evaluates otherwise)."""
+    rec = dyn.recursive
+    if rec is None or dyn.mass_is_constant:
+        return False
+    graph = dyn.ops.graph
+    qdd, pivots = rec.forward_dynamics()
+    return operation_count(graph, qdd + pivots) < operation_count(graph, list(dyn.native["H"]) + list(dyn.native["rhs"]))
+
+
 def factor_at_import(dyn) -> bool:
     """True when H is constant and every parameter it depends on has a default value."""
     if not dyn.mass_is_constant:
@@ -175,6 +267,9 @@ def unrolled_forward_text(dyn) -> str:
 
 def forward_source(dyn) -> str:
     """Source of forward_dynamics and accelerations for this model (see the module docstring)."""
+    if uses_aba(dyn):
+        return "\n\n\n".join([aba_text(dyn), aba_text(dyn, torques=True), inverse_dynamics_jacobian_text(dyn)]) + \
+            "\n" + _ACCELERATIONS + _RECURSIVE_JACOBIAN
     torques = _WITH_TORQUES if hasattr(dyn.jac, "inverse_dynamics") and not dyn.mass_is_constant else ""
     if not factor_at_import(dyn):
         if not dyn.mass_is_constant and dyn.n <= UNROLL_MAX:

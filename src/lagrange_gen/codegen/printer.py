@@ -73,6 +73,8 @@ class Inputs:
             self._loads[arg] = [(f"{arg}_{i}", f"{arg}[{i}]") for i in range(len(symbols[arg]))]
             for i, s in enumerate(symbols[arg]):
                 self.rename[s] = f"{arg}_{i}"
+        # generalized forces given to a kernel (forward_dynamics_torques) are the w symbols
+        self._loads["tau"] = [(f"w_{i}", f"tau[{i}]") for i in range(len(symbols["w"]))]
 
     def loads(self, args):
         return [pair for arg in args for pair in self._loads.get(arg, [])]

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from .kernel_abi import ALWAYS_2D
+from ..derive.recursive import operation_count
 from ..model.symbols import Parameter
 
 
@@ -142,13 +143,23 @@ ROBOT_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
 
 def robot_kernels(dyn) -> dict:
     """inverse_dynamics, gravity_forces and bias_forces of a graph model (each one pass over
-    the graph, cheaper than dynamics: no mass matrix is formed)."""
+    the graph, cheaper than dynamics: no mass matrix is formed): by RNEA over the tree of joints
+    (derive/recursive.py) where it has fewer operations than the tangent of the momentum."""
     nat, o = dyn.native, dyn.ops
-    minus_rhs = o.column([-e for e in nat["rhs"]])
+    qdd = o.symbols(dyn.aux["qdd"])
+    tau, minus_rhs = dyn.jac.inverse_dynamics(qdd), [-e for e in nat["rhs"]]
+    if dyn.recursive is not None:
+        graph = o.graph
+        rnea, bias = dyn.recursive.inverse_dynamics(qdd), dyn.recursive.inverse_dynamics([0] * dyn.n)
+        if operation_count(graph, rnea) < operation_count(graph, tau):
+            tau = rnea
+        if operation_count(graph, bias) < operation_count(graph, minus_rhs):
+            minus_rhs = bias
+    minus_rhs = o.column(minus_rhs)
     return {
         "inverse_dynamics": lambda: KernelSpec(
             "inverse_dynamics", ["q", "qd", "qdd", "t", "p"],
-            [Output("tau", o.column(dyn.jac.inverse_dynamics(o.symbols(dyn.aux["qdd"]))))],
+            [Output("tau", o.column(tau))],
             doc="tau = H(q) qdd + h(q, qd) + g(q) - Q (n,): the generalized forces that give the "
                 "accelerations qdd (n,) (RNEA's answer)"),
         "gravity_forces": lambda: KernelSpec(

@@ -12,7 +12,9 @@ from .jacobians import Jacobians
 from .lagrangian import derive_lagrangian
 from .structured import (GraphJacobians, NotScleronomic, derive_lagrangian_graph, graph_model, import_expressions,
                          uses_graph)
+from ..model.joint_form import joint_form
 from ..model.model import Model, t as time_symbol
+from .recursive import recursive_dynamics
 
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
@@ -46,6 +48,8 @@ class Dynamics:
         self.jac = jacobians(o, jac_parts, o.symbols(self.q), o.symbols(self.qd),
                              o.symbols(aux["w"]), o.symbols(aux["lam"]), self.to_sympy)
         self._sympy = {}
+        #: derive.recursive.RecursiveDynamics when T is a tree of joints (else None)
+        self.recursive = None
 
     def to_sympy(self, obj):
         return self.ops.to_sympy(obj, self._names)
@@ -115,10 +119,11 @@ def derive(model: Model, check_samples: int = 8, freeze=None) -> Dynamics:
     value} substitutes those parameters by numbers before anything is derived.
     """
     frozen = dict(freeze or {})
+    links = joint_form(model.T)          # the record is keyed by the T kinetic_energy returned
     model = freeze_model(model, frozen) if frozen else model
     if uses_graph(model):
         try:
-            return _derive_through_graph(model, frozen, check_samples)
+            return _derive_through_graph(model, frozen, check_samples, links)
         except NotScleronomic:
             pass
     if getattr(model, "intermediates", ()):
@@ -141,9 +146,14 @@ def _finish(model, o, parts, frozen, jacobians):
     return Dynamics(model, o, native, parts, aux, frozen, jacobians)
 
 
-def _derive_through_graph(model, frozen, check_samples):
-    """derive() for a model over Intermediates (derive/structured.py)."""
+def _derive_through_graph(model, frozen, check_samples, links=None):
+    """derive() for a model over Intermediates (derive/structured.py); with ``links`` (its T
+    as a tree of joints, model/joint_form.py) also the recursive algorithms (derive/recursive.py)
+    when they reproduce the graph's dynamics."""
     model = graph_model(model)
     o, (T, V, D, *forces) = import_expressions(model, frozen, [model.T, model.V, model.dissipation, *model.forces])
     parts = derive_lagrangian_graph(model, o, T, V, D, forces, check_samples)
-    return _finish(model, o, parts, frozen, GraphJacobians)
+    dyn = _finish(model, o, parts, frozen, GraphJacobians)
+    if links is not None:
+        dyn.recursive = recursive_dynamics(links, o, model, T, parts, o.symbols(dyn.aux["qdd"]), frozen)
+    return dyn

@@ -25,6 +25,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .intermediates import new_intermediate
+from .joint_form import remember
 from .symbols import Coordinate, t
 
 __all__ = ["kinetic_energy", "gravity_potential", "is_constant_force", "constant_force_potential"]
@@ -40,6 +41,7 @@ class _Tree:
         self._R = {frame: sp.eye(3)}
         self._w = {frame: sp.zeros(3, 1)}
         self._r, self._v = {}, {}
+        self._parent = {frame: None}
         self._convert = {}
         self._walk_frames()
 
@@ -84,10 +86,29 @@ class _Tree:
                 if child in self._R:
                     continue
                 local = self._coords(child.dcm(parent))        # [v]_child = local [v]_parent
+                self._parent[child] = parent
                 self._R[child] = self._named(self._R[parent] * local.T)
                 relative = self.components(child.ang_vel_in(parent), child, adjacent=parent)
                 self._w[child] = self._named(local * self._w[parent] + relative)
                 queue.append(child)
+
+    def parent_frame(self, frame):
+        """The frame ``frame`` was reached from in the walk (None for N and unreached frames)."""
+        return self._parent.get(frame)
+
+    def coords(self, expr):
+        """``expr`` (a sympy expression or Matrix of mechanics) in Coordinates (see _coords)."""
+        if isinstance(expr, sp.MatrixBase):
+            return expr.applyfunc(self._coords)
+        return self._coords(expr)
+
+    def point_path(self, point):
+        """[points] from the nearest fixed point out to ``point`` (as position() walks it)."""
+        def fixed(p):
+            given = _records(p, "_vel_dict").get(self.N)
+            return given is not None and given == 0
+        root, path = _nearest(point, fixed, self.N, what="a fixed point (O.set_vel(N, 0))")
+        return [root] + [child for child, _ in path]
 
     def R(self, frame):
         if frame not in self._R:
@@ -246,14 +267,16 @@ def kinetic_energy(frame, *bodies):
     me = _me()
     try:
         tree = _Tree(frame)
-        total = sp.S.Zero
+        total, inertias = sp.S.Zero, []
         for body in bodies:
             v = tree.velocity(body.masscenter)
             total += body.mass * v.dot(v) / 2
             if isinstance(body, me.RigidBody):
                 w = tree.w(body.frame)
                 inertia = tree._coords(body.central_inertia.to_matrix(body.frame))
+                inertias.append(inertia)
                 total += (w.T * inertia * w)[0, 0] / 2
+        remember(total, frame, bodies, tree, inertias)
         return total
     except _NoRecords as exc:
         _fallback("kinetic_energy", exc)

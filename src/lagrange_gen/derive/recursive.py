@@ -1,0 +1,253 @@
+"""Recursive rigid-body algorithms as expression-graph programs, specialized to the model's constants.
+
+For a kinetic energy built from bodies that form a tree of joints (model/joint_form.py), the
+inverse dynamics (RNEA) and the forward dynamics (ABA, Featherstone's articulated-body
+algorithm) take O(n) operations where H from n tangents of the momentum and its Cholesky
+factorization take O(n^2) and more. Each algorithm is written here once, over spatial vectors
+whose entries are graph nodes (derive/graph.py): the joint axes, offsets and inertias are
+numbers, so the products with their zeros and ones vanish as the nodes are made, and the
+emitter writes the result like any other graph kernel.
+
+Only T goes through the tree. The potential, dissipation, forces and inputs enter as the
+generalized force tau_model = Q - dV/dq (the graph's own g and Q), so gravity needs no special
+case. Conventions: spatial vectors (angular; linear) in a link's frame at its origin; a link's
+transform from its parent is [x]_link = E [x]_parent with origin r (joint_form.Link).
+
+``recursive_dynamics`` checks, at random states, the tree's kinetic energy, its inverse dynamics
+and its forward dynamics against the graph's T, H qdd + h + g - Q and H^-1 rhs; any difference
+and the module is not used (the H + Cholesky kernels stay).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import symengine as se
+import sympy as sp
+
+from ..model.symbols import Parameter, t
+
+__all__ = ["RecursiveDynamics", "recursive_dynamics", "operation_count"]
+
+
+def operation_count(graph, exprs):
+    """Arithmetic operations and function calls to evaluate ``exprs`` (native) with the graph
+    nodes they use: what numba's compile time and the run time follow."""
+    def count(e):
+        if e.is_Number or e.is_Symbol:
+            return 0
+        own = len(e.args) - 1 if type(e).__name__ in ("Add", "Mul") else 1
+        return own + sum(count(a) for a in e.args)
+    return sum(count(d) for _, d in graph.used_nodes(exprs)) + sum(count(se.sympify(e)) for e in exprs)
+
+
+def _cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+class RecursiveDynamics:
+    """The tree's recursions over the graph of ``o`` (GraphOps); q, qd native symbols (n,),
+    tau_model (n,) native: Q - g, the generalized forces besides inertia."""
+
+    def __init__(self, links, o, q, qd, tau_model, frozen):
+        self.graph, self.o = o.graph, o
+        self.n, self.qd, self.tau_model = len(q), list(qd), list(tau_model)
+        names = {str(s): i for i, s in enumerate(q)}
+        freeze = {}
+        self.links = []
+        for link in links:
+            for e in (link.S, link.E, link.r, link.com, link.inertia, link.mass):
+                freeze.update({p: sp.Float(frozen[p.name]) for p in sp.sympify(e).free_symbols
+                               if isinstance(p, Parameter) and p.name in frozen})
+
+            def native(matrix):
+                return [[o.native(matrix[i, j].xreplace(freeze)) for j in range(matrix.cols)] for i in range(matrix.rows)]
+            cols = [list(col) for col in zip(*native(link.S))] if link.S.cols else []
+            E, Ic = native(link.E), native(link.inertia)
+            r, c = [row[0] for row in native(link.r)], [row[0] for row in native(link.com)]
+            m = o.native(sp.sympify(link.mass).xreplace(freeze))
+            cx = [[0, -c[2], c[1]], [c[2], 0, -c[0]], [-c[1], c[0], 0]]
+            A = [[Ic[i][j] + m * sum(cx[i][l] * cx[j][l] for l in range(3)) for j in range(3)] for i in range(3)]
+            B = [[m * cx[i][j] for j in range(3)] for i in range(3)]
+            inertia = [A[i] + B[i] for i in range(3)] + [[B[j][i] for j in range(3)] + [m if j == i else 0 for j in range(3)]
+                                                          for i in range(3)]
+            S_dot = [[sum(s.diff(x) * o.native(sp.Symbol(str(x) + "_dot")) for x in s.free_symbols if str(x) in names)
+                      for s in col] for col in cols]
+            self.links.append(dict(parent=link.parent, joint=[names[str(x)] for x in link.coords], S=cols,
+                                   S_dot=S_dot, E=E, r=r, inertia=inertia))
+
+    # -- spatial algebra on lists of graph nodes -------------------------------------------
+    def _nodes(self, exprs):
+        return [self.graph.node(e) for e in exprs]
+
+    def _to_child(self, link, m):
+        """X m: a motion vector of the parent in the link's coordinates."""
+        E, r = link["E"], link["r"]
+        w, v = m[:3], [a + b for a, b in zip(m[3:], _cross(m[:3], r))]
+        return self._nodes([sum(E[i][j] * w[j] for j in range(3)) for i in range(3)] +
+                           [sum(E[i][j] * v[j] for j in range(3)) for i in range(3)])
+
+    def _to_parent(self, link, f):
+        """X^T f: a force of the link in the parent's coordinates."""
+        E, r = link["E"], link["r"]
+        fp = self._nodes([sum(E[j][i] * f[3 + j] for j in range(3)) for i in range(3)])
+        n = [sum(E[j][i] * f[j] for j in range(3)) for i in range(3)]
+        return self._nodes([a + b for a, b in zip(n, _cross(r, fp))] + fp)
+
+    def _congruence(self, link, M):
+        """X^T M X (6, 6) for a symmetric M (6, 6) in the link's coordinates: the parent's view."""
+        E, r = link["E"], link["r"]
+
+        def rotated(block, symmetric):                       # E^T block E
+            half = [[self.graph.node(sum(block[i][l] * E[l][j] for l in range(3))) for j in range(3)] for i in range(3)]
+            out = [[None] * 3 for _ in range(3)]
+            for i in range(3):
+                for j in range(i if symmetric else 0, 3):
+                    out[i][j] = self.graph.node(sum(E[l][i] * half[l][j] for l in range(3)))
+                    if symmetric:
+                        out[j][i] = out[i][j]
+            return out
+        A = rotated([row[:3] for row in M[:3]], True)
+        B = rotated([row[3:] for row in M[:3]], False)
+        C = rotated([row[3:] for row in M[3:]], True)
+        rx = [[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]]
+
+        def mul(P, Q):
+            return [[self.graph.node(sum(P[i][l] * Q[l][j] for l in range(3))) for j in range(3)] for i in range(3)]
+        K, rC = mul(B, rx), mul(rx, C)
+        rCr = mul(rC, rx)
+        top = [[self.graph.node(A[i][j] - K[i][j] - K[j][i] - rCr[i][j]) for j in range(3)] for i in range(3)]
+        right = [[self.graph.node(B[i][j] + rC[i][j]) for j in range(3)] for i in range(3)]
+        return [top[i] + right[i] for i in range(3)] + [[right[j][i] for j in range(3)] + C[i] for i in range(3)]
+
+    def _times(self, M, x):
+        return self._nodes([sum(M[i][j] * x[j] for j in range(6)) for i in range(6)])
+
+    def _cross_motion(self, v, m):
+        w, v0 = v[:3], v[3:]
+        return self._nodes(_cross(w, m[:3]) + [a + b for a, b in zip(_cross(w, m[3:]), _cross(v0, m[:3]))])
+
+    def _cross_force(self, v, f):
+        w, v0 = v[:3], v[3:]
+        return self._nodes([a + b for a, b in zip(_cross(w, f[:3]), _cross(v0, f[3:]))] + _cross(w, f[3:]))
+
+    def _velocities(self):
+        """[(v, c)] per link: spatial velocity and velocity-product acceleration c = S' qd + v x vJ."""
+        out = []
+        for link in self.links:
+            rates = [self.qd[j] for j in link["joint"]]
+            vJ = self._nodes([sum(col[i] * x for col, x in zip(link["S"], rates)) for i in range(6)])
+            parent = [0] * 6 if link["parent"] < 0 else self._to_child(link, out[link["parent"]][0])
+            v = self._nodes([a + b for a, b in zip(parent, vJ)])
+            S_dot_qd = [sum(col[i] * x for col, x in zip(link["S_dot"], rates)) for i in range(6)]
+            c = self._nodes([a + b for a, b in zip(S_dot_qd, self._cross_motion(v, vJ))])
+            out.append((v, c))
+        return out
+
+    # -- the algorithms ----------------------------------------------------------------------
+    def kinetic_energy(self):
+        """T of the tree, sum 1/2 v . I v (checked against the model's T)."""
+        total = 0
+        for link, (v, _) in zip(self.links, self._velocities()):
+            total += sum(a * b for a, b in zip(v, self._times(link["inertia"], v))) / 2
+        return self.graph.node(total)
+
+    def inverse_dynamics(self, qdd):
+        """tau (n,) = H qdd + h + g - Q by RNEA (qdd: n native expressions, zeros for h + g - Q)."""
+        kinematics = self._velocities()
+        accelerations, forces = [], []
+        for link, (v, c) in zip(self.links, kinematics):
+            parent = [0] * 6 if link["parent"] < 0 else self._to_child(link, accelerations[link["parent"]])
+            joint = [sum(col[i] * qdd[j] for col, j in zip(link["S"], link["joint"])) for i in range(6)]
+            a = self._nodes([p + s + x for p, s, x in zip(parent, joint, c)])
+            accelerations.append(a)
+            forces.append(self._nodes([x + y for x, y in zip(
+                self._times(link["inertia"], a), self._cross_force(v, self._times(link["inertia"], v)))]))
+        tau = [0] * self.n
+        for i in reversed(range(len(self.links))):
+            link = self.links[i]
+            for col, j in zip(link["S"], link["joint"]):
+                tau[j] = self.graph.node(sum(s * f for s, f in zip(col, forces[i])))
+            if link["parent"] >= 0:
+                up = self._to_parent(link, forces[i])
+                forces[link["parent"]] = self._nodes([a + b for a, b in zip(forces[link["parent"]], up)])
+        return [self.graph.node(x - y) for x, y in zip(tau, self.tau_model)]
+
+    def forward_dynamics(self, tau_extra=None):
+        """(qdd (n,), pivots) by ABA for the generalized forces tau_model (+ tau_extra, n native
+        symbols); pivots: the joints' D = S^T I^A S (each must be > 0)."""
+        tau = list(self.tau_model) if tau_extra is None else [self.graph.node(a + b) for a, b in zip(self.tau_model, tau_extra)]
+        kinematics = self._velocities()
+        IA = [[row[:] for row in link["inertia"]] for link in self.links]
+        pA = [self._cross_force(v, self._times(link["inertia"], v)) for link, (v, _) in zip(self.links, kinematics)]
+        solved = {}
+        for i in reversed(range(len(self.links))):
+            link, (_, c) = self.links[i], kinematics[i]
+            Ia, pa = IA[i], pA[i]
+            if link["joint"]:
+                if len(link["joint"]) > 1:
+                    raise NotImplementedError("joints of several coordinates")
+                (S,), j = link["S"], link["joint"][0]
+                U = self._times(IA[i], S)
+                D = self.graph.node(sum(s * u for s, u in zip(S, U)))
+                D_inv = self.graph.node(1 / D)
+                u = self.graph.node(tau[j] - sum(s * p for s, p in zip(S, pA[i])))
+                solved[i] = (U, D, D_inv, u, j)
+                if link["parent"] >= 0:
+                    Ia = [[self.graph.node(IA[i][r][s] - U[r] * U[s] * D_inv) for s in range(6)] for r in range(6)]
+                    pa = self._nodes([p + x + y * D_inv * u for p, x, y in zip(pA[i], self._times(Ia, c), U)])
+            elif link["parent"] >= 0:
+                pa = self._nodes([p + x for p, x in zip(pA[i], self._times(Ia, c))])
+            if link["parent"] >= 0:
+                parent = link["parent"]
+                extra = self._congruence(link, Ia)
+                IA[parent] = [[self.graph.node(IA[parent][r][s] + extra[r][s]) for s in range(6)] for r in range(6)]
+                pA[parent] = self._nodes([a + b for a, b in zip(pA[parent], self._to_parent(link, pa))])
+        qdd, pivots, accelerations = [0] * self.n, [], []
+        for i, link in enumerate(self.links):
+            c = kinematics[i][1]
+            parent = [0] * 6 if link["parent"] < 0 else self._to_child(link, accelerations[link["parent"]])
+            a = self._nodes([x + y for x, y in zip(parent, c)])
+            if i in solved:
+                U, D, D_inv, u, j = solved[i]
+                qdd[j] = self.graph.node(D_inv * (u - sum(x * y for x, y in zip(U, a))))
+                a = self._nodes([x + s * qdd[j] for x, s in zip(a, link["S"][0])])
+                pivots.append(D)
+            accelerations.append(a)
+        return qdd, pivots
+
+
+def recursive_dynamics(links, o, model, T, parts, qdd, frozen, samples=3):
+    """RecursiveDynamics of the tree ``links`` (joint_form) over the graph of ``o``, or None when
+    the tree does not reproduce the model's T, H qdd + h + g - Q and H^-1 rhs at ``samples``
+    random states (T: the model's, native; parts: derive_lagrangian_graph's fields; qdd: n
+    native symbols; frozen: {parameter name: value} folded into the links)."""
+    q, qd = o.symbols(model.coords), o.symbols(model.velocities)
+    if links is None or model.constraints or sorted(j for l in links for j in (str(x) for x in l.coords)) != sorted(map(str, q)):
+        return None
+    n = len(q)
+    tau_model = [o.graph.node(a - b) for a, b in zip(parts["Q"].entries, parts["g"].entries)]
+    try:
+        rec = RecursiveDynamics(links, o, q, qd, tau_model, frozen)
+        T_tree, tau = rec.kinetic_energy(), rec.inverse_dynamics(qdd)
+        accelerations, pivots = rec.forward_dynamics()
+    except (NotImplementedError, KeyError, ZeroDivisionError):
+        return None
+    graph = o.graph
+    Hqdd = graph.tangents(parts["p"], dict(zip(qd, qdd)))
+    reference = [graph.node(a - r) for a, r in zip(Hqdd, parts["rhs"].entries)]
+    args = q + qd + list(qdd) + o.symbols(list(model.params) + [t])
+    f = graph.evaluator(args, [T, T_tree, *tau, *reference, *accelerations])
+    from .lagrangian import sample_values
+    rng = np.random.default_rng(20261123)
+    for _ in range(samples):
+        state, rest = [*rng.uniform(-np.pi, np.pi, n), *rng.uniform(-1, 1, n)], [*sample_values(model), 0.5]
+        values = np.asarray(f(state + list(rng.uniform(-1, 1, n)) + rest), dtype=float)
+        T_m, T_r = values[:2]
+        tau_r, tau_m, acc = values[2:2 + n], values[2 + n:2 + 2 * n], values[2 + 2 * n:]
+        scale = 1.0 + abs(T_m) + np.abs(tau_m).max()
+        # ABA solves the inverse dynamics (checked against the graph's) for zero joint force
+        residual = np.asarray(f(state + list(acc) + rest), dtype=float)[2 + n:2 + 2 * n]
+        if (abs(T_m - T_r) > 1e-9 * (1 + abs(T_m)) or np.abs(tau_r - tau_m).max() > 1e-9 * scale
+                or np.abs(residual).max() > 1e-9 * (1.0 + np.abs(acc).max()) * scale):
+            return None
+    return rec

@@ -1,0 +1,227 @@
+"""Recursive algorithms over a tree of joints (model/joint_form.py, derive/recursive.py): on small
+random spatial trees (revolute and prismatic joints, full inertias) ABA, RNEA and the derivative
+of the accelerations through RNEA equal the H + Cholesky path of the graph and an independent
+plain-sympy Lagrange derivation (explicit rotation matrices); models that do not fit keep the
+old path."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from lagrange_gen import Model, parameters
+from lagrange_gen.analysis.random_trees import random_tree
+from lagrange_gen.codegen.forward import forward_source, uses_aba
+from lagrange_gen.derive import derive
+from lagrange_gen.derive.recursive import recursive_dynamics
+from lagrange_gen.model.bodies import gravity_potential, kinetic_energy
+from lagrange_gen.model.joint_form import joint_form
+from lagrange_gen.model.joint_tree import model_from_tree, tree_bodies
+from lagrange_gen.model.symbols import t
+
+#: (bodies, seed): prismatic joints and branching among them (seeds 0 and 1: two prismatic each)
+CASES = [(3, 2), (4, 0), (4, 1)]
+RTOL = 1e-12
+
+
+def _rodrigues(axis, angle):
+    k = sp.Matrix(axis) / sp.sqrt(sum(sp.Float(a) ** 2 for a in axis))
+    K = sp.Matrix([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return sp.eye(3) + sp.sin(angle) * K + (1 - sp.cos(angle)) * K * K
+
+
+def plain_lagrange(tree, g=9.81):
+    """(H(q), rhs(q, qd)) numpy functions from L = T - V written with explicit rotation matrices
+    (world from body) and mass-centre positions: no lagrange_gen derivation, no mechanics."""
+    n = len(tree)
+    q, qd = sp.symbols(f"q0:{n}"), sp.symbols(f"qd0:{n}")
+    R_of, p_of, L = {}, {}, sp.S.Zero
+    for i, joint in enumerate(tree):
+        R_p = sp.eye(3) if joint["parent"] < 0 else R_of[joint["parent"]]
+        p_p = sp.zeros(3, 1) if joint["parent"] < 0 else p_of[joint["parent"]]
+        J = p_p + R_p * sp.Matrix(joint["origin"])
+        if joint["type"] == "revolute":
+            R, origin = R_p * _rodrigues(joint["axis"], q[i]), J
+        else:
+            unit = sp.Matrix(joint["axis"]) / sp.sqrt(sum(sp.Float(a) ** 2 for a in joint["axis"]))
+            R, origin = R_p, J + R_p * unit * q[i]
+        R_of[i], p_of[i] = R, origin
+        c = origin + R * sp.Matrix(joint["com"])
+        vel = c.jacobian(q) * sp.Matrix(qd)
+        W = R.T * sum((R.diff(q[j]) * qd[j] for j in range(n)), sp.zeros(3, 3))
+        w = sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
+        ixx, iyy, izz, ixy, iyz, izx = joint["inertia"]
+        I = sp.Matrix([[ixx, ixy, izx], [ixy, iyy, iyz], [izx, iyz, izz]])
+        L += joint["mass"] * vel.dot(vel) / 2 + (w.T * I * w)[0] / 2 - joint["mass"] * g * c[2]
+    dL_dqd = sp.Matrix([L.diff(x) for x in qd])
+    H = dL_dqd.jacobian(qd)
+    rhs = sp.Matrix([L.diff(x) for x in q]) - dL_dqd.jacobian(q) * sp.Matrix(qd)
+    fH, frhs = sp.lambdify([q], H, cse=True), sp.lambdify([q, qd], rhs, cse=True)
+    return lambda x: np.array(fH(x), dtype=float), lambda x, v: np.array(frhs(x, v), dtype=float).ravel()
+
+
+@pytest.fixture(scope="module", params=CASES, ids=[f"{n}bodies-seed{s}" for n, s in CASES])
+def case(request):
+    n, seed = request.param
+    tree = random_tree(np.random.default_rng(seed), n, prismatic=0.4)
+    return tree, derive(model_from_tree(f"tree{n}_{seed}", tree))
+
+
+def _evaluate(dyn, exprs):
+    """f(q, qd, other (n,)) -> values of ``exprs`` (native, over q, qd, qdd or w, p, t)."""
+    o = dyn.ops
+    args = o.symbols(dyn.q + dyn.qd + dyn.aux["qdd"] + dyn.aux["w"] + dyn.params + [t])
+    f = o.graph.evaluator(args, list(exprs))
+    p = [9.81]
+    return lambda q, v, x: np.asarray(f([*q, *v, *x, *x, *p, 0.0]), dtype=float)
+
+
+def _rel(a, b):
+    return float(np.abs(np.asarray(a) - np.asarray(b)).max() / max(np.abs(b).max(), 1e-12))
+
+
+def test_the_cases_have_prismatic_joints_and_branching():
+    trees = [random_tree(np.random.default_rng(s), n, prismatic=0.4) for n, s in CASES]
+    assert any(j["type"] == "prismatic" for tree in trees for j in tree)
+    assert any(len({j["parent"] for j in tree}) < len(tree) for tree in trees)
+
+
+def test_aba_and_rnea_equal_the_graph_path(case):
+    tree, dyn = case
+    assert dyn.recursive is not None
+    n, o = dyn.n, dyn.ops
+    w, qdd = o.symbols(dyn.aux["w"]), o.symbols(dyn.aux["qdd"])
+    aba, _ = dyn.recursive.forward_dynamics(w)
+    rnea = dyn.recursive.inverse_dynamics(qdd)
+    f = _evaluate(dyn, [*aba, *rnea, *dyn.native["H"], *dyn.native["rhs"]])
+    rng = np.random.default_rng(7)
+    for _ in range(2):
+        q, v, x = rng.uniform(-1.5, 1.5, (3, n))
+        values = f(q, v, x)
+        acc, tau = values[:n], values[n:2 * n]
+        H, rhs = values[2 * n:2 * n + n * n].reshape(n, n), values[2 * n + n * n:]
+        assert _rel(acc, np.linalg.solve(H, rhs + x)) < RTOL          # x as joint torques
+        assert _rel(tau, H @ x - rhs) < RTOL                           # x as accelerations
+
+
+def test_aba_and_rnea_equal_plain_sympy_on_a_3_body_tree():
+    tree = random_tree(np.random.default_rng(1), 3, prismatic=0.5)
+    assert {j["type"] for j in tree} == {"revolute", "prismatic"}
+    dyn = derive(model_from_tree("tree3_1", tree))
+    n, o = dyn.n, dyn.ops
+    aba, _ = dyn.recursive.forward_dynamics(o.symbols(dyn.aux["w"]))
+    f = _evaluate(dyn, [*aba, *dyn.recursive.inverse_dynamics(o.symbols(dyn.aux["qdd"]))])
+    H_ref, rhs_ref = plain_lagrange(tree)
+    q, v, x = np.random.default_rng(7).uniform(-1.5, 1.5, (3, n))
+    values = f(q, v, x)
+    assert _rel(values[:n], np.linalg.solve(H_ref(q), rhs_ref(q, v) + x)) < 1e-10
+    assert _rel(values[n:], H_ref(q) @ x - rhs_ref(q, v)) < 1e-10
+
+
+def test_acceleration_derivatives_through_rnea_equal_the_graph_path(case):
+    """-H^-1 d(RNEA)/dx at the solved qdd equals H^-1 (d rhs/dx - d(H w)/dq) of the graph."""
+    _, dyn = case
+    n, o, graph = dyn.n, dyn.ops, dyn.ops.graph
+    q_s, qd_s = o.symbols(dyn.q), o.symbols(dyn.qd)
+    rnea = dyn.recursive.inverse_dynamics(o.symbols(dyn.aux["qdd"]))
+    d_rnea = graph.jacobian(rnea, q_s + qd_s)
+    old = [*dyn.jac.native("drhs_dq"), *dyn.jac.native("drhs_dqd"), *dyn.jac.native("dHw_dq")]
+    aba, _ = dyn.recursive.forward_dynamics()
+    f_acc = _evaluate(dyn, aba + list(dyn.native["H"]))
+    f = _evaluate(dyn, [e for row in d_rnea for e in row] + old)
+    rng = np.random.default_rng(8)
+    q, v = rng.uniform(-1.5, 1.5, (2, n))
+    values = f_acc(q, v, np.zeros(n))
+    acc, H = values[:n], values[n:].reshape(n, n)
+    values = f(q, v, acc)                        # qdd and w both the solved accelerations
+    d_id = values[:2 * n * n].reshape(n, 2 * n)
+    drhs_dq, drhs_dqd, dHw_dq = values[2 * n * n:].reshape(3, n, n)
+    ours = -np.linalg.solve(H, d_id)
+    graph_path = np.linalg.solve(H, np.hstack((drhs_dq - dHw_dq, drhs_dqd)))
+    assert _rel(ours, graph_path) < 1e-11
+
+
+def test_generated_forward_dynamics_is_aba_and_agrees(case):
+    """The emitted ABA, ABA with torques and RNEA Jacobian kernels (their Python functions, no
+    numba compile) give the accelerations and derivatives of dynamics + solve."""
+    _, dyn = case
+    assert uses_aba(dyn)
+    text = forward_source(dyn)
+    assert "articulated-body algorithm" in text and "def inverse_dynamics_jacobian(" in text
+    namespace = {}      # the module's names the kernels use; njit left out: plain Python
+    exec("import math\nimport numpy as np\nSINGULAR_RTOL = 1e-13\nOK, SINGULAR_MASS = 0, 1\n"
+         f"N_COORDS = {dyn.n}\nKERNEL_OPTIONS = {{}}\ndef njit(**options):\n    return lambda f: f\n" + text,
+         namespace)
+    n = dyn.n
+    rng = np.random.default_rng(9)
+    q, v, tau = rng.uniform(-1.5, 1.5, (3, n))
+    p = np.array([9.81])
+    H, rhs = _graph_dynamics(dyn, q, v)
+    qdd = np.zeros(n)
+    assert namespace["forward_dynamics"](q, v, 0.0, p, None, qdd) == 0
+    assert _rel(qdd, np.linalg.solve(H, rhs)) < RTOL
+    with_tau = np.zeros(n)
+    assert namespace["forward_dynamics_torques"](q, v, tau, 0.0, p, None, with_tau) == 0
+    assert _rel(with_tau, np.linalg.solve(H, rhs + tau)) < RTOL
+    Jq, Jqd = np.zeros((n, n)), np.zeros((n, n))
+    namespace["inverse_dynamics_jacobian"](q, v, qdd, 0.0, p, Jq, Jqd)
+    eps = 1e-6
+    numeric = np.array([(_accelerations(dyn, q + eps * e, v) - _accelerations(dyn, q - eps * e, v)) / (2 * eps)
+                        for e in np.eye(n)]).T
+    assert np.allclose(-np.linalg.solve(H, Jq), numeric, rtol=1e-6, atol=1e-7)
+
+
+def _graph_dynamics(dyn, q, v):
+    n = dyn.n
+    values = _evaluate(dyn, [*dyn.native["H"], *dyn.native["rhs"]])(q, v, np.zeros(n))
+    return values[:n * n].reshape(n, n), values[n * n:]
+
+
+def _accelerations(dyn, q, v):
+    H, rhs = _graph_dynamics(dyn, q, v)
+    return np.linalg.solve(H, rhs)
+
+
+# ------------------------------------------------------------------ models that do not fit
+
+
+def _tree_model(extra_T=0, **options):
+    tree = random_tree(np.random.default_rng(0), 3, prismatic=0.4)
+    g = parameters("g", defaults=(9.81,))
+    N, O, q, bodies = tree_bodies(tree)
+    T = kinetic_energy(N, bodies)
+    model = Model("misfit", coords=q, T=T + extra_T(q) if extra_T else T,
+                  V=gravity_potential(N, -g * N.z, bodies), **options)
+    return model
+
+
+def test_energy_with_extra_terms_keeps_the_old_path():
+    model = _tree_model(lambda q: sp.Rational(1, 2) * q[0].diff() ** 2)
+    dyn = derive(model)
+    assert joint_form(model.T) is None and dyn.recursive is None and not uses_aba(dyn)
+    assert "articulated-body" not in forward_source(dyn)
+
+
+def test_constrained_tree_keeps_the_old_path():
+    model = _tree_model()
+    q = model.coords
+    constrained = Model("constrained", coords=q, T=model.T, V=model.V, constraints=[q[0] - q[1]])
+    assert joint_form(constrained.T) is not None
+    assert derive(constrained).recursive is None
+
+
+def test_a_tree_that_does_not_reproduce_the_energy_is_refused():
+    """The numeric check can fail: a link with the wrong mass is not used."""
+    model = _tree_model()
+    links = joint_form(model.T)
+    dyn = derive(model)
+    assert dyn.recursive is not None
+    wrong = [dataclasses.replace(links[0], mass=2 * links[0].mass)] + links[1:]
+    from lagrange_gen.derive.structured import graph_model, import_expressions, derive_lagrangian_graph
+    plain = graph_model(model)
+    o, (T, V, D) = import_expressions(plain, {}, [plain.T, plain.V, plain.dissipation])
+    parts = derive_lagrangian_graph(plain, o, T, V, D, [0] * len(model.coords))
+    qdd = o.symbols(dyn.aux["qdd"])
+    assert recursive_dynamics(links, o, plain, T, parts, qdd, {}) is not None
+    assert recursive_dynamics(wrong, o, plain, T, parts, qdd, {}) is None
