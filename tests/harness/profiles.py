@@ -19,7 +19,7 @@ PROFILES = {
     # spatial trees (test_spatial_trees.py): 3-4 bodies against the reference (py_func; njit),
     # 5-10 bodies against the invariants (py_func)
     "ci": {"py_func": 6, "njit": 1, "states": 3, "trees": 1, "trees_njit": 0, "large_trees": 1},
-    "thorough": {"py_func": 60, "njit": 8, "states": 4, "trees": 30, "trees_njit": 2, "large_trees": 10},
+    "thorough": {"py_func": 60, "njit": 8, "states": 4, "trees": 30, "trees_njit": 1, "large_trees": 10},
 }
 _current = {"name": "ci", "count_only": False}
 

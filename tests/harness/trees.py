@@ -126,8 +126,9 @@ def _build_bodies(drawn, g):
             B, Bo = _rotated(P, i, b, q[i]), J
         if drawn.velocities == "v2pt":
             J.v2pt_theory(Po, N, P)                 # both fixed in P
-            if b.kind == "prismatic":
-                Bo.v1pt_theory(J, N, P)             # slides in P
+            if b.kind == "prismatic":               # slides along the axis in P
+                Bo.set_vel(P, q[i].diff(me.dynamicsymbols._t) * _vec(P, b.angles))
+                Bo.v1pt_theory(J, N, P)
         G = Bo.locatenew(f"G{i}", _vec(B, b.com))
         if drawn.velocities == "v2pt":
             G.v2pt_theory(Bo, N, B)
