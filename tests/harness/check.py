@@ -50,7 +50,13 @@ CONTRACT = {
     "elements": (("q", "p"), (("s", "e"), ("G", "en"), ("coef", "e3")), ("s", "G", "coef")),
     "elements_hessian": (("q", "we", "p"), (("out_mat", "nn"),), ("hess_w",)),
     "events": (_QQTP, (("out", "g"),), ("events",)),
+    # the kernels of a module generated from bodies (README, Robots); qdd is the State's w
+    "inverse_dynamics": (("q", "qd", "qdd", "t", "p"), (("tau", "n"),), ("tau_id",)),
+    "gravity_forces": (("q", "t", "p"), (("out", "n"),), ("gravity",)),
+    "bias_forces": (_QQTP, (("out", "n"),), ("bias",)),
 }
+#: the kernels only a module generated from bodies has (tests/harness/test_spatial_trees.py)
+BODY_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
 
 
 @dataclass
@@ -65,6 +71,11 @@ class State:
     w: np.ndarray
     lam: np.ndarray
     we: np.ndarray
+
+    @property
+    def qdd(self):
+        """The accelerations given to inverse_dynamics: the numbers of w (n,)."""
+        return self.w
 
 
 def generate(drawn, out_dir, methods):
@@ -145,11 +156,12 @@ def kind(mod, name):
     return f"{name}[composed]" if "composed" in doc else name
 
 
-def check_kernels(mod, kern, ref, state, mode):
-    """Every kernel of mod.KERNELS, forward_dynamics and accelerations at one state against the
-    reference: a list of mismatches (a kernel that raises is one)."""
+def check_kernels(mod, kern, ref, state, mode, skip=()):
+    """Every kernel of mod.KERNELS but those in ``skip`` (checked otherwise by the caller),
+    forward_dynamics and accelerations at one state against the reference: a list of
+    mismatches (a kernel that raises is one)."""
     failures = []
-    for name in (*mod.KERNELS, "forward_dynamics"):
+    for name in (*(k for k in mod.KERNELS if k not in skip), "forward_dynamics"):
         try:
             failures += _check_forward(mod, kern, ref, state, mode) if name == "forward_dynamics" \
                 else _check_kernel(mod, kern, name, ref, state, mode)
@@ -190,7 +202,15 @@ def _check_forward(mod, kern, ref, state, mode):
     CHECKED[(forward_path(mod, state), mode)] += 1
     CHECKED[("accelerations", mode)] += 1
     out = [None if status == OK else f"forward_dynamics: status {status}"]
-    return out + [_residual("forward_dynamics.qdd", qdd, H, rhs), _residual("accelerations", acc, H, rhs)]
+    out += [_residual("forward_dynamics.qdd", qdd, H, rhs), _residual("accelerations", acc, H, rhs)]
+    if hasattr(mod, "forward_dynamics_torques"):
+        # joint torques tau = w: H qdd = rhs + tau
+        qdd_tau = np.full(n, np.nan)
+        status = kern.forward_dynamics_torques(state.q, state.qd, state.w, state.t, state.p, np.full((n, n), np.nan), qdd_tau)
+        CHECKED[("forward_dynamics_torques", mode)] += 1
+        out += [None if status == OK else f"forward_dynamics_torques: status {status}",
+                _residual("forward_dynamics_torques.qdd", qdd_tau, H, rhs + state.w)]
+    return out
 
 
 def _residual(label, qdd, H, rhs):

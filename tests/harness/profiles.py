@@ -15,9 +15,11 @@ from __future__ import annotations
 from hypothesis import HealthCheck, Phase, settings
 
 PROFILES = {
-    # examples per model class: run as py_func / compiled (njit and py_func); states per model
-    "ci": {"py_func": 6, "njit": 1, "states": 3},
-    "thorough": {"py_func": 60, "njit": 8, "states": 4},
+    # examples per model class: run as py_func / compiled (njit and py_func); states per model;
+    # spatial trees (test_spatial_trees.py): 3-4 bodies against the reference (py_func; njit),
+    # 5-10 bodies against the invariants (py_func)
+    "ci": {"py_func": 6, "njit": 1, "states": 3, "trees": 1, "trees_njit": 0, "large_trees": 1},
+    "thorough": {"py_func": 60, "njit": 8, "states": 4, "trees": 30, "trees_njit": 1, "large_trees": 10},
 }
 _current = {"name": "ci", "count_only": False}
 
@@ -32,8 +34,9 @@ def current():
 
 
 def hypothesis_settings(mode):
-    """Hypothesis settings of the tests running kernels in ``mode`` ("py_func" or "njit")."""
-    return settings(max_examples=current()[mode], derandomize=True, database=None, deadline=None,
+    """Hypothesis settings of the tests running kernels in ``mode`` ("py_func" or "njit"; or a
+    count of the spatial-tree tests: "trees", "trees_njit", "large_trees")."""
+    return settings(max_examples=max(1, current()[mode]), derandomize=True, database=None, deadline=None,
                     phases=(Phase.explicit, Phase.generate), print_blob=False,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                            HealthCheck.filter_too_much])

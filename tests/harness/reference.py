@@ -24,7 +24,7 @@ _MODULES = [{"DiracDelta": lambda *args: 0.0}, "numpy"]
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
 VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
-           "power", "b"}
+           "power", "b", "tau_id", "gravity", "bias"}
 
 
 def _vector(exprs):
@@ -100,6 +100,16 @@ class Reference:
 
     def _dHw_dq(self):
         return (self.expr("H") * self.w).jacobian(self.q)
+
+    def _tau_id(self):
+        """inverse dynamics at qdd = w: H w - rhs."""
+        return self.expr("H") * self.w - self.expr("rhs")
+
+    def _gravity(self):
+        return sp.Matrix([self.drawn.V]).jacobian(self.q).T
+
+    def _bias(self):
+        return -self.expr("rhs")
 
     def _events(self):
         return _vector(self.drawn.events) if self.drawn.events else sp.zeros(0, 1)

@@ -202,3 +202,29 @@ def test_derivation_equals_plain_sympy_lagrange_on_a_3_body_tree(trees):
         dynamics(q, v, 0.0, mod.DEFAULT_PARAMS, H, rhs)
         assert _rel(H, H_ref(q)) < RTOL
         assert _rel(rhs, rhs_ref(q, v)) < RTOL
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: f"{c[0]}bodies-seed{c[1]}")
+def test_robot_kernels_equal_pinocchio(trees, case):
+    """The module's own robot kernels, not compositions of ours: inverse_dynamics = rnea,
+    gravity_forces = rnea(q, 0, 0), bias_forces = rnea(q, v, 0) (nonLinearEffects),
+    forward_dynamics_torques = aba(tau), forward_dynamics_jacobian = computeABADerivatives at
+    tau = 0 (the tests above compare dynamics and the Jacobian kernels composed here)."""
+    tree, mod = trees[case]
+    n, p = len(tree), mod.DEFAULT_PARAMS
+    peer = robots_peers.pinocchio_model(tree)
+    for q, v, tau, a in _states(*case):
+        out = np.zeros(n)
+        mod.inverse_dynamics.py_func(q, v, a, 0.0, p, out)
+        assert _rel(out, robots_peers.rnea(peer, q, v, a)) < RTOL
+        mod.gravity_forces.py_func(q, 0.0, p, out)
+        assert _rel(out, robots_peers.rnea(peer, q, np.zeros(n), np.zeros(n))) < RTOL
+        mod.bias_forces.py_func(q, v, 0.0, p, out)
+        assert _rel(out, robots_peers.rnea(peer, q, v, np.zeros(n))) < RTOL
+        assert mod.forward_dynamics_torques.py_func(q, v, tau, 0.0, p, np.zeros((n, n)), out) == 0
+        assert _rel(out, robots_peers.aba(peer, q, v, tau)) < RTOL
+        H, W, Jq, Jqd = (np.zeros((n, n)) for _ in range(4))
+        assert mod.forward_dynamics_jacobian.py_func(q, v, 0.0, p, H, out, Jq, Jqd, W) == 0
+        dq, dv = robots_peers.aba_derivatives(peer, q, v, np.zeros(n))
+        assert _rel(out, robots_peers.aba(peer, q, v, np.zeros(n))) < RTOL
+        assert _rel(Jq, dq) < RTOL and _rel(Jqd, dv) < RTOL

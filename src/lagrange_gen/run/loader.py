@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..codegen.keys import check_current, read_key
 from ..errors import GenerationError, StaleModuleError
+from . import model_cache
 
 
 def import_generated(path):
@@ -54,17 +55,23 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True,
     differs and the command that regenerates it (``force=True`` regenerates it);
     ``regenerate=False`` raises StaleModuleError instead of generating.
     """
-    from ..codegen.generate import generate_model
     path = Path(path)
     if read_key(path) is not None:
         return import_generated(path)
+    # a module this file gave before, current and complete: import it without running the file
+    known = None if force else model_cache.current_module(path, out_dir, methods, options, freeze)
+    if known is not None:
+        return import_generated(known)
+    from ..codegen.generate import generate_model
     target, plan = _plan(path, out_dir, methods, options, freeze, force)
     if plan is not None:
         why, build, methods, freeze, command = plan
         if not regenerate:
             raise StaleModuleError(f"{target} is {why}: run {command}")
         generate_model(path, out_dir, methods, build, freeze, force=True)
-    return import_generated(target)
+    module = import_generated(target)
+    model_cache.remember_module(path, out_dir, options, target)
+    return module
 
 
 def _plan(path, out_dir, methods, options, freeze, force):
