@@ -7,6 +7,12 @@ with a fresh NUMBA_CACHE_DIR and a time limit: a case that does not finish is re
 "timeout after X s" with the stage it was in (the child announces every stage on stdout as it
 enters it, so what it finished survives the kill).
 
+Before each case, another child compiles the stepper library's rk4 glue into that fresh cache
+(one rk4 step of the cart pendulum through the portable glue) and reports its seconds apart:
+that compile is paid once per installation and numba cache, by the first model a user runs,
+not by every model, so the case's first step measures what the robot itself costs (its
+kernels, the energy check). The first-step column with that compile added is reported too.
+
 In the child, one after the other:
 
 1. run the model file (load_model), derive and emit (codegen.generate.generate_parts with
@@ -81,12 +87,34 @@ def summary_line(row):
             f"(pin {row['pin_daba_ns'] / 1e3:.2f} us), rk4 {row['rk4_ns'] / 1e3:.2f} us per step")
 
 
+def warm_stepper_library(models_dir, work, env, limit):
+    """Seconds to compile the portable rk4 glue into ``env``'s numba cache (a child process:
+    the cart pendulum generated into ``work`` and one rk4 step); None when it failed."""
+    code = ("import sys, time\n"
+            "from pathlib import Path\n"
+            "from lagrange_gen.codegen.generate import generate_model\n"
+            "from lagrange_gen.run.loader import import_generated\n"
+            "from lagrange_gen.run.simulate import simulate\n"
+            "mod = import_generated(generate_model(Path(sys.argv[1]), Path(sys.argv[2]), methods=['rk4']).path)\n"
+            "start = time.perf_counter()\n"
+            "simulate(mod, 'rk4', [0.1, 0.5], [0.0, 0.0], t_end=1e-3, h=1e-3, jit='portable')\n"
+            "print(time.perf_counter() - start)\n")
+    try:
+        done = subprocess.run([sys.executable, "-c", code, str(Path(models_dir) / "cart_pendulum.py"),
+                               str(work / "warm")], env=env, capture_output=True, text=True, timeout=limit)
+        return float(done.stdout.strip().splitlines()[-1])
+    except (subprocess.TimeoutExpired, ValueError, IndexError):
+        return None
+
+
 def measure_case(model_file, options, work, limit):
     """Run the child on one model file; the row of everything it reported (stage seconds,
     sizes, ns), with ``timeout``/``error`` and ``where`` (the stage it was in) when it did
-    not finish."""
+    not finish. ``library_compile``: the stepper library's rk4 glue compiled into the case's
+    fresh numba cache beforehand (warm_stepper_library)."""
     work.mkdir(parents=True, exist_ok=True)
     env = dict(os.environ, NUMBA_CACHE_DIR=str(work / "numba_cache"))
+    library_compile = warm_stepper_library(Path(model_file).parent, work, env, limit)
     cmd = [sys.executable, "-m", "lagrange_gen.bench.robots", "--child",
            json.dumps({"model_file": str(model_file), "options": options, "out_dir": str(work / "gen")})]
     start = time.perf_counter()
@@ -97,6 +125,7 @@ def measure_case(model_file, options, work, limit):
         stdout, stderr, timed_out, code = _text(exc.stdout), _text(exc.stderr), True, None
     row = parse_events(stdout)
     row["wall"] = time.perf_counter() - start
+    row["library_compile"] = library_compile
     if timed_out:
         row["timeout"] = True
     elif code != 0 or "done" not in row:

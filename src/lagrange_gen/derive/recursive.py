@@ -115,9 +115,19 @@ class RecursiveDynamics:
             return [[self.graph.node(sum(P[i][l] * Q[l][j] for l in range(3))) for j in range(3)] for i in range(3)]
         K, rC = mul(B, rx), mul(rx, C)
         rCr = mul(rC, rx)
-        top = [[self.graph.node(A[i][j] - K[i][j] - K[j][i] - rCr[i][j]) for j in range(3)] for i in range(3)]
+        top = self._symmetric(3, lambda i, j: A[i][j] - K[i][j] - K[j][i] - rCr[i][j])
         right = [[self.graph.node(B[i][j] + rC[i][j]) for j in range(3)] for i in range(3)]
         return [top[i] + right[i] for i in range(3)] + [[right[j][i] for j in range(3)] + C[i] for i in range(3)]
+
+    def _symmetric(self, size, entry):
+        """The symmetric (size, size) matrix of nodes entry(i, j), formed for j >= i only: the
+        articulated inertias are symmetric, and a product computed twice in a different order
+        would be two nodes."""
+        out = [[None] * size for _ in range(size)]
+        for i in range(size):
+            for j in range(i, size):
+                out[i][j] = out[j][i] = self.graph.node(entry(i, j))
+        return out
 
     def _times(self, M, x):
         return self._nodes([sum(M[i][j] * x[j] for j in range(6)) for i in range(6)])
@@ -193,14 +203,15 @@ class RecursiveDynamics:
                 u = self.graph.node(tau[j] - sum(s * p for s, p in zip(S, pA[i])))
                 solved[i] = (U, D, D_inv, u, j)
                 if link["parent"] >= 0:
-                    Ia = [[self.graph.node(IA[i][r][s] - U[r] * U[s] * D_inv) for s in range(6)] for r in range(6)]
-                    pa = self._nodes([p + x + y * D_inv * u for p, x, y in zip(pA[i], self._times(Ia, c), U)])
+                    W = self._nodes([x * D_inv for x in U])
+                    Ia = self._symmetric(6, lambda r, s: IA[i][r][s] - U[r] * W[s])
+                    pa = self._nodes([p + x + w * u for p, x, w in zip(pA[i], self._times(Ia, c), W)])
             elif link["parent"] >= 0:
                 pa = self._nodes([p + x for p, x in zip(pA[i], self._times(Ia, c))])
             if link["parent"] >= 0:
                 parent = link["parent"]
                 extra = self._congruence(link, Ia)
-                IA[parent] = [[self.graph.node(IA[parent][r][s] + extra[r][s]) for s in range(6)] for r in range(6)]
+                IA[parent] = self._symmetric(6, lambda r, s, P=IA[parent]: P[r][s] + extra[r][s])
                 pA[parent] = self._nodes([a + b for a, b in zip(pA[parent], self._to_parent(link, pa))])
         qdd, pivots, accelerations = [0] * self.n, [], []
         for i, link in enumerate(self.links):
