@@ -58,6 +58,14 @@ def _default_value(expr):
     return float(value) if value.is_number else None
 
 
+def _shown(value):
+    """A coefficient for a message: ``0.3``, or ``e = 2`` for one given by parameters."""
+    number = _default_value(value)
+    if value.is_number or number is None:
+        return f"{float(value):g}" if value.is_number else str(value)
+    return f"{value} = {number:g}"
+
+
 def check_contacts(model):
     """ModelError (one line, naming the model and the contact) when a contact's gap does not
     depend on the coordinates or depends on velocities or t, its restitution is outside [0, 1],
@@ -67,11 +75,11 @@ def check_contacts(model):
     for c in model.contacts:
         where = f"model {model.name}: contact {c.name}"
         used = model.symbols_of(c.gap)
+        if used & qd:
+            raise ModelError(f"{where}: the gap {c.gap} depends on velocities; a gap is g(q)")
         if not used & q:
             raise ModelError(f"{where}: the gap {c.gap} does not depend on any coordinate "
                              f"({', '.join(s.name for s in model.coords)})")
-        if used & qd:
-            raise ModelError(f"{where}: the gap {c.gap} depends on velocities; a gap is g(q)")
         if t in used:
             raise ModelError(f"{where}: the gap {c.gap} depends on t; rheonomic gaps g(q, t) are "
                              "not supported yet")
@@ -82,12 +90,12 @@ def check_contacts(model):
             if number is None:
                 continue
             if label == "restitution" and not 0.0 <= number <= 1.0:
-                raise ModelError(f"{where}: restitution must be in [0, 1], got {value} = {number:g}")
+                raise ModelError(f"{where}: restitution must be in [0, 1], got {_shown(value)}")
             if label == "friction" and not number >= 0.0:
-                raise ModelError(f"{where}: friction must be >= 0, got {value} = {number:g}")
+                raise ModelError(f"{where}: friction must be >= 0, got {_shown(value)}")
         if c.slip is None:
-            if c.friction != 0:
-                raise ModelError(f"{where}: friction {c.friction} without a tangent: give "
+            if c.friction.is_zero is not True:
+                raise ModelError(f"{where}: friction {_shown(c.friction)} without a tangent: give "
                                  "slip=, the slip velocity (e.g. x.d)")
             continue
         _check_slip(model, c, where, qd)

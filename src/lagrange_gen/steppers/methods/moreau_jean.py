@@ -13,15 +13,18 @@ W_N = dg/dq, W_T = d slip/d qdot) and r = (p_N, p_T) the impulses. For a model w
 constant (gravity) the smooth part is exact: v+ = v + h a, q+ = q + h v + h^2 a / 2 at
 theta = 1/2.
 
-Contacts in the step: those whose gap predicted at the end of the step closes,
-g(q) + h W_N v <= 0 (the index set). On them, with u = W v+ = u_free + D r, u_free = W v_free,
+Contacts in the step: those whose gap closes at the end of the step without contact impulses,
+to first order: g(q) + h W_N ((1 - theta) v + theta v_free) <= 0 (the index set; the free
+velocity, not v alone, so that a contact at rest with g = +1e-19 after rounding stays in it
+instead of leaving for a step of free fall). On them, with u = W v+ = u_free + D r, u_free = W v_free,
 v_free = v + A^-1 (h f + h^2 theta K v) and the Delassus operator D = W A^-1 W^T:
 
-    Newton's impact law:  u_N + e u_N- >= 0  _|_  p_N >= 0      (u_N- = W_N v, restitution e)
+    Newton's impact law:  u_N + e min(u_N-, 0) >= 0  _|_  p_N >= 0   (u_N- = W_N v, restitution e;
+                          a contact already opening at the step's start gets u_N >= 0)
     Coulomb (2D):         p_T in [-mu p_N, mu p_N], p_T = -mu p_N sign(u_T) when u_T != 0
 
 solved by projected Gauss-Seidel, contact by contact:
-p_N <- max(0, p_N - (u_N + e u_N-) / D_NN), then p_T <- clamp(p_T - u_T / D_TT, -mu p_N, mu p_N),
+p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then p_T <- clamp(p_T - u_T / D_TT, -mu p_N, mu p_N),
 until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
 (CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
 impulse that zeroes u_T: no creep.
@@ -145,7 +148,8 @@ def _gauss_seidel(c, tol, max_sweeps, active, coef, un, uf, D, r):
             if active[a] == 0.0 or D[a, a] <= 0.0:
                 continue
             e, mu = coef[a, 0], coef[a, 1]
-            pn = max(0.0, r[a] - (_local_velocity(a, c, uf, D, r) + e * un[a]) / D[a, a])
+            # restitution reverses an approaching velocity only (u_N- < 0)
+            pn = max(0.0, r[a] - (_local_velocity(a, c, uf, D, r) + e * min(un[a], 0.0)) / D[a, a])
             change = max(change, abs(pn - r[a]))
             r[a] = pn
             t = c + a
@@ -190,7 +194,8 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
             uft += WT[a, i] * vf[i]
         ws.un[a] = un
         uf[a], uf[c + a] = ufn, uft
-        active[a] = 1.0 if ws.g[a] + h * un <= 0.0 else 0.0
+        # the gap the step reaches without contact impulses (first order in h)
+        active[a] = 1.0 if ws.g[a] + h * ((1.0 - theta) * un + theta * ufn) <= 0.0 else 0.0
         n_active += int(active[a])
         r[a], r[c + a] = 0.0, 0.0
     sweeps, change = 0, 0.0
