@@ -34,7 +34,7 @@ def test_spec_is_complete(method):
     assert spec.name == method and spec.family in FAMILIES and spec.order >= 1
     assert spec.summary and "blowup_bound" in spec.settings._fields
     assert all(isinstance(w, int) or w in ("n", "m", "ne", "c") for _, w in spec.saved)
-    if not (spec.constraints or spec.elements or spec.adaptive):
+    if not (spec.constraints or spec.elements or spec.adaptive or spec.contacts):
         assert spec.stable_tau is not None and spec.rho is not None, \
             "a fixed-step unconstrained method declares its linear stability"
     if spec.constraints:
