@@ -20,7 +20,7 @@ from .errors import (BlowUp, EnergyWarning, GenerationError, LagrangeGenError, M
 _LAZY = {
     "Model": "model.model", "PointForce": "model.model", "coordinates": "model.model",
     "parameters": "model.model", "t": "model.model", "SaintVenant": "model.model",
-    "DryFriction": "model.model", "Event": "model.model", "Drawing": "model.model",
+    "DryFriction": "model.model", "Contact": "model.model", "Event": "model.model", "Drawing": "model.model",
     "inputs": "model.model", "load_model": "model.model_file", "kinetic_energy": "model.bodies", "gravity_potential": "model.bodies",
     "equations": "derive.equations",
     "Signal": "run.control", "linearize": "linear.linearize", "equilibrium": "linear.linearize",

@@ -28,6 +28,11 @@ def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
         lines.append("Nonsmooth elements (index in s / rows of G and coef):")
         lines += [f"    {i}: {e.name} ({e.kind}) on s = {sp.sstr(e.strain)}, coef = "
                   f"({', '.join(sp.sstr(c) for c in e.coefficients())})" for i, e in enumerate(m.elements)]
+    if dyn.n_contacts:
+        lines.append("Contacts gap(q) >= 0 (index in gap / rows of WN, WT, coef):")
+        lines += [f"    {i}: {c.name}: gap = {sp.sstr(c.gap)}, slip = {sp.sstr(c.slip)}, "
+                  f"restitution = {sp.sstr(c.restitution)}, friction = {sp.sstr(c.friction)}"
+                  for i, c in enumerate(m.contacts)]
     if m.events:
         lines.append("Events g(q, qd, t) (index in the out of events; direction, terminal):")
         lines += [f"    {i}: {e.name}: {sp.sstr(g)} ({_DIRECTIONS[e.direction]}"
@@ -103,6 +108,8 @@ def _model_constants(dyn, methods, texts):
         f"N_ELEMENTS = {dyn.n_elements}",
         f"ELEMENTS = {tuple(e.name for e in elements)!r}",
         f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in elements)!r}  # 0 Saint-Venant, 1 dry friction",
+        f"N_CONTACTS = {dyn.n_contacts}",
+        f"CONTACTS = {tuple(c.name for c in getattr(dyn.model, 'contacts', ()))!r}",
         f"N_EVENTS = {len(events)}",
         f"EVENT_NAMES = {tuple(e.name for e in events)!r}",
         f"EVENT_TERMINAL = np.array({[e.terminal for e in events]!r}, dtype=np.bool_)",

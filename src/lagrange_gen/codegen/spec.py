@@ -131,6 +131,7 @@ def kernel_table(dyn) -> dict:
                 "steppers/core/events.py locates"),
     }
     table.update(io_kernels(dyn))
+    table.update(contact_kernels(dyn))
     if hasattr(dyn.jac, "columns"):
         table.update(column_kernels(dyn))
         table.update(robot_kernels(dyn))
@@ -170,6 +171,19 @@ def robot_kernels(dyn) -> dict:
             doc="h(q, qd) + g(q) - Q (n,): tau at qdd = 0 (velocity terms, gravity and the "
                 "model's own forces)"),
     }
+
+
+def contact_kernels(dyn) -> dict:
+    """The ``contacts`` kernel of a model with unilateral contacts ({} without any)."""
+    if not dyn.n_contacts:
+        return {}
+    nat = dyn.native
+    return {"contacts": lambda: KernelSpec(
+        "contacts", ["q", "t", "p"],
+        [Output("gap", nat["contact_gap"]), Output("WN", nat["contact_WN"]),
+         Output("WT", nat["contact_WT"]), Output("coef", nat["contact_coef"])],
+        doc="unilateral contacts: gaps g (c,), W_N = dg/dq (c, n), W_T = d slip/d qd (c, n), "
+            "coef (c, 2) = (restitution, friction)")}
 
 
 def column_kernels(dyn) -> dict:

@@ -6,6 +6,7 @@ import sympy as sp
 
 from .backend import backend_for, ops
 from .constraints import derive_constraints
+from .contacts import derive_contacts
 from .elements import derive_elements
 from .freeze import freeze_model
 from .jacobians import Jacobians
@@ -18,7 +19,8 @@ from .recursive import recursive_dynamics
 
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
-          "elem_s", "elem_grad", "elem_coef", "elem_hess_w")
+          "elem_s", "elem_grad", "elem_coef", "elem_hess_w",
+          "contact_gap", "contact_WN", "contact_WT", "contact_coef")
 
 
 class Dynamics:
@@ -30,7 +32,9 @@ class Dynamics:
     The equations of motion are H qddot + h + g = Q + J^T lambda with Phi(q) = 0, and
     rhs = Q - h - g (smooth forces only: nonsmooth element forces are the steppers' business).
     Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 3),
-    elem_hess_w (n, n). ``momentum_rate`` = dL/dq + Q_nc is dp/dt for the canonical momentum
+    elem_hess_w (n, n). Contacts (c of them): contact_gap (c, 1), contact_WN = d gap/dq (c, n),
+    contact_WT = d slip/d qdot (c, n), contact_coef (c, 2) = (restitution, friction).
+    ``momentum_rate`` = dL/dq + Q_nc is dp/dt for the canonical momentum
     p = H qdot + b, b (n, 1) = dT/dqdot at qdot = 0 (T1 = b . qdot), db = db/dq (n, n).
 
     Each field is a sympy Matrix (or Expr) built from ``native[field]`` when first read; code
@@ -72,6 +76,10 @@ class Dynamics:
     @property
     def n_elements(self):
         return self.native["elem_s"].shape[0]
+
+    @property
+    def n_contacts(self):
+        return self.native["contact_gap"].shape[0]
 
     @property
     def mass_is_constant(self):
@@ -141,6 +149,8 @@ def _finish(model, o, parts, frozen, jacobians):
     aux = {"w": input_symbols("w", n), "qdd": input_symbols("qdd", n), "lam": input_symbols("lam", m),
            "we": input_symbols("we", len(model.elements))}
     for key, value in derive_elements(model, aux["we"]).items():
+        parts[key] = o.matrix(*value.shape, list(value))
+    for key, value in derive_contacts(model).items():
         parts[key] = o.matrix(*value.shape, list(value))
     native = {k: parts[k] for k in FIELDS}
     return Dynamics(model, o, native, parts, aux, frozen, jacobians)

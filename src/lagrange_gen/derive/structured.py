@@ -87,7 +87,7 @@ def uses_graph(model) -> bool:
 
 
 def graph_model(model, expand_all=False):
-    """A shallow copy of ``model`` whose constraints, element strains, events and outputs have
+    """A shallow copy of ``model`` whose constraints, element strains, events, contacts and outputs have
     their Intermediates expanded (those are derived or printed from their own expressions);
     with ``expand_all`` T, V, the dissipation and the forces too, and no Intermediates remain
     (the expression path of derive/lagrangian.py)."""
@@ -108,6 +108,12 @@ def graph_model(model, expand_all=False):
         e = copy.copy(e)
         e.expr = expand_intermediates(e.expr)
         out.events.append(e)
+    out.contacts = []
+    for c in getattr(model, "contacts", ()):
+        c = copy.copy(c)
+        c.gap = expand_intermediates(c.gap)
+        c.slip = None if c.slip is None else expand_intermediates(c.slip)
+        out.contacts.append(c)
     out.outputs = {k: expand_intermediates(y) for k, y in model.outputs.items()}
     return out
 

@@ -226,7 +226,8 @@ def _bound(module, method, function):
     method's n_saved on that model (SPEC.n_saved) passed in front of the glue arguments."""
     from ..steppers.core.registry import spec
     run, table = getattr(_glue_module(method), function), kernel_table(module, method)
-    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS)
+    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,
+                                   getattr(module, "N_CONTACTS", 0))
 
     def bound(*args):
         return run(table, n_saved, *args)

@@ -18,10 +18,12 @@ from ..errors import ModelError
 from .expressions import (Event, convert_dynamicsymbols, equation_as_expr, is_mechanics_load,
                           mechanics_speeds, named_events, prescriptions, sympify_scalar)
 from .loads import DryFriction, PointForce, SaintVenant
+from .contacts import Contact, check_contacts, named_contacts
 from .symbols import Coordinate, Parameter, Velocity, check_name, coordinates, parameters, t
 
 __all__ = [
-    "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Event", "Model",
+    "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Contact", "Event",
+    "Model",
     "Drawing",
     "coordinates", "parameters", "t", "inputs",
 ]
@@ -54,6 +56,9 @@ class Model:
     constraints : list of holonomic constraints Phi(q) = 0 or Phi(q, t) = 0 (rheonomic; an
         sp.Eq(lhs, rhs) means lhs - rhs).
     elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
+    contacts : unilateral contacts Contact(gap=g(q), restitution=e, friction=mu, slip=u_T):
+        g >= 0 with impacts (Newton's law) and Coulomb friction on the slip velocity u_T
+        (model/contacts.py); stepped by moreau_jean.
     events : {name: g} with g(q, qdot, t) an expression, or Event(g, terminal=, direction=):
         simulate locates the zero crossings of each g and records them (steppers/core/events.py).
     prescribed : {Coordinate: expression of t and parameters}: coordinates whose motion is
@@ -73,7 +78,7 @@ class Model:
 
     def __init__(self, name, coords, T, V=0, forces=None, dissipation=0, constraints=(),
                  elements=(), params=None, description="", events=None, prescribed=None, frame=None,
-                 inputs=(), outputs=None, draw=None):
+                 inputs=(), outputs=None, draw=None, contacts=()):
         check_name("model", str(name))
         self.name = str(name)
         self.description = description
@@ -90,6 +95,7 @@ class Model:
         self.constraints = [self._scalar(equation_as_expr(c), f"constraint {i}", replace)
                             for i, c in enumerate(self._sequence(constraints, "constraints", "expressions Phi(q)"))]
         self.elements = self._elements(elements, replace)
+        self.contacts = self._contacts(contacts, replace)
         self.events = named_events(self.name, events, replace)
         self.inputs = self._inputs(inputs)
         self.outputs = {str(k): self._scalar(v, f"output {k}", replace) for k, v in (outputs or {}).items()}
@@ -102,6 +108,7 @@ class Model:
         self.source_text = ""
         self.build_options = {}
         check_model(self)
+        check_contacts(self)
         # A drawing may show a prescribed coordinate (the driven pivot): substituted like the rest.
         sub = getattr(self, "_prescribed_sub", {})
         self.draw = check_drawing(self, draw, lambda e, what: self._scalar(e, what, replace).xreplace(sub))
@@ -125,6 +132,9 @@ class Model:
             e.strain = e.strain.xreplace(sub)
         for e in self.events:
             e.expr = e.expr.xreplace(sub)
+        for c in self.contacts:
+            c.gap = c.gap.xreplace(sub)
+            c.slip = None if c.slip is None else c.slip.xreplace(sub)
         self.outputs = {k: y.xreplace(sub) for k, y in self.outputs.items()}
         self._prescribed_sub = sub
 
@@ -224,6 +234,20 @@ class Model:
     def n_elements(self):
         return len(self.elements)
 
+    def _contacts(self, contacts, replace):
+        out = named_contacts(self.name, self._sequence(contacts, "contacts", "Contact"))
+        for c in out:
+            c.gap = self._scalar(c.gap, f"gap of contact {c.name}", replace)
+            if c.slip is not None:
+                c.slip = self._scalar(c.slip, f"slip of contact {c.name}", replace)
+            c.restitution = self._scalar(c.restitution, f"restitution of contact {c.name}", {})
+            c.friction = self._scalar(c.friction, f"friction of contact {c.name}", {})
+        return out
+
+    @property
+    def n_contacts(self):
+        return len(self.contacts)
+
     def _all_expressions(self):
         yield "T", self.T
         yield "V", self.V
@@ -236,6 +260,12 @@ class Model:
             yield f"strain of element {e.name}", e.strain
             for c in e.coefficients():
                 yield f"coefficient of element {e.name}", c
+        for c in self.contacts:
+            yield f"gap of contact {c.name}", c.gap
+            if c.slip is not None:
+                yield f"slip of contact {c.name}", c.slip
+            for k in c.coefficients():
+                yield f"coefficient of contact {c.name}", k
 
     def _expressions_and_events(self):
         """_all_expressions, the events and the outputs, as the user gave them."""
@@ -282,6 +312,9 @@ class Model:
             e.strain = expand_intermediates(e.strain)
         for e in self.events:
             e.expr = expand_intermediates(e.expr)
+        for c in self.contacts:
+            c.gap = expand_intermediates(c.gap)
+            c.slip = None if c.slip is None else expand_intermediates(c.slip)
         self.outputs = {k: expand_intermediates(y) for k, y in self.outputs.items()}
 
     def _inputs(self, given):

@@ -261,7 +261,8 @@ def check_method(module, method):
     """Refuse an unconstrained method on a constrained model and the other way round."""
     from ..steppers.core import registry
     m = getattr(module, "N_CONSTRAINTS", 0)
-    why = registry.inapplicable(method, m, getattr(module, "N_ELEMENTS", 0))
+    why = registry.inapplicable(method, m, getattr(module, "N_ELEMENTS", 0),
+                                getattr(module, "N_CONTACTS", 0))
     if not why:
         return
     if m and not registry.spec(method).constraints:

@@ -60,6 +60,10 @@ def raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
     if code == st.TOO_MANY_STEPS:
         raise SimulationError(f"{where}: max_steps step attempts without reaching the end, at "
                               f"{state}; raise max_steps or loosen rtol/atol", **kwargs)
+    if code == st.CONTACT_NOT_CONVERGED:
+        raise SimulationError(f"{where}: the contact problem (projected Gauss-Seidel) did not "
+                              f"converge (last sweep's impulse change {resid:.3g}) from {state}; "
+                              f"raise max_sweeps or contact_tol, or reduce h", **kwargs)
     if code == st.UNSTABLE:
         raise BlowUp(f"{where}: the state grew past the blow-up bound (unstable at this h?): "
                      f"{state}", **kwargs)

@@ -133,9 +133,11 @@ class Stepper:
         from .simulate import load_module
         module = load_module(module, method=method)
         spec = registry.spec(method)
-        if spec.adaptive or spec.constraints or getattr(module, "N_ELEMENTS", 0) or module.N_CONSTRAINTS:
+        if (spec.adaptive or spec.constraints or spec.contacts or getattr(module, "N_ELEMENTS", 0)
+                or module.N_CONSTRAINTS or getattr(module, "N_CONTACTS", 0)):
             raise SimulationError(f"Stepper: {method} on {module.NAME}: the step API takes a "
-                                  "fixed-step method on a model without constraints or elements")
+                                  "fixed-step method on a model without constraints, elements "
+                                  "or contacts")
         if h is None or not float(h) > 0:
             raise SimulationError(f"Stepper: give a step h > 0, got {h!r}")
         n, (first, k) = module.N_COORDS, input_slots(module)

@@ -9,7 +9,8 @@ method names. A spec says:
   linear stability range ``stable`` in tau = h omega (quoted by the energy warning and README);
 * which models it applies to: ``constraints`` (True: only models with holonomic constraints,
   False: only models without), ``elements`` (treats nonsmooth elements), ``stands_in_for`` (the
-  methods it runs in place of on a model with elements: nonsmooth_euler for implicit_euler);
+  methods it runs in place of on a model with elements: nonsmooth_euler for implicit_euler),
+  ``contacts`` (True: only models with unilateral contacts, False: only models without);
 * ``settings``: a NamedTuple class, its fields typed and defaulted; simulate builds one from the
   user's keywords (``make_settings``, validated by the field types and ``limits``) and the jitted
   step reads it by name (``settings.newton_tol``), so numba sees ints as ints and bools as bools;
@@ -17,7 +18,8 @@ method names. A spec says:
   the code, codegen.needs);
 * ``saved``: the named fields the method saves per output row besides (t, q, v, energy, Newton
   iterations and residual), in the order of its ``extra`` buffer, each with a width given as a
-  count name (``"m"`` constraints, ``"ne"`` elements, ``"n"`` coordinates) or an int;
+  count name (``"m"`` constraints, ``"ne"`` elements, ``"c"`` contacts, ``"n"`` coordinates)
+  or an int;
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
   adaptive signature (codegen/glue.py).
 
@@ -73,6 +75,10 @@ SETTING_HELP = {
     "atol": "absolute tolerance of the local error",
     "h_max": "largest step",
     "max_steps": "cap on the steps (accepted and rejected) of one call",
+    "theta": "theta-method weight in (0, 1] (1/2: energy-neutral free flight, 1: damping)",
+    "contact_tol": "contact problem tolerance: largest impulse change of a Gauss-Seidel sweep "
+                   "relative to the largest impulse",
+    "max_sweeps": "cap on the projected Gauss-Seidel sweeps of one step's contact problem",
 }
 
 #: Validation of the common fields: (lower bound, bound included, inf allowed).
@@ -97,6 +103,7 @@ class Spec:
     constraints: bool = False
     elements: bool = False
     stands_in_for: tuple = ()
+    contacts: bool = False
     saved: tuple = ()
     limits: dict = field(default_factory=dict)
     adaptive: bool = False
@@ -115,9 +122,9 @@ class Spec:
         if self.family not in FAMILIES:
             raise ValueError(f"{self.name}: family {self.family!r} is not one of {FAMILIES}")
 
-    def saved_layout(self, n: int, m: int, ne: int) -> tuple:
-        """((name, start, width), ...) of the saved fields in the extra buffer."""
-        counts = {"n": n, "m": m, "ne": ne}
+    def saved_layout(self, n: int, m: int, ne: int, nc: int = 0) -> tuple:
+        """((name, start, width), ...) of the saved fields in the extra buffer (nc contacts)."""
+        counts = {"n": n, "m": m, "ne": ne, "c": nc}
         layout, start = [], 0
         for name, width in self.saved:
             w = counts[width] if isinstance(width, str) else int(width)
@@ -125,9 +132,9 @@ class Spec:
             start += w
         return tuple(layout)
 
-    def n_saved(self, n: int, m: int, ne: int) -> int:
+    def n_saved(self, n: int, m: int, ne: int, nc: int = 0) -> int:
         """Width of the extra buffer (sum of the saved fields' widths)."""
-        return sum(w for _, _, w in self.saved_layout(n, m, ne))
+        return sum(w for _, _, w in self.saved_layout(n, m, ne, nc))
 
     def setting_names(self) -> tuple:
         return tuple(self.settings._fields)

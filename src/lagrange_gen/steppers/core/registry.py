@@ -14,7 +14,7 @@ import importlib
 #: method is declared by its module's SPEC (method_spec.py).
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
            "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
-           "constrained_midpoint", "constrained_implicit_euler", "spook", "index1")
+           "constrained_midpoint", "constrained_implicit_euler", "spook", "index1", "moreau_jean")
 
 #: {method: its Spec}.
 INFO = {m: importlib.import_module(f"lagrange_gen.steppers.methods.{m}").SPEC for m in METHODS}
@@ -50,11 +50,18 @@ def runs_as(method: str, n_elements: int) -> str:
     return ON_ELEMENTS.get(method, method) if n_elements else method
 
 
-def inapplicable(method: str, n_constraints: int, n_elements: int) -> str:
+def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: int = 0) -> str:
     """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
     flags = INFO[method]
     if n_constraints and n_elements:
         return "constraints together with nonsmooth elements are not supported by any method"
+    if n_contacts and (n_constraints or n_elements):
+        return ("contacts together with constraints or nonsmooth elements are not supported by "
+                "any method yet")
+    if bool(n_contacts) != flags.contacts:
+        contact_methods = ", ".join(m for m in METHODS if INFO[m].contacts)
+        return (f"it ignores the model's unilateral contacts (use {contact_methods})" if n_contacts
+                else "it is for models with unilateral contacts and this model has none")
     if bool(n_constraints) != flags.constraints:
         return ("it ignores the model's constraints" if n_constraints
                 else "it is for models with constraints and this model has none")
@@ -65,9 +72,9 @@ def inapplicable(method: str, n_constraints: int, n_elements: int) -> str:
     return ""
 
 
-def applicable_methods(n_constraints: int, n_elements: int) -> tuple:
+def applicable_methods(n_constraints: int, n_elements: int, n_contacts: int = 0) -> tuple:
     """The methods that apply to a model with these counts, in METHODS order."""
-    return tuple(m for m in METHODS if not inapplicable(m, n_constraints, n_elements))
+    return tuple(m for m in METHODS if not inapplicable(m, n_constraints, n_elements, n_contacts))
 
 
 #: The jitted loop each kind of method runs in: (module, function).

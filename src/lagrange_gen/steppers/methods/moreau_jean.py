@@ -1,0 +1,244 @@
+"""Moreau-Jean time stepping for unilateral contacts with impacts and Coulomb friction.
+
+Event-free: impacts happen inside a step, as impulses at the velocity level (Moreau 1988; Jean
+1999; Acary & Brogliato, "Numerical Methods for Nonsmooth Dynamical Systems", 2008, ch. 10).
+With M = H(q), f = rhs(q, v, t_theta) (= Q - h - g; t_theta = t + theta h), K = d rhs/dq,
+C = d rhs/dv at the start of the step, the linearized theta method is
+
+    A (v+ - v) = h f + h^2 theta K v + W r,        A = M - h theta C - h^2 theta^2 K
+    q+ = q + h ((1 - theta) v + theta v+)
+
+with W = [W_N^T, W_T^T] (n, 2c) the contact Jacobians at q (generated ``contacts``: gaps g,
+W_N = dg/dq, W_T = d slip/d qdot) and r = (p_N, p_T) the impulses. For a model whose forces are
+constant (gravity) the smooth part is exact: v+ = v + h a, q+ = q + h v + h^2 a / 2 at
+theta = 1/2.
+
+Contacts in the step: those whose gap closes at the end of the step without contact impulses,
+to first order: g(q) + h W_N ((1 - theta) v + theta v_free) <= 0 (the index set; the free
+velocity, not v alone, so that a contact at rest with g = +1e-19 after rounding stays in it
+instead of leaving for a step of free fall). On them, with u = W v+ = u_free + D r, u_free = W v_free,
+v_free = v + A^-1 (h f + h^2 theta K v) and the Delassus operator D = W A^-1 W^T:
+
+    Newton's impact law:  u_N + e min(u_N-, 0) >= 0  _|_  p_N >= 0   (u_N- = W_N v, restitution e;
+                          a contact already opening at the step's start gets u_N >= 0)
+    Coulomb (2D):         p_T in [-mu p_N, mu p_N], p_T = -mu p_N sign(u_T) when u_T != 0
+
+solved by projected Gauss-Seidel, contact by contact:
+p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then p_T <- clamp(p_T - u_T / D_TT, -mu p_N, mu p_N),
+until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
+(CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
+impulse that zeroes u_T: no creep.
+
+Order 1 (impacts located to within a step). theta = 1/2 (default) is energy-neutral in free
+flight; the work of the contact impulses per step is r . (u- + u+) / 2 with u- = W v, u+ = W v+
+(the kinetic energy change an impulse causes), and for forces that do not depend on q and v
+(the bouncing ball, the block on a ramp) E - E0 - W_contact = 0 to rounding at theta = 1/2.
+Positions may go below the gap by O(h |u_N|) at an impact (the impulse acts on velocities);
+``min_gap`` reports it. No Newton: one LU of A per step.
+
+``extra`` (SPEC.saved), c = kern.N_CONTACTS: active contacts (1), normal impulses p_N (c),
+tangential impulses p_T (c), the smallest gap at the end of the step (1), the cumulated work
+of the contact impulses (1). The step returns (status, sweeps, last sweep's largest change).
+"""
+
+from collections import namedtuple
+from typing import NamedTuple
+
+import numpy as np
+from ...jit.cache import njit
+
+from ..core.options import FAST, inline_step
+from ..core.linalg import lu_inplace, lu_solve_inplace
+from ..core.method_spec import Spec
+from ..core.solve import failed_solve_status
+from ..core.status import CONTACT_NOT_CONVERGED, OK
+
+#: Scratch of one run (n coordinates, c contacts). (n,): rhs f, the free velocity vf, solver
+#: scratch s and pivots piv; (n, n): H, the iteration matrix A (LU-factored in place), d rhs/dq
+#: Jq, d rhs/dv Jqd; (c,): gaps g, normal velocities before the step un; W_N, W_T (c, n);
+#: coef (c, 2) = (e, mu); (2c,): impulses r = (p_N, p_T), free local velocities uf, active flag
+#: of each contact (first c entries); Y (2c, n) the rows A^-1 W^T; D (2c, 2c) the Delassus matrix.
+Workspace = namedtuple("Workspace", "f vf s piv H A Jq Jqd g un WN WT coef r uf active Y D")
+
+
+class MoreauJeanSettings(NamedTuple):
+    """moreau_jean's settings (no Newton: one linear solve per step, then the contact problem)."""
+
+    blowup_bound: float = 1e150
+    theta: float = 0.5            # theta method weight in (0, 1]: 1/2 energy-neutral, 1 damping
+    contact_tol: float = 1e-10    # projected Gauss-Seidel stop: max change <= tol * max|r|
+    max_sweeps: int = 1000        # cap on the Gauss-Seidel sweeps per step
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by run_loop.run_loop."""
+    c = kern.N_CONTACTS
+    return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros(c), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
+                     np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
+                     np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)))
+
+
+@njit(inline="always")
+def _min_gap(g):
+    """The smallest entry of g (c,) (inf for no contacts)."""
+    m = np.inf
+    for i in range(g.shape[0]):
+        m = min(m, g[i])
+    return m
+
+
+@njit(**FAST)
+def prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """Row 0 of the saved fields: no active contact, no impulse, the initial smallest gap; the
+    contact work continues from what extra holds (0 at the start of a run)."""
+    c = kern.N_CONTACTS
+    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    for i in range(2 * c + 1):
+        extra[i] = 0.0
+    extra[2 * c + 1] = _min_gap(ws.g)
+    return OK
+
+
+@njit(inline="always")
+def _row(k, c, WN, WT):
+    """Row k of W^T (2c, n): W_N's rows, then W_T's."""
+    return WN[k] if k < c else WT[k - c]
+
+
+@njit(inline="always")
+def _delassus(c, n, active, WN, WT, A, piv, scratch, Y, D):
+    """Y_k = A^-1 W_k^T (rows of the active contacts) and D = W A^-1 W^T (2c, 2c) on them."""
+    for k in range(2 * c):
+        if active[k % c] == 0.0:
+            continue
+        w = _row(k, c, WN, WT)
+        for i in range(n):
+            Y[k, i] = w[i]
+        lu_solve_inplace(A, piv, Y[k], scratch)
+    for a in range(2 * c):
+        for b in range(2 * c):
+            s = 0.0
+            if active[a % c] != 0.0 and active[b % c] != 0.0:
+                w = _row(a, c, WN, WT)
+                for i in range(n):
+                    s += w[i] * Y[b, i]
+            D[a, b] = s
+
+
+@njit(inline="always")
+def _local_velocity(k, c, uf, D, r):
+    """(u_free + D r)_k, the local velocity of row k after the impulses r."""
+    s = uf[k]
+    for b in range(2 * c):
+        s += D[k, b] * r[b]
+    return s
+
+
+@njit(inline="always")
+def _gauss_seidel(c, tol, max_sweeps, active, coef, un, uf, D, r):
+    """Projected Gauss-Seidel on the impulses r (2c,) (see the module docstring). Returns
+    (converged, sweeps, the last sweep's largest change)."""
+    change = 0.0
+    for sweep in range(max_sweeps):
+        change, largest = 0.0, 0.0
+        for a in range(c):
+            if active[a] == 0.0 or D[a, a] <= 0.0:
+                continue
+            e, mu = coef[a, 0], coef[a, 1]
+            # restitution reverses an approaching velocity only (u_N- < 0)
+            pn = max(0.0, r[a] - (_local_velocity(a, c, uf, D, r) + e * min(un[a], 0.0)) / D[a, a])
+            change = max(change, abs(pn - r[a]))
+            r[a] = pn
+            t = c + a
+            pt = 0.0
+            if mu > 0.0 and D[t, t] > 0.0:
+                pt = r[t] - _local_velocity(t, c, uf, D, r) / D[t, t]
+                pt = min(max(pt, -mu * pn), mu * pn)
+            change = max(change, abs(pt - r[t]))
+            r[t] = pt
+            largest = max(largest, abs(pn), abs(pt))
+        if change <= tol * largest:
+            return True, sweep + 1, change
+    return False, max_sweeps, change
+
+
+@njit(inline=inline_step, **FAST)
+def step(kern, q, v, mom, t, h, p, settings, ws, extra):
+    """One step from (q, v) at t, in place. Returns (status, Gauss-Seidel sweeps, last change)."""
+    n, c = kern.N_COORDS, kern.N_CONTACTS
+    theta = settings.theta
+    f, vf, A, r, uf, active, WN, WT = ws.f, ws.vf, ws.A, ws.r, ws.uf, ws.active, ws.WN, ws.WT
+    kern.dynamics(q, v, t + theta * h, p, ws.H, f)
+    kern.rhs_jacobian(q, v, t + theta * h, p, ws.Jq, ws.Jqd)
+    for i in range(n):
+        s = h * f[i]
+        for j in range(n):
+            s += h * h * theta * ws.Jq[i, j] * v[j]
+            A[i, j] = ws.H[i, j] - h * theta * ws.Jqd[i, j] - h * h * theta * theta * ws.Jq[i, j]
+        vf[i] = s
+    if not lu_inplace(A, ws.piv):
+        return failed_solve_status(A), 0, 0.0
+    lu_solve_inplace(A, ws.piv, vf, ws.s)
+    for i in range(n):
+        vf[i] += v[i]
+    kern.contacts(q, t, p, ws.g, WN, WT, ws.coef)
+    n_active = 0
+    for a in range(c):
+        un, ufn, uft = 0.0, 0.0, 0.0
+        for i in range(n):
+            un += WN[a, i] * v[i]
+            ufn += WN[a, i] * vf[i]
+            uft += WT[a, i] * vf[i]
+        ws.un[a] = un
+        uf[a], uf[c + a] = ufn, uft
+        # the gap the step reaches without contact impulses (first order in h)
+        active[a] = 1.0 if ws.g[a] + h * ((1.0 - theta) * un + theta * ufn) <= 0.0 else 0.0
+        n_active += int(active[a])
+        r[a], r[c + a] = 0.0, 0.0
+    sweeps, change = 0, 0.0
+    if n_active > 0:
+        _delassus(c, n, active, WN, WT, A, ws.piv, ws.s, ws.Y, ws.D)
+        converged, sweeps, change = _gauss_seidel(c, settings.contact_tol, settings.max_sweeps,
+                                                  active, ws.coef, ws.un, uf, ws.D, r)
+        if not converged:
+            return CONTACT_NOT_CONVERGED, sweeps, change
+    work = 0.0
+    for a in range(c):                   # r . (u- + u+) / 2, u+ = u_free + D r
+        if active[a] == 0.0:
+            continue
+        ut_minus = 0.0
+        for i in range(n):
+            ut_minus += WT[a, i] * v[i]
+        work += r[a] * 0.5 * (ws.un[a] + _local_velocity(a, c, uf, ws.D, r))
+        work += r[c + a] * 0.5 * (ut_minus + _local_velocity(c + a, c, uf, ws.D, r))
+    for i in range(n):
+        vi = vf[i]
+        for k in range(2 * c):
+            if active[k % c] != 0.0:
+                vi += ws.Y[k, i] * r[k]
+        q[i] += h * ((1.0 - theta) * v[i] + theta * vi)
+        v[i] = vi
+    kern.contacts(q, t + h, p, ws.g, WN, WT, ws.coef)
+    extra[0] = n_active
+    for k in range(2 * c):
+        extra[1 + k] = r[k]
+    extra[2 * c + 1] = _min_gap(ws.g)
+    extra[2 * c + 2] += work
+    return OK, sweeps, change
+
+
+SPEC = Spec(
+    name="moreau_jean", order=1, family="nonsmooth", implicit=True, symplectic=False,
+    symmetric=False,
+    summary="Moreau-Jean time stepping: impacts (Newton) and Coulomb friction as impulses, "
+            "projected Gauss-Seidel",
+    contacts=True,
+    saved=(("active_contacts", 1), ("normal_impulse", "c"), ("tangent_impulse", "c"),
+           ("min_gap", 1), ("contact_work", 1)),
+    limits={"theta": (0.0, False, False), "contact_tol": (0.0, False, False),
+            "max_sweeps": (1, True, False)},
+    settings=MoreauJeanSettings,
+    kernels=("contacts", "dynamics", "rhs_jacobian"))

@@ -1,0 +1,56 @@
+"""Contact input: the one-line ModelError of each bad contact, and which methods apply."""
+
+import pytest
+import sympy as sp
+
+from lagrange_gen import Contact, Model, ModelError, coordinates, parameters, t
+from lagrange_gen.steppers.core import registry
+
+
+def _ball(**contact):
+    y = coordinates("y")
+    m, g = parameters("m g", defaults=(1.0, 9.81))
+    contact = {"gap": y, **contact}
+    contact = {k: (v(y) if callable(v) else v) for k, v in contact.items()}
+    return Model("ball", coords=[y], T=m * y.d**2 / 2, V=m * g * y, contacts=[Contact(**contact)])
+
+
+def test_a_good_contact_is_accepted():
+    model = _ball(restitution=0.5, friction=0.0)
+    assert model.n_contacts == 1 and model.contacts[0].name == "contact_0"
+
+
+@pytest.mark.parametrize("contact, message", [
+    (dict(restitution=-0.1), r"contact contact_0: restitution must be in \[0, 1\], got -0.1"),
+    (dict(restitution=1.5), r"restitution must be in \[0, 1\], got 1.5"),
+    (dict(friction=-0.2, slip=lambda y: y.d), r"friction must be >= 0, got -0.2"),
+    (dict(friction=0.3), r"friction 0.3 without a tangent: give slip="),
+    (dict(gap=sp.Integer(2)), r"the gap 2 does not depend on any coordinate \(y\)"),
+    (dict(gap=lambda y: y.d), r"the gap y_dot depends on velocities"),
+    (dict(gap=lambda y: y - t), r"depends on t; rheonomic gaps"),
+    (dict(friction=0.3, slip=lambda y: y.d**2), r"the slip y_dot\*\*2 is not linear"),
+    (dict(friction=0.3, slip=lambda y: y), r"the slip y does not depend on any velocity"),
+])
+def test_bad_contact_is_one_line_naming_it(contact, message):
+    with pytest.raises(ModelError, match=message) as info:
+        _ball(**contact)
+    assert "\n" not in str(info.value) and "model ball" in str(info.value)
+
+
+def test_restitution_from_a_parameter_default_is_checked():
+    e = parameters("e", defaults=(2.0,))
+    with pytest.raises(ModelError, match=r"restitution must be in \[0, 1\], got e = 2"):
+        _ball(restitution=e)
+
+
+def test_not_a_contact_is_refused():
+    y = coordinates("y")
+    with pytest.raises(ModelError, match="contact 0 is int, not Contact"):
+        Model("ball", coords=[y], T=y.d**2 / 2, contacts=[3])
+
+
+def test_only_moreau_jean_applies_to_contacts_and_not_elsewhere():
+    assert registry.applicable_methods(0, 0, 1) == ("moreau_jean",)
+    assert "moreau_jean" not in registry.applicable_methods(0, 0, 0)
+    assert "unilateral contacts" in registry.inapplicable("verlet", 0, 0, 2)
+    assert "has none" in registry.inapplicable("moreau_jean", 0, 0, 0)
