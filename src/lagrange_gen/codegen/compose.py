@@ -1,8 +1,9 @@
 """Kernels built from other kernels instead of from their own symbolic expressions.
 
-numba's compile time grows with the operations a kernel contains (about a millisecond each on
-this machine), so symbolic work that two kernels share is compiled twice. When the kernels
-that hold the shared part are emitted anyway, a kernel is composed from them:
+numba's compile time grows with the operations a kernel contains (about a millisecond each; kernel
+compile times: ``lagrange-gen bench scale``, reports/scale.md), so symbolic work that two kernels
+share is compiled twice. When the kernels that hold the shared part are emitted anyway, a kernel is
+composed from them:
 
 * momentum_rate_jacobian: d(dp/dt)/dqd = D(qd)^T + dQ/dqd, where D(w) = d(H(q) w)/dq is the
   kernel mass_matvec_dq; only d(dp/dt)/dq (and a nonzero dQ/dqd) stays symbolic.

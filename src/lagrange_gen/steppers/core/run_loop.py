@@ -68,7 +68,7 @@ def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, s
     start of the interpolant) and one evaluation of the event functions; the end accelerations
     and the root refinement only a step where some g changed sign. Without events the literal
     n_event_fns = 0 lets numba prune the event branches before typing them: no work, no
-    allocation and no compile time (typing them cost about 2.5 s per module).
+    allocation and no compile time (typing them would cost about 2.5 s per module).
     Inputs (lagrange_gen.run.control): ``control(control_data, t, q, v, p) -> changed``, a jitted
     function, writes the model's inputs (the trailing entries of p) from the state at the start
     of each step and at t0 (zero-order hold over a step), and the method's prepare runs again
