@@ -1,4 +1,4 @@
-"""Exception hierarchy (DESIGN.md section 7).
+"""Exception hierarchy.
 
 User errors carry a one-line message that names the file, symbol, step or value; the CLI prints
 that line and exits non-zero without a traceback (``--debug`` shows it).

@@ -1,5 +1,5 @@
-"""Linear stability measured from the steppers themselves (DESIGN.md section 6, HARD_CASES
-case 3, Lacoursiere's slides), and the closed forms it must match.
+"""Linear stability measured from the steppers themselves (HARD_CASES case 3, Lacoursiere's
+slides), and the closed forms it must match.
 
 Step matrix: one step of the real stepper, through ``simulate``, applied to the basis vectors
 (x, v) = (1, 0) and (0, 1) of the oscillator x'' = -omega^2 x (models/damped_oscillator.py with

@@ -83,8 +83,8 @@ def portable_step_ns(mod, method, steps, repeats):
 def chain_dir():
     """Where bench speed writes the 16-link chain's module: beside the portable glue (kept, so
     numba's cache of it serves the next run), not in the repository's generated/, which holds
-    each model file's default build (generated/n_link_pendulum_16.py was left there untracked
-    after every run)."""
+    each model file's default build (writing there would leave generated/n_link_pendulum_16.py
+    untracked after every run)."""
     from ..jit import portable
     return portable.portable_dir().parent / "bench"
 

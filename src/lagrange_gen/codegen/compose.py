@@ -1,8 +1,9 @@
 """Kernels built from other kernels instead of from their own symbolic expressions.
 
-numba's compile time grows with the operations a kernel contains (about a millisecond each on
-this machine), so symbolic work that two kernels share is compiled twice. When the kernels
-that hold the shared part are emitted anyway, a kernel is composed from them:
+numba's compile time grows with the operations a kernel contains (about a millisecond each; kernel
+compile times: ``lagrange-gen bench scale``, reports/scale.md), so symbolic work that two kernels
+share is compiled twice. When the kernels that hold the shared part are emitted anyway, a kernel is
+composed from them:
 
 * momentum_rate_jacobian: d(dp/dt)/dqd = D(qd)^T + dQ/dqd, where D(w) = d(H(q) w)/dq is the
   kernel mass_matvec_dq; only d(dp/dt)/dq (and a nonzero dQ/dqd) stays symbolic.
@@ -31,10 +32,9 @@ def compositions(dyn, selected, needs) -> dict:
     if "mass_matvec_dq" in selected and "momentum_rate_jacobian" in selected:
         out["momentum_rate_jacobian"] = "d/dqd part = mass_matvec_dq(q, qd)^T + dQ/dqd"
     # The steppers reach dynamics through the module function forward_dynamics (steppers/core/legendre.py
-    # accel): a method naming either calls it. (Counting only "dynamics" found no caller once the
-    # steppers called forward_dynamics, and the verlet/midpoint module went back to the
-    # symbolic dynamics: at 16 links 979 more lines; its kernels' first compile 12.3 s, 10.3 s
-    # with dynamics composed again.)
+    # accel): a method naming either calls it. (Counting only "dynamics" would find no caller,
+    # and the verlet/midpoint module would fall back to the symbolic dynamics: at 16 links about
+    # a thousand more lines and a slower first compile of its kernels.)
     callers = [names for names in needs.values() if {"dynamics", "forward_dynamics"} & set(names)]
     # (not for H(q, t): rhs also holds -dH/dt qd, which the composition would miss)
     if (not dyn.mass_is_constant and not dyn.mass_depends_on_t and {"mass_matvec_dq", "momentum_rate"} <= set(selected)

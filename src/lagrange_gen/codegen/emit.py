@@ -1,20 +1,21 @@
 """Emit one KernelSpec as numba source: loads, one CSE pass, stores (deterministic, no I/O).
 
-The shape of the emitted code is chosen for numba's compile time, measured on the 16-link
-pendulum (dynamics kernel, 850 lines: 17.4 s to compile as first emitted, 4.9 s now):
+The shape of the emitted code is chosen for numba's compile time, which on a large model is
+mostly LLVM's (the 16-link pendulum's dynamics kernel has hundreds of lines; first compile of
+the kernels against the number of links: ``lagrange-gen bench scale``, reports/scale.md):
 
 * Every input entry is loaded once into a local (``q_3 = q[3]``) before anything is stored.
   LLVM cannot prove that the output arrays do not alias the inputs, so an expression reading
   ``q[3]`` after a store must reload it, and memory-dependence analysis over hundreds of
-  interleaved loads and stores was most of LLVM's time (9.9 s -> 1.6 s).
+  interleaved loads and stores would be most of LLVM's time.
 * Large 2-D outputs (more than FLAT_VIEW_MIN entries) are written through a flat view
-  (``H_f = H.reshape(n * n)``): one store per entry instead of numba's 2-D index arithmetic
-  (LLVM 1.6 s -> 0.7 s). Outputs must therefore be C-contiguous, which every caller in the
-  package passes. Small ones are written as ``H[i, j]``: the reshape is a run-time call
-  (numba_attempt_nocopy_reshape) on every kernel call, about 7 ns each, which on the cart
-  pendulum was a third of symplectic Euler's step (271 -> 191 ns with direct stores). At
-  n = 8 the direct stores gained nothing at run time and cost 10 % more compile time (kernels
-  4.9 -> 5.4 s), hence the threshold (n <= 4 direct).
+  (``H_f = H.reshape(n * n)``): one store per entry instead of numba's 2-D index arithmetic,
+  which halves what remains of LLVM's time. Outputs must therefore be C-contiguous, which
+  every caller in the package passes. Small ones are written as ``H[i, j]``: the reshape is a
+  run-time call (numba_attempt_nocopy_reshape) on every kernel call, a few ns each, which on
+  the cart pendulum would be about a third of symplectic Euler's step. At n = 8 the direct
+  stores gain nothing at run time and cost about 10 % more compile time, hence the threshold
+  (n <= 4 direct).
 * Structurally zero entries (zero for every state, decided symbolically) are not computed: a
   few are stored as ``0.0``; more are written by a loop over a module constant of flat indices.
 * Symmetric outputs compute the upper triangle and store each value to both places.

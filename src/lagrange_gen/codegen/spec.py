@@ -73,8 +73,8 @@ CORE_KERNELS = ("mass_matrix", "dynamics", "energy")
 
 
 def kernel_table(dyn) -> dict:
-    """{kernel name: function returning its KernelSpec}, in the fixed order of DESIGN.md
-    section 5. Specs are built on demand: a Jacobian is only derived when its kernel is emitted."""
+    """{kernel name: function returning its KernelSpec}, in a fixed order. Specs are built on
+    demand: a Jacobian is only derived when its kernel is emitted."""
     nat, jac = dyn.native, dyn.jac.native
     table = {
         "mass_matrix": lambda: KernelSpec("mass_matrix", ["q", "t", "p"], [Output("H", nat["H"], symmetric=True)],

@@ -1,9 +1,10 @@
 """Symbolic backend of the derivation: symengine when installed, sympy otherwise.
 
 The derivation runs entirely in one backend's *native* objects (``Ops``): on a 20-link pendulum
-converting every intermediate symengine result back to sympy took 5 of 10 s (profiled), and
-sympy's matrix products another 2. Results are converted to sympy only when someone reads a
-Dynamics field (tests, small models); code generation reads the native expressions directly.
+converting every intermediate symengine result back to sympy would take about half of the derivation
+(profiled), and sympy's matrix products another fifth. Results are converted to sympy only when
+someone reads a Dynamics field (tests, small models); code generation reads the native expressions
+directly.
 Native symbols carry only names; ``to_sympy`` maps them back to the model's symbols by name.
 
 ``jacobian``/``gradient`` (sympy in, sympy out) remain for callers that work in sympy.

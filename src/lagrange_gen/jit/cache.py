@@ -5,12 +5,13 @@ here. With ``cache=True`` it changes two things in numba's cache (numba.core.cac
 
 - **Key.** numba keys an entry on the text of the one file that defines the function. The
   compiled code also holds every function that function calls, from other files: when
-  steppers/core/linalg.py changed and constrained.py did not, numba served the old constrained.solve_rows with
-  the old Cholesky solve inside, without a word (tests/test_jit_cache.py). For a function defined
-  in the package, the entry's stamp also holds the hashes of the module's source closure
-  (sources.source_closure: every package file it imports, transitively), so a change in any of
-  them compiles it again. Generated modules and the portable glue need no more than numba's own
-  key: their text carries the hashes of the package files they compile (codegen/keys.py, jit/portable.py).
+  steppers/core/linalg.py changes and constrained.py does not, numba serves the old
+  constrained.solve_rows with the old Cholesky solve inside, without a word
+  (tests/test_jit_cache.py). For a function defined in the package, the entry's stamp also holds the
+  hashes of the module's source closure (sources.source_closure: every package file it imports,
+  transitively), so a change in any of them compiles it again. Generated modules and the portable
+  glue need no more than numba's own key: their text carries the hashes of the package files they
+  compile (codegen/keys.py, jit/portable.py).
 - **Failure.** An entry that cannot be loaded or saved (truncated, garbage, written by something
   else) is a cache miss: the entry is removed, the function compiled again, and one warning line
   printed per source file.

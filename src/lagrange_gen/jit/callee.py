@@ -7,19 +7,16 @@ The functions of the stepper library (lagrange_gen.steppers.*, lagrange_gen.step
 by jitted code only: the glue (a generated module's ``run_<method>``, the portable glue, the step
 API's loops) compiles them in, each one that is not inlined at numba-IR level as a function of
 its own (numba's typing of a call compiles the callee). Their wrappers are never used, and they
-cost compile time in every first compile of a stepper.
+cost compile time in every first compile of a stepper: dropping them takes a sixth to a quarter off
+a first simulate with empty caches (with and without: ``lagrange-gen bench compile``,
+reports/compile.md). The compiled steps are the same: tests/test_jit_callee.py compares a run's bits
+with and without ($LAGRANGE_GEN_SPEEDUPS=-callee keeps the wrappers, jit.speedups).
 
-Measured (a new process with an empty NUMBA_CACHE_DIR and portable directory, first simulate of
-10 steps with the portable glue, this 2-core machine), seconds with the wrappers -> without:
-cart pendulum midpoint 9.8 -> 8.1, verlet 13.5 -> 11.4, rk4 5.4 -> 3.9; Cartesian pendulum
-rattle 15.4 -> 12.7. The compiled steps are the same: tests/test_jit_callee.py compares a run's
-bits with and without ($LAGRANGE_GEN_SPEEDUPS=-callee keeps the wrappers, jit.speedups).
-
-numba itself gives a function compiled without the CPython wrapper no safe Python entry: calling
-it from Python jumps to an entry point that does not exist (a segmentation fault, measured). A
-CalleeDispatcher therefore answers a call from Python by compiling, on the first such call, a
-twin with the wrappers (the same Python function and options) and calling that: the function
-works from Python as before, at the cost of one more compile, paid only by whoever calls it from
+numba itself gives a function compiled without the CPython wrapper no safe Python entry: calling it
+from Python jumps to an entry point that does not exist (a segmentation fault, measured). A
+CalleeDispatcher therefore answers a call from Python by compiling, on the first such call, a twin
+with the wrappers (the same Python function and options) and calling that: the function works from
+Python as any dispatcher does, at the cost of one more compile, paid only by whoever calls it from
 Python (tests, a debugging session).
 """
 

@@ -3,12 +3,12 @@
 A numba compile allocates millions of container objects (IR nodes, type maps, LLVM wrappers),
 most of which stay alive until the function is compiled. CPython's collector runs a young
 collection every 700 net allocations and traverses every object of the young generation each
-time, and the survivors again in the older generations: profiled (perf, cart pendulum, first
+time, and the survivors again in the older generations: in a profile (perf, cart pendulum, first
 simulate of verlet with empty caches) the collector's functions (gc_collect_main, visit_decref,
-visit_reachable, ...) took about 10 % of the compile. Measured the same way (midpoint, three
-runs each, new processes): 7.28 / 7.56 / 7.50 s with the default thresholds, 6.99 / 7.06 /
-6.67 s with the young threshold at 200000 during the compile (peak RSS 297 -> 314 MB), 7.53 /
-7.08 / 6.75 s with the collector off (359 MB).
+visit_reachable, ...) take about 10 % of the compile. A young threshold of COMPILE_THRESHOLD
+during the compile saves about as much as turning the collector off, for a small fraction of
+the peak memory that costs (compile time with and without: ``lagrange-gen bench compile``,
+reports/compile.md).
 
 ``activate()`` sets the young generation's threshold to COMPILE_THRESHOLD when the outermost
 compile of a lagrange_gen function starts (jit.speedups.compiling, cache loads included) and

@@ -5,17 +5,18 @@ inline_ir) copies the callee's IR twice, block by block, each block with ``copy.
 shared memo. All blocks of a function share one Scope, which holds every variable of the
 function, so each block's copy copies that whole scope again: quadratic in the size of the
 callee. The steppers inline their Newton solves into the step and the step into the stepping
-loop, so the callees are large. Profiled (cProfile, cart pendulum, the specialized run_verlet):
-deepcopy took 16.4 of the 18.1 s the inlining pass spent under the profiler; without profiler
-the pass took 4.8 s of a 12.7 s compile.
+loop, so the callees are large. In a profile (cProfile, cart pendulum, the specialized
+run_verlet) deepcopy takes about nine tenths of the inlining pass, and the pass over a third of
+the compile.
 
 ``install()`` replaces the ``copy`` module that inline_closurecall sees by a stand-in whose
 ``deepcopy`` of an ir.Block (the one call numba makes there) reuses one copy of the scope for
-consecutive blocks of the same scope, so the copied blocks share one scope again, as the
-blocks they were copied from do. Every other attribute is the real ``copy`` module's. Measured
-the same way: the inlining pass 4.8 -> 1.1 s, run_verlet's compile 12.7 -> 9.8 s. The compiled
-code is the same: tests/test_numba_inline_copy.py compares the copies with numba's own, and a
-stepper compiled in two fresh processes, with and without it, bit for bit.
+consecutive blocks of the same scope, so the copied blocks share one scope again, as the blocks they
+were copied from do. Every other attribute is the real ``copy`` module's. The inlining pass then
+takes a fraction of its time (compile time with and without: ``lagrange-gen bench compile``,
+reports/compile.md). The compiled code is the same: tests/test_numba_inline_copy.py compares the
+copies with numba's own, and a stepper compiled in two fresh processes, with and without it, bit for
+bit.
 
 Active only while a lagrange_gen function compiles (jit.speedups.compiling), when
 $LAGRANGE_GEN_SPEEDUPS selects inline_copy and inline_closurecall still makes exactly that call

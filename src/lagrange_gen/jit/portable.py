@@ -10,13 +10,12 @@ first-class functions (the addresses of the model's compiled kernels, typed by n
 the same for every model, so the stepper is compiled once per method and then loaded from
 numba's cache for every model: a model just written compiles only its own kernels.
 
-The price is a call through a pointer per kernel evaluation, without inlining across kernels
-(measured on the cart pendulum: verlet 505 against 356 ns per step). The results are the same
-floating-point operations in the same order, so a portable run equals the specialized run
-bit for bit (tests/test_portable.py checks every method). simulate(jit="auto") runs the
-specialized glue when numba's cache already holds it, and otherwise starts portable and
-switches to the specialized glue between chunks when the run is long enough to pay for its
-compile (run/fixed_driver.py).
+The price is a call through a pointer per kernel evaluation, without inlining across kernels (ns per
+step of both loops: ``lagrange-gen bench speed``, reports/speed.md). The results are the same
+floating-point operations in the same order, so a portable run equals the specialized run bit for
+bit (tests/test_portable.py checks every method). simulate(jit="auto") runs the specialized glue
+when numba's cache already holds it, and otherwise starts portable and switches to the specialized
+glue between chunks when the run is long enough to pay for its compile (run/fixed_driver.py).
 
 Layout: the portable glue sources (codegen.glue.portable_glue_source) are written to
 ``portable_dir()/<library hash>/``; the hash covers every package file the glue compiles, so a
@@ -136,8 +135,8 @@ _TABLE_TYPES: dict = {}
 def _typeof_table(table, context):
     """numba's type of a kernel table (registered for every table class): numba's own tuple
     typing, done on the first call only. numba types the arguments of every call of the glue
-    in Python; a table of 11 first-class functions took a third of the time of a short
-    simulate() call (cProfile: 22 FunctionType constructions per call)."""
+    in Python; typing a table of 11 first-class functions on every call would take a third of
+    a short simulate() call (cProfile: 22 FunctionType constructions per call)."""
     from numba.core.typing.typeof import typeof_impl
     entry = _TABLE_TYPES.get(id(table))
     if entry is None or entry[0] is not table:
@@ -333,8 +332,9 @@ def specialized_ready(dispatcher, args) -> bool:
     """Whether the specialized glue ``dispatcher`` can run ``args`` without compiling: already
     compiled in this process, or in numba's on-disk cache (then it is loaded now, as numba's own
     first call would load it). A miss is remembered until the cache index changes (another
-    process may compile the glue meanwhile). Measured on the cart pole (midpoint, one
-    simulate() call per 1 ms step, its glue not compiled): 450 us per call before."""
+    process may compile the glue meanwhile): a caller running simulate() once per short step
+    (a controller on the cart pole, ``lagrange-gen bench stepapi``) would otherwise look the
+    glue up in numba's cache on every call, hundreds of microseconds each."""
     try:
         key = tuple(_argument_key(a) for a in args)
         sig = _SIGNATURES.get(key)

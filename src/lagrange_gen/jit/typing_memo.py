@@ -4,9 +4,9 @@ numba's type inference resolves every call in a function through its templates
 (numba.core.types.functions.BaseFunction.get_call_type): for ``operator.mul`` on two float64 it
 tries a dozen templates (integers, complex, NumPy ufuncs, ...) until one accepts, and it does so
 again for each of the thousands of multiplications of a generated kernel. Nothing is kept
-between two occurrences. Profiled (cProfile, 16-link pendulum, momentum_rate_jacobian with the
-mass_matvec_dq it calls): type inference took 6.4 of the 9.5 s of the compile under the
-profiler, 66231 template applications for about 5500 calls.
+between two occurrences. In a profile (cProfile, 16-link pendulum, momentum_rate_jacobian with
+the mass_matvec_dq it calls) type inference takes about two thirds of the compile, over ten
+template applications per call.
 
 ``install()`` wraps ``BaseFunction.get_call_type`` with a memo for the calls whose arguments
 are all plain numeric scalars (Float, Integer, Boolean, not literals) and that have no keyword
@@ -15,12 +15,11 @@ are made of. Their signature depends only on the function and those types. A hit
 signature found the first time and records the implementation key numba's lowering looks up
 (``_impl_keys``), as the first resolution did. Every other call goes through numba unchanged.
 
-Measured (fresh processes, empty numba cache, two runs each; /tmp/s3/kc3.py): the kernels of
-the 16-link verlet/midpoint module compile in 7.6 and 7.6 s instead of 10.1 and 9.9 s (14955
-hits, 40 misses), to the same machine code (tests/test_numba_typing_memo.py compares the
-assembly of every kernel of two models with and without the memo).
-The stepper glue hardly changes (run_verlet of the cart pendulum 10.4 s either way): its calls
-take arrays.
+Nearly every such call of a large kernel is then a hit, and the kernels compile to the same
+machine code (tests/test_numba_typing_memo.py compares the assembly of every kernel of two
+models with and without the memo) in about three quarters of the time (kernels with and without
+it: ``lagrange-gen bench compile``, reports/compile.md). The stepper glue hardly gains: its
+calls take arrays.
 
 Active only while a lagrange_gen function compiles (jit.speedups.compiling), when
 $LAGRANGE_GEN_SPEEDUPS selects typing_memo and numba's get_call_type still records the

@@ -24,9 +24,9 @@ from ..steppers.core.layout import N_STATS, STAT_ITERS, events_size, last_size, 
 CHUNK_STEPS = 200_000
 
 #: A portable run under simulate(jit="auto") compiles the specialized glue between chunks once
-#: its projected remaining time passes this many seconds. Measured by bench speed: the
-#: specialized loop takes 30 to 55 % off the step time on the cart pendulum but at most 10 % on
-#: the 16-link chain (where the kernels dominate; verlet's portable loop was even 3 % faster),
+#: its projected remaining time passes this many seconds. Measured by ``lagrange-gen bench
+#: speed`` (reports/speed.md): the specialized loop takes a third to a half off the step time
+#: on the cart pendulum but little or nothing on the 16-link chain (where the kernels dominate),
 #: and its compile costs 10 to 20 s: below a minute of remaining work it cannot pay for itself,
 #: and on large models it may not pay at all (then it costs one compile in a run of minutes).
 SPECIALIZE_AFTER_S = 60.0

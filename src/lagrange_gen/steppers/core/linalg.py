@@ -6,19 +6,17 @@ and with it every call pays atomic increments per array argument (see steppers/c
 2 x 2 systems (the cart pendulum, every two-coordinate model, and its Newton matrices) take a
 path on scalars: the same operations in the same order as the loops, so bitwise the same
 result (tests/test_linalg.py), but held in registers instead of re-read from the array after
-every store. The loops over a run-time n cost 17 ns per 2 x 2 LU solve and 19 ns per Cholesky
-factor-and-solve; the scalar paths 4 ns (10^7 solves, /work/scratch/lu2.py in the issue-13
-note).
+every store, which makes a 2 x 2 LU solve or Cholesky factor-and-solve several times faster than
+the loops over a run-time n.
 
 The substitutions multiply by the reciprocal of each diagonal entry, 1.0 / L[i, i], instead of
 dividing by it: the reciprocal does not depend on the running sum, so the divisions leave the
 chain of dependent operations that every unknown waits on (each unknown feeds the next
 substitution). At most one rounding more per unknown. The back substitutions go column by
-column (_back_substitute). Measured (best of 7 x 2e5 solves, taskset to one core, scripts
-/tmp/s2/la3.py and la4.py in the issue-13 note): Cholesky solve at n = 16 213 -> 125 ns, n = 8
-103 -> 59; LU solve (lu_solve_inplace) at n = 16 207 -> 130, n = 8 100 -> 63. The Cholesky
-factorization stays in the dot-product (left-looking) order: column-oriented and right-looking
-variants were slower at n = 8 to 24 (/tmp/s2/ch.py: 424 against 522 and 672 ns at n = 16).
+column (_back_substitute). Together they take the Cholesky and LU solves at n = 8 to 16 to
+about 60 % of the time of dividing, dot-product substitutions. The Cholesky factorization stays
+in the dot-product (left-looking) order: column-oriented and right-looking variants are slower
+at n = 8 to 24.
 """
 
 import math
@@ -92,7 +90,7 @@ def _cholesky_solve_loops(L, b):
         b[i] = s * (1.0 / L[i, i])
     # L^T x = y column by column: x_i is final once the rows below have been subtracted, then
     # row i of L (contiguous) updates the entries above it. The dot-product form walks the
-    # columns of L (stride n): 320 against 228 ns per solve at n = 16.
+    # columns of L (stride n), which is slower (at n = 16 by about 40 %).
     for i in range(n - 1, -1, -1):
         x = b[i] * (1.0 / L[i, i])
         b[i] = x
@@ -230,7 +228,7 @@ def _back_substitute(U, x):
     """Overwrite x (n,) by U^-1 x for the upper triangle of U (n, n), column by column: x_i is
     final once the rows below have been subtracted, then column i of U updates the entries
     above it (each update independent of the others, where the dot-product form waits on its
-    running sum: LU solve at n = 16 163 -> 135 ns, /tmp/s2/la4.py in the issue-13 note)."""
+    running sum)."""
     for i in range(U.shape[0] - 1, -1, -1):
         xi = x[i] * (1.0 / U[i, i])
         x[i] = xi

@@ -23,8 +23,9 @@ passes itself; one with several (partitioned: kick and drift) wraps each assembl
 
 Speed: ``solve`` and the assemblies are ``inline="always"`` (inlined at numba-IR level into the
 method's step), so the loop compiles as if written in the step. As separately compiled
-functions taking the args tuple they cost 40-60 ns per step on the cart pendulum (midpoint
-about 370 against 320 ns, implicit_euler 280 against 220 ns, best of 5 runs of 2e5 steps).
+functions taking the args tuple they would cost 40-60 ns more per step on the cart pendulum, a
+sixth to a quarter of a midpoint or implicit_euler step there (``lagrange-gen bench steppers``,
+reports/steppers.md).
 """
 
 import math
@@ -163,8 +164,8 @@ def solve_simplified(problem, kern, args, x, F, J, piv, scratch, tol, max_iter, 
         # tol per solve shows above the round-off floor of a 6th-order composition
         # (tests/zoo/test_heavy_top.py) and in the order of the 4th-order one: the compositions
         # pass False. Verlet and symplectic Euler (orders 2 and 1) pass True, as every other
-        # Newton method stops (solve): on the 16-link chain verlet took 5.76 -> 4.20 iterations
-        # per step, 4097 -> 3265 ns.
+        # Newton method stops (solve): on the 16-link chain it saves verlet about a quarter of its
+        # iterations per step, and as much of its step time.
         d = max_abs_of(F, size)
         if increment_converged(d, max_abs_of(x, size), prev if contraction_stop else 0.0, tol):
             return OK, it, resid

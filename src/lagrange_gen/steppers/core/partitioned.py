@@ -26,19 +26,14 @@ kick; the drift starts from what the kick used). Only when that contraction is s
 newton.THETA_REFRESH (stiff velocity-dependent forces, h far beyond the time scale of the
 Coriolis terms) is the exact Jacobian assembled (d f/d v from ``momentum_rate_jacobian``,
 d(H(q) w)/dq from ``mass_matvec_dq``) and LU-factored, and kept while it contracts fast.
-Measured (best of 3 runs of 2e4 steps, h = 1e-3, one process): 16-link chain
-symplectic_euler 12.5 us per step with Newton -> 6.9 with the Jacobian kept within the step ->
-4.6 with H's factors and begin_step's extrapolated guess (4.75 iterations per step instead of
-3, each a residual and a triangular solve instead of a Jacobian and an LU factorization);
-verlet 19.5 -> 11.4 -> 8.3 us. Cart pendulum: symplectic_euler 231 -> 210 ns, verlet 394 ->
-389 ns, composition 1152 -> 1184 ns (each substep extrapolating along its own sequence, 17.9
-iterations per step; 1284 ns and 22.5 when they started from v); 16-link chain composition
-62.9 -> 27.7 us. Then the guesses of degree up to GUESS_DEGREE = 4 (best_degree), on a faster
-machine (best of 3 runs of 2e4 steps, taskset to one core): 16-link chain symplectic_euler
-3535 -> 2959-3269 ns (4.75 -> 3.27 iterations per step), verlet 6472 -> 5061 ns (10.11 ->
-5.76); cart pendulum (best of 7 runs of 1e5 steps) symplectic_euler 2.88 -> 1.78 iterations,
-verlet 5.75 -> 2.78, composition 17.9 -> 8.3, composition6 48.3 -> 25.0 (at n = 2 the step
-time hardly moves: an iteration is a small part of it).
+H's factors and begin_step's extrapolated guess take a few more iterations per step than Newton
+with the exact Jacobian, but each iteration is a residual and a triangular solve instead of a
+Jacobian and an LU factorization, which on many links is most of the step (verlet up to 32
+links: ``lagrange-gen bench scale``, reports/scale.md). Each substep of a composition
+extrapolates along its own sequence of earlier solutions, which takes fewer iterations than
+starting from v. On small models (n = 2) the step time hardly depends on the iteration count:
+an iteration is a small part of the step (``lagrange-gen bench steppers``,
+reports/steppers.md).
 Shapes: q, mom, u, w, R, f, scratch (n,); H, A, Jq, Jqd, dHw (n, n).
 """
 
@@ -82,12 +77,10 @@ def jacobian_kick(kern, args, u, A):
 
 # solve_kick and solve_drift are inlined into the step (and with it into the stepping loop), as
 # are solve.factor_mass and legendre.velocity_from_factors: as separate functions each call passes
-# about a dozen arrays, each as its own pointer, shape and strides. Measured on the cart pendulum
-# (best of 7 runs of 1e5 steps, taskset to one core): symplectic_euler 128 -> 98 ns per step,
-# verlet 248 -> 180, composition 835 -> 663; the 16-link chain's verlet 5580 -> 4996 ns. The
-# price was compile time: the cart pendulum's specialized run_verlet 15.4 -> 18.4 s, verlet with
-# every cache cold 20.5 -> 21.7 s, most of it numba's inlining pass copying the larger step,
-# which lagrange_gen.jit.inline_copy then took back (run_verlet 14.3 -> 9.7 s).
+# about a dozen arrays, each as its own pointer, shape and strides, which is a large part of a
+# step on small models (ns per step: ``lagrange-gen bench steppers``, reports/steppers.md). The
+# price is compile time, most of it numba's inlining pass copying the larger step, which
+# lagrange_gen.jit.inline_copy makes cheap (``lagrange-gen bench compile``).
 @njit(inline="always")
 def solve_kick(kern, q, mom, t, hk, p, tol, max_iter, H, A, Jq, Jqd, piv, u, R, f, scratch,
                contraction_stop):
@@ -147,8 +140,8 @@ def solve_drift(kern, q, u, mom, hd, td, p, tol, max_iter, H, A, dHw, piv, w, R,
     On return q_new = q + hd (u + w) and H holds H (unfactored) at the last iterate the residual
     was evaluated at, q + hd (u + w_prev): it differs from q_new by hd times the last Newton
     increment, within the tolerance (newton.solve_simplified's stopping rule), as everything
-    after a Newton solve does. Evaluating H once more at q_new cost 6 % of a verlet step on the
-    16-link chain (3441 -> 3220 ns, /tmp/s4/chain.py of the issue-13 note).
+    after a Newton solve does. Evaluating H once more at q_new would cost about 6 % of a verlet
+    step on the 16-link chain.
     Returns (status, iterations, max-norm of the residual at the last iterate).
     """
     status, iters, resid = newton.solve_simplified(_DRIFT, kern,
@@ -254,10 +247,10 @@ def extrapolation_weights(max_degree):
     return weights
 
 
-#: Highest degree of the extrapolated Newton guesses (begin_step, verlet's drift). Measured on
-#: the 16-link chain (symplectic_euler, h = 1e-3, 2e4 steps, newton_tol 1e-12): Newton iterations
-#: per step 4.75 at degree 2 (the fixed quadratic extrapolation before), 4.00 at 3, 3.27 at 4 and
-#: no fewer at 5 to 7 (the guess is then below what one iteration resolves).
+#: Highest degree of the extrapolated Newton guesses (begin_step, verlet's drift). On the
+#: 16-link chain (symplectic_euler, h = 1e-3, newton_tol 1e-12) each degree up to 4 saves Newton
+#: iterations per step (4.75 at degree 2, 3.27 at 4) and degrees 5 to 7 save none: the guess is
+#: then below what one iteration resolves.
 GUESS_DEGREE = 4
 EXTRAPOLATE = extrapolation_weights(GUESS_DEGREE)
 

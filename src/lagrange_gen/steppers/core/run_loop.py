@@ -68,7 +68,7 @@ def run_loop(method, loop, kern, n_saved, n_event_fns, q0, v0, t0, h, n_steps, s
     start of the interpolant) and one evaluation of the event functions; the end accelerations
     and the root refinement only a step where some g changed sign. Without events the literal
     n_event_fns = 0 lets numba prune the event branches before typing them: no work, no
-    allocation and no compile time (typing them cost about 2.5 s per module).
+    allocation and no compile time (typing them would cost about 2.5 s per module).
     Inputs (lagrange_gen.run.control): ``control(control_data, t, q, v, p) -> changed``, a jitted
     function, writes the model's inputs (the trailing entries of p) from the state at the start
     of each step and at t0 (zero-order hold over a step), and the method's prepare runs again
@@ -154,15 +154,14 @@ def stepping_loop(method, kern, n_event_fns):
     them (numba prunes a branch on a constant, not on a literal argument).
 
     Why a function of its own: in run_loop, which allocates and so counts references, a step
-    inlined paid for the count of every array it touched (rk4 170 against 100 ns per step on
-    the cart pendulum), and a step called paid for the call. Cart pendulum, best of 7 runs of
-    1e5 steps, one process, the module's glue before -> after: rk4 102 -> 78 ns,
-    symplectic_euler 183 -> 138, verlet 276 -> 219, explicit_euler 18 -> 18; its compile (a
-    fresh process, the library's own numba cache warm) about 1 s longer, an extra compiled
-    layer (rk4 3.6 -> 4.8 s, verlet 11.4 -> 12.2 s, composition 14.2 -> 16.1 s). The
-    portable glue (loop None in run_loop) keeps the steps inlined in run_loop and calls the
-    step: as a loop of its own there, the first use of a method after an install compiled 2 s
-    longer (rk4 5.7 -> 7.8 s, verlet 18.1 -> 20.1 s, fresh numba cache)."""
+    inlined pays for the count of every array it touches, and a step called pays for the call;
+    here the step is inlined and nothing is counted (every method but explicit_euler steps
+    faster; ns per step of every method: ``lagrange-gen bench steppers``, reports/steppers.md).
+    The price is one more compiled layer in the glue's first compile (about a second; the time
+    to a first step with numba's cache warm is in the same report). The portable glue (loop
+    None in run_loop) keeps the steps inlined in run_loop and calls the step: it is compiled
+    once per method for every model (jit/portable.py), on the first use of a method after an
+    install, and a loop of its own would make that wait one compiled layer longer."""
     fixed_kern, fixed_events = kern, n_event_fns
 
     @fast_loop

@@ -14,8 +14,8 @@ def check_state(q, v, bound):
     """NON_FINITE if any entry is NaN/inf, UNSTABLE if one exceeds bound, else OK.
 
     Runs after every step: one comparison per entry (NaN fails it too), the failing case sorted
-    out by _classify. Against max_abs over q and v (a branch on NaN per entry) that took 26.2 ->
-    23.3 ns per explicit Euler step on the cart pendulum (best of 15 runs of 2e5 steps)."""
+    out by _classify. max_abs over q and v instead (a branch on NaN per entry) would add about
+    a tenth to an explicit Euler step on the cart pendulum."""
     limit = min(bound, _LARGEST)       # a bound of inf must still stop at inf
     for i in range(q.shape[0]):
         if not (abs(q[i]) <= limit and abs(v[i]) <= limit):
