@@ -29,6 +29,9 @@ In the child, one after the other:
    ``pin.aba`` (Pinocchio has no jitted loop of its own; for scale only).
 
 Times are of one run on a shared machine: compare ratios within the run.
+
+Over 300 lines: the parent and the child it starts (``python -m lagrange_gen.bench.robots
+--child``) stay in one module so that the stage events they exchange have one definition.
 """
 
 from __future__ import annotations

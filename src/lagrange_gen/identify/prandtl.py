@@ -32,6 +32,9 @@ reached after a monotone excursion of at least 2 max(eta) (true on a steady symm
 unlocks every element), otherwise the elements are not all saturated there and the breakpoints
 move (checked when the record shows the excursion, a warning otherwise); noise is additive on
 y, and x is much less noisy than its advance per sample.
+
+Over 300 lines with its documentation: a quarter of the module is the derivation above and
+the reasons of each step; the code is about 270 lines.
 """
 
 from __future__ import annotations

@@ -22,6 +22,9 @@ Layout: the portable glue sources (codegen.glue.portable_glue_source) are writte
 changed library gives new files and numba never loads a stale entry (numba's cache checks only
 the glue file itself). A version directory no process has used for UNUSED_DAYS is removed when
 a new one is made (remove_unused_versions), so upgrades do not pile up compiled glue.
+
+Over 300 lines with its documentation (a fifth of the module): the kernel table, its cache
+directory and the choice between portable and specialized glue share the table's type.
 """
 
 from __future__ import annotations

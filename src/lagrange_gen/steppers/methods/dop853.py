@@ -19,6 +19,8 @@ K[12] = f(t + h, y_new), K[13..15] the dense-output stages.
 
 The adaptive loop (adaptive.run_adaptive) calls the functions below; their contract is in its
 module docstring. Not symplectic, not symmetric: energy drifts with the error tolerance.
+
+Over 300 lines: about 80 of them are the published coefficients.
 """
 
 import math
