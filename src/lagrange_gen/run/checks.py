@@ -90,6 +90,19 @@ def vector(name, value, n, coords):
     return np.ascontiguousarray(arr)
 
 
+def state_vector(name, value, n, coords):
+    """value as a float64 vector (n,) like ``vector``, refusing also an array of more than one
+    dimension (a (2, 2) q0 is not the 4 coordinates of a 4-coordinate model)."""
+    try:
+        ndim = 0 if value is None else np.ndim(value)
+    except ValueError:          # a ragged sequence: vector() names it
+        ndim = 1
+    if ndim > 1:
+        raise SimulationError(f"{name} must be a flat sequence of {n} numbers ({', '.join(coords)}), "
+                              f"got an array of shape {np.shape(value)}")
+    return vector(name, value, n, coords)
+
+
 def check_element_coefficients(module, p):
     """Refuse a non-positive (or non-finite) stiffness, threshold or friction bound of a
     nonsmooth element at the parameter vector p (n_params,), naming the element and the

@@ -17,14 +17,17 @@ Failures raise the exception simulate raises for that status (failures.raise_for
 from __future__ import annotations
 
 import importlib
+import math
 
 import numpy as np
 from numba import njit, typeof
 from numba.experimental import jitclass
 
+from .checks import state_vector
 from .control import input_slots
 from ..errors import SimulationError
 from .failures import raise_for_status
+from .params import is_number
 from ..linear.linearize import parameter_vector
 from ..steppers.core import status as st
 from ..steppers.core import registry
@@ -137,14 +140,17 @@ class Stepper:
         if spec.adaptive or spec.constraints or getattr(module, "N_ELEMENTS", 0) or module.N_CONSTRAINTS:
             raise SimulationError(f"Stepper: {method} on {module.NAME}: the step API takes a "
                                   "fixed-step method on a model without constraints or elements")
-        if h is None or not float(h) > 0:
-            raise SimulationError(f"Stepper: give a step h > 0, got {h!r}")
+        if not (is_number(h) and math.isfinite(h) and h > 0):
+            raise SimulationError(f"Stepper: give a finite step h > 0, got {h!r}")
+        if not (is_number(t0) and math.isfinite(t0)):
+            raise SimulationError(f"Stepper: t0 must be a finite number, got {t0!r}")
         n, (first, k) = module.N_COORDS, input_slots(module)
         self.module, self.method, self.h, self.n_inputs = module, method, float(h), k
         self.settings = make_settings(spec, settings)
         p = parameter_vector(module, params)
-        self.q = np.ascontiguousarray(np.zeros(n) if q0 is None else q0, dtype=np.float64).copy()
-        self.v = np.ascontiguousarray(np.zeros(n) if v0 is None else v0, dtype=np.float64).copy()
+        # The compiled step indexes q and v up to n - 1 without bounds checks.
+        self.q = state_vector("q0", q0, n, module.COORDS).copy()
+        self.v = state_vector("v0", v0, n, module.COORDS).copy()
         self.p = p
         self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
         ws = _workspace(module, method)
