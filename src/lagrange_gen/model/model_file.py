@@ -9,6 +9,7 @@ import traceback
 from pathlib import Path
 
 from ..errors import ModelError
+from .data_files import file_record, files_read
 from .model import Model
 
 __all__ = ["load_model"]
@@ -35,8 +36,11 @@ def load_model(path, **options) -> Model:
         compile(source, str(path), "exec")
     except SyntaxError as exc:
         raise ModelError(f"{path}:{exc.lineno}: not valid Python: {exc.msg}") from None
-    model = _run_model_file(path, options)
+    with files_read(exclude=[path]) as data_files:
+        model = _run_model_file(path, options)
     model.source_path = str(path)
+    # What the model read besides its own text: generation records it (codegen.generate).
+    model.data_files = {name: file_record(name) for name in sorted(data_files)}
     model.source_text = source
     model.build_options = dict(options)
     return model
