@@ -7,17 +7,18 @@
 * The step count (``check_step_count``): at most MAX_STEPS steps.
 * The resolution of the time grid (``check_time_resolution``): the stepper evaluates forces at
   t0 + k h, and the driver saves those times; they must resolve h (TIME_RESOLUTION).
-* Memory for the saved rows (``check_memory``), against the memory the system has available now.
+* Memory for the saved rows (``check_memory``), against the memory this process can still take
+  now: MemAvailable, its cgroup's memory limit and RLIMIT_AS (run/memory.py).
 """
 
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
 from ..errors import SimulationError
+from . import memory
 from .params import is_number
 
 #: Largest step count simulate runs. At the fastest measured step (tens of ns, reports/steppers.md)
@@ -179,19 +180,21 @@ def check_time_resolution(t0, t_last, h, n_steps):
 
 
 def available_memory():
-    """Bytes the system can give a new allocation now: MemAvailable from /proc/meminfo, else
-    the free physical pages (os.sysconf); None when neither is known."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
+    """Bytes a new allocation can take now: the least of MemAvailable, the cgroup memory limits
+    and RLIMIT_AS (run/memory.py); None when none is known."""
+    return memory.available_memory()
+
+
+def _binding_bound(free):
+    """" (the cgroup limit (PATH))" when a process limit, not the machine's MemAvailable, is what
+    leaves ``free`` bytes; else ""."""
+    bounds = memory.memory_bounds()
+    if not bounds or free is None:
+        return ""
+    name = min(bounds, key=bounds.get)
+    if name == "MemAvailable" or abs(bounds[name] - free) > 0.05 * free + 2**20:
+        return ""
+    return f" (the {name})"
 
 
 def saved_rows(n_steps, save_every):
@@ -219,7 +222,8 @@ def check_memory(model, n_steps, save_every, n, n_saved, need=None, what=None):
     suggest = save_every * math.ceil(need / (0.5 * free))
     what = what or f"saving {rows} states ({n_steps} steps, save_every = {save_every})"
     raise SimulationError(
-        f"{model}: {what} needs {_gb(need)} of memory and {_gb(free)} is available; use "
+        f"{model}: {what} needs {_gb(need)} of memory and {_gb(free)} is available"
+        f"{_binding_bound(free)}; use "
         f"save_every >= {suggest} (--save-every {suggest})")
 
 
