@@ -39,15 +39,30 @@ class Signal:
     last sample)."""
 
     def __init__(self, times, values, hold="zoh"):
-        self.times = np.ascontiguousarray(times, dtype=np.float64)
-        values = np.asarray(values, dtype=np.float64)
-        self.values = np.ascontiguousarray(values.reshape(len(values), -1))
         if hold not in ("zoh", "linear"):
             raise SimulationError(f"Signal: hold={hold!r}; use 'zoh' or 'linear'")
-        if self.times.ndim != 1 or len(self.times) == 0 or len(self.values) != len(self.times):
-            raise SimulationError(f"Signal: {len(self.times)} times for {len(self.values)} samples")
-        if np.any(np.diff(self.times) <= 0) or not np.all(np.isfinite(self.values)):
-            raise SimulationError("Signal: times must increase and values be finite")
+        self.times = _samples("times", times)
+        values = _samples("values", values)
+        if self.times.ndim != 1:
+            raise SimulationError(f"Signal: times must be a 1-d sequence, got shape {self.times.shape}")
+        if values.ndim not in (1, 2):
+            raise SimulationError(f"Signal: values must be (S,) or (S, n_inputs), got shape "
+                                  f"{values.shape}")
+        if len(self.times) == 0:
+            raise SimulationError("Signal: no samples (give at least one time and value)")
+        if len(values) != len(self.times):
+            raise SimulationError(f"Signal: {len(self.times)} times for {len(values)} samples")
+        for name, arr in (("times", self.times), ("values", values)):
+            bad = np.argwhere(~np.isfinite(arr))
+            if bad.size:
+                raise SimulationError(f"Signal: {name} must be finite; {name}[{bad[0][0]}] = "
+                                      f"{arr[tuple(bad[0])]!r}")
+        steps = np.diff(self.times)
+        if np.any(steps <= 0):
+            k = int(np.argmax(steps <= 0)) + 1
+            raise SimulationError(f"Signal: times must increase; times[{k}] = {self.times[k]:g} "
+                                  f"after {self.times[k - 1]:g}")
+        self.values = np.ascontiguousarray(values.reshape(len(values), -1))
         self.hold = hold
 
     def __call__(self, t):
@@ -55,6 +70,14 @@ class Signal:
         out = np.zeros(self.values.shape[1] + 1)
         _signal_apply((self.times, self.values, self.hold == "linear", 1, 0.0), t, None, None, out)
         return out[1:]
+
+
+def _samples(name, value):
+    """``value`` as a C-contiguous float64 array, or a one-line SimulationError naming it."""
+    try:
+        return np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SimulationError(f"Signal: {name} must be numbers, got {value!r}") from None
 
 
 def _write_inputs(u, p, first):
