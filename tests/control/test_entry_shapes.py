@@ -90,3 +90,32 @@ def test_ensemble_refuses_q0_of_the_wrong_shape(double_pendulum):
     with pytest.raises(lg.SimulationError) as err:
         lg.ensemble(double_pendulum, "rk4", q0=np.zeros((4, 3)), t_end=0.1, h=0.01)
     _one_line(err, "q0")
+
+
+# Issue 34, item 8: the step API's other inputs ---------------------------------------------------
+
+@pytest.mark.parametrize("k", [-3, 0, 2.5, "2", True])
+def test_stepper_step_count_must_be_a_positive_integer(double_pendulum, k):
+    stepper = lg.Stepper(double_pendulum, "rk4", h=0.01, q0=[0.1, 0.2])
+    with pytest.raises(lg.SimulationError) as err:
+        stepper.step(k=k)
+    _one_line(err, "k")
+    assert stepper.steps == 0
+
+
+def test_stepper_unknown_method_is_one_line(double_pendulum):
+    with pytest.raises(lg.SimulationError) as err:
+        lg.Stepper(double_pendulum, "rk5", h=0.01)
+    _one_line(err, "rk5", "rk4")
+
+
+def test_stepper_refuses_to_step_on_after_a_failure(double_pendulum):
+    stepper = lg.Stepper(double_pendulum, "explicit_euler", h=0.5, q0=[2.0, 3.0], v0=[5.0, -5.0],
+                         blowup_bound=10.0)
+    with pytest.raises(lg.BlowUp):
+        stepper.step(k=100)
+    steps = stepper.steps
+    with pytest.raises(lg.SimulationError) as err:
+        stepper.step()
+    _one_line(err, "failed")
+    assert stepper.steps == steps

@@ -135,6 +135,9 @@ class Stepper:
     def __init__(self, module, method="midpoint", h=None, params=None, q0=None, v0=None, t0=0.0,
                  **settings):
         from .simulate import load_module
+        if method not in registry.METHODS:
+            raise SimulationError(f"Stepper: unknown method {method!r}; known: "
+                                  f"{', '.join(registry.METHODS)}")
         module = load_module(module, method=method)
         spec = registry.spec(method)
         if spec.adaptive or spec.constraints or getattr(module, "N_ELEMENTS", 0) or module.N_CONSTRAINTS:
@@ -153,6 +156,7 @@ class Stepper:
         self.v = state_vector("v0", v0, n, module.COORDS).copy()
         self.p = p
         self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
+        self._failure = None        # the message of the failure that ended this stepper
         ws = _workspace(module, method)
         cls = _core_class(module, method, typeof(self.settings), typeof(ws))
         self._core = cls(self.q, self.v, np.zeros(n), p, np.zeros(0), self._clock, self._info,
@@ -172,7 +176,15 @@ class Stepper:
         return np.concatenate((self.q, self.v))
 
     def step(self, u=None, k=1):
-        """Advance k steps with the inputs held at u; returns nothing, raises on failure."""
+        """Advance k steps with the inputs held at u; returns nothing, raises on failure (and
+        on any later call: the state is the failed one)."""
+        if not (is_number(k) and int(k) == k and k >= 1):
+            raise SimulationError(f"Stepper.step: k must be a positive integer (the number of "
+                                  f"steps), got {k!r}")
+        if self._failure is not None:
+            raise SimulationError(f"Stepper: this run failed at t = {self.t:g} ({self._failure}); "
+                                  f"make a new Stepper to start again")
+        k = int(k)
         core = self._core
         if u is None:
             code = core.advance(k)
@@ -185,7 +197,11 @@ class Stepper:
                                       f"{self.n_inputs} input(s)")
             code = core.step_vector(u, k)
         if code:
-            self._check(code, k)
+            try:
+                self._check(code, k)
+            except SimulationError as exc:
+                self._failure = str(exc)
+                raise
 
     def _check(self, code, k):
         if code == st.OK:
