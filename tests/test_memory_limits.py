@@ -101,3 +101,11 @@ def test_an_ensemble_of_no_members_is_refused(generated):
     with pytest.raises(lg.SimulationError) as err:
         lg.ensemble(generated("damped_oscillator"), "rk4", q0=np.zeros((0, 1)), t_end=0.1, h=0.01)
     assert "\n" not in str(err.value) and "0 members" in str(err.value)
+
+
+def test_a_step_longer_than_the_run_warns(generated):
+    """h = 1 > t_end = 0.5 ran to t = 1 without a word (issue 34, item 8)."""
+    with pytest.warns(UserWarning, match=r"h = 1 is longer than the run .* ends at t = 1, past "
+                                         r"t_end = 0\.5"):
+        traj = lg.simulate(generated("damped_oscillator"), "rk4", q0=[1.0], t_end=0.5, h=1.0)
+    assert traj.t[-1] == 1.0 and "longer than the run" in traj.warnings[0]

@@ -164,6 +164,17 @@ def check_step_count(t0, t_end, h):
             f"2.2e-16, outgrow any gain from a smaller h); use a larger h or a shorter run")
 
 
+def step_past_end(model, method, t0, t_end, h, n_steps):
+    """The warning (one line) for a step longer than the whole run: the run's only step ends
+    past t_end (h = 1 with t_end = 0.5 ends at t = 1); None otherwise. (A step that divides the
+    span unevenly overshoots by less than h, as simulate documents.)"""
+    if not (t_end > t0 and h > t_end - t0):
+        return None
+    return (f"{model}, {method}: the step h = {h:g} is longer than the run (t_end - t0 = "
+            f"{t_end - t0:g}): it ends at t = {t0 + n_steps * h:g}, past t_end = {t_end:g}; "
+            f"use h <= {t_end - t0:g}")
+
+
 def check_time_resolution(t0, t_last, h, n_steps):
     """Refuse a run whose times t0 + k h (up to t_last) cannot be told apart to
     max(TIME_RESOLUTION, 2 n_steps eps) h in float64 (e.g. t0 = 1.7e9 with h = 1e-7: saved

@@ -188,6 +188,9 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         return attach_inputs_outputs(_adaptive_trajectory(task, out, wanted, wall, compile_time),
                                      module, p, hook, data)
     n_steps = n_steps_to(t0, t_end, h)
+    overshoot = run_checks.step_past_end(module.NAME, method, t0, t_end, h, n_steps)
+    if overshoot:
+        warnings.warn(overshoot, stacklevel=2)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
@@ -195,7 +198,10 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     compile_time, wall = integrate_fixed(task, q, v, out, progress)
-    return attach_inputs_outputs(_trajectory(task, out, wall, compile_time), module, p, hook, data)
+    traj = _trajectory(task, out, wall, compile_time)
+    if overshoot:
+        traj.warnings.insert(0, overshoot)
+    return attach_inputs_outputs(traj, module, p, hook, data)
 
 
 def _with_data(run, data):
