@@ -21,6 +21,8 @@ saved row) and, with outputs, ``saved["output_<name>"]`` (the generated ``output
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, types
 from numba.extending import overload
@@ -141,12 +143,42 @@ def make_apply(controller):
     if not hasattr(controller, "py_func"):
         raise SimulationError(f"control: {getattr(controller, '__name__', controller)!r} is not "
                               "numba-jitted; decorate it with @numba.njit (it runs inside the loop)")
+    _check_arity(controller)
     if controller not in _APPLY:
         @njit(**FAST)
         def apply(data, t, q, v, p):
             return _write_inputs(controller(t, q, v, p), p, data[0])
         _APPLY[controller] = apply
     return _APPLY[controller]
+
+
+def _check_arity(controller):
+    """numba's "too many arguments" would come from inside the loop's compile: a controller must
+    take (t, q, qd, p), checked on its Python function."""
+    import inspect
+    try:
+        inspect.signature(controller.py_func).bind(0.0, None, None, None)
+    except TypeError:
+        raise SimulationError(f"control: the controller {controller.__name__}"
+                              f"{inspect.signature(controller.py_func)} must take (t, q, qd, p)") from None
+    except ValueError:         # no signature to read: numba tells
+        pass
+
+
+def blame_inputs(error, module, p, control):
+    """``error`` (a SimulationError of a run with inputs from ``control``) as one line that also
+    names the inputs when the last values written to p (n_params,) are not finite: the failure
+    (NaN state, singular matrix) then comes from them, not from the model. Else ``error``."""
+    first, k = input_slots(module)
+    bad = [f"{name} = {value!r}" for name, value in zip(module.PARAMS[first:], p[first:].tolist())
+           if not math.isfinite(value)]
+    if not bad:
+        return error
+    source = (f"the controller {control.__name__}" if not isinstance(control, Signal)
+              else "the Signal")
+    return type(error)(f"{error}; the input {', '.join(bad)} from {source} is not finite there",
+                       step=error.step, time=error.time, state=error.state,
+                       residual=error.residual)
 
 
 def input_slots(module):
@@ -235,6 +267,10 @@ def _check_size(module, controller, t0, q0, v0, p, names):
         raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns "
                               f"{u.size} value(s) at t0 for {len(names)} input(s) "
                               f"({', '.join(names)})")
+    bad = [f"{name} = {value!r}" for name, value in zip(names, u.tolist()) if not math.isfinite(value)]
+    if bad:
+        raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns a "
+                              f"non-finite input at t0 = {t0:g}: input {', '.join(bad)}")
 
 
 def attach_inputs_outputs(traj, module, p, hook, data):

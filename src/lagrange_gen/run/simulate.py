@@ -26,7 +26,7 @@ import numpy as np
 from . import checks as run_checks
 from .adaptive_driver import C_ACCEPTED, C_EVALS, C_REJECTED, integrate_adaptive
 from ..codegen.keys import regeneration_command_for
-from .control import attach_inputs_outputs, controlled_run, resolve_inputs
+from .control import attach_inputs_outputs, blame_inputs, controlled_run, resolve_inputs
 from .energy_check import energy_warning
 from ..errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
@@ -197,7 +197,12 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
                  jit=jit)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
-    compile_time, wall = integrate_fixed(task, q, v, out, progress)
+    try:
+        compile_time, wall = integrate_fixed(task, q, v, out, progress)
+    except SimulationError as exc:
+        if hook is None:
+            raise
+        raise blame_inputs(exc, module, task.p, control) from None
     traj = _trajectory(task, out, wall, compile_time)
     if overshoot:
         traj.warnings.insert(0, overshoot)
