@@ -69,10 +69,15 @@ def _run_model_file(path, options):
     """Run the file and pick its Model; every failure (an exception, sys.exit, any other
     BaseException but Ctrl-C) becomes a ModelError naming the file and line. The path is resolved
     before and the working directory restored after, whatever the file does (os.chdir)."""
-    resolved, cwd = path.resolve(), os.getcwd()
+    resolved, cwd, hard_exit = path.resolve(), os.getcwd(), os._exit
+    os._exit = _refuse_hard_exit          # it would end this process (and a batch) at once
     try:
         namespace = runpy.run_path(str(resolved), run_name=f"lagrange_gen_model_{path.stem}")
         return _pick_model(path, namespace, options)
+    except _HardExit as exc:
+        line = _user_line(exc, resolved)
+        raise ModelError(f"{path}{line}: called os._exit({exc.code}) while loading; a model file "
+                         "must define `model`, not exit") from None
     except ModelError as exc:
         msg = str(exc)
         raise ModelError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
@@ -86,7 +91,21 @@ def _run_model_file(path, options):
         line = _user_line(exc, resolved)
         raise ModelError(f"{path}{line}: raised {type(exc).__name__}: {exc}") from exc
     finally:
+        os._exit = hard_exit
         os.chdir(cwd)
+
+
+class _HardExit(BaseException):
+    """os._exit called by a model file (a BaseException: ``except Exception`` in it must not
+    swallow it)."""
+
+    def __init__(self, code):
+        super().__init__(code)
+        self.code = code
+
+
+def _refuse_hard_exit(code):
+    raise _HardExit(code)
 
 
 def _pick_model(path, namespace, options):
