@@ -117,6 +117,9 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
         raise SimulationError(f"method {method!r} chooses its own steps; ensemble runs the "
                               f"fixed-step methods only (e.g. rk4, midpoint, verlet)")
     run = _ensemble_glue(module, method)
+    if client is not None:
+        from .ensemble_dask import check_client
+        check_client(client)
     h = check_times(spec, h, t0, t_end, save_every, None)
     config = make_settings(spec, settings)
     M = member_count(module, q0, v0, params)
