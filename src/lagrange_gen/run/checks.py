@@ -104,6 +104,22 @@ def state_vector(name, value, n, coords):
     return vector(name, value, n, coords)
 
 
+def check_events_at_start(module, q, v, t0, p):
+    """Refuse a run whose event functions are not finite at the initial state (q, v (n,), t0):
+    NaN compares false with everything, so such an event would never fire."""
+    names = tuple(getattr(module, "EVENT_NAMES", ()))
+    if not names:
+        return
+    values = np.empty(len(names))
+    module.events(np.ascontiguousarray(q, dtype=np.float64), np.ascontiguousarray(v, dtype=np.float64),
+                  float(t0), np.ascontiguousarray(p, dtype=np.float64), values)
+    for name, value in zip(names, values.tolist()):
+        if not math.isfinite(value):
+            raise SimulationError(f"{module.NAME}: event {name} is {value} at the initial state "
+                                  f"(t0 = {t0:g}, q0 = {np.asarray(q).tolist()}): it would never "
+                                  f"fire; check where its function is defined")
+
+
 def check_element_coefficients(module, p):
     """Refuse a non-positive (or non-finite) stiffness, threshold or friction bound of a
     nonsmooth element at the parameter vector p (n_params,), naming the element and the

@@ -180,6 +180,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
                                            getattr(config, "newton_tol", 1e-12), keep)
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    run_checks.check_events_at_start(module, q, v, t0, p)
     if spec.adaptive:
         task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit)
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
