@@ -207,6 +207,12 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     traj = _trajectory(task, out, wall, compile_time)
     if overshoot:
         traj.warnings.insert(0, overshoot)
+    if spec.constraints:
+        violated = run_checks.constraint_violation(module.NAME, method, traj.t, traj.q,
+                                                   traj.saved.get("constraint_error"))
+        if violated:
+            traj.warnings.append(violated)
+            warnings.warn(violated, stacklevel=2)
     return attach_inputs_outputs(traj, module, p, hook, data)
 
 
