@@ -18,7 +18,7 @@ import numpy as np
 from ..codegen.kernel_abi import argument_shapes, kernel_dimensions
 from ..errors import SimulationError
 
-__all__ = ["check_python_calls", "check_kernel_arguments"]
+__all__ = ["check_python_calls", "check_kernel_arguments", "unchecked"]
 
 
 def check_python_calls(namespace):
@@ -32,8 +32,15 @@ def check_python_calls(namespace):
         if shapes is None or not hasattr(dispatcher, "overloads"):      # NUMBA_DISABLE_JIT
             continue
         dispatcher.__class__ = _checked_class(type(dispatcher))
-        dispatcher.python_call_check = functools.partial(check_kernel_arguments,
-                                                         f"{model}.{kernel}", shapes)
+        dispatcher.python_call_check = _fast_check(f"{model}.{kernel}", shapes)
+
+
+def unchecked(kernel):
+    """``kernel``'s call without the argument check, for a loop of the package over arrays it
+    made itself (one call per saved row: the check costs a few microseconds a call). A kernel
+    without the check is returned as it is."""
+    base = getattr(type(kernel), "unchecked_base", None)
+    return kernel if base is None else functools.partial(base.__call__, kernel)
 
 
 def check_kernel_arguments(kernel, shapes, args, kwargs):
@@ -63,6 +70,31 @@ def check_kernel_arguments(kernel, shapes, args, kwargs):
     return args
 
 
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _fast_check(kernel, shapes):
+    """check(args, kwargs) for ``kernel``: the common call (positional float64 arrays of the
+    right shapes, a float t) passes in a few type and shape comparisons; anything else goes to
+    check_kernel_arguments, which accepts it (an int t) or names what is wrong."""
+    expected = tuple(shape for _, shape in shapes)
+    count = len(expected)
+
+    def check(args, kwargs):
+        if kwargs or len(args) != count:
+            check_kernel_arguments(kernel, shapes, args, kwargs)
+            return
+        for value, shape in zip(args, expected):
+            if shape is None:
+                if type(value) is not float:
+                    check_kernel_arguments(kernel, shapes, args, kwargs)
+                    return
+            elif type(value) is not np.ndarray or value.shape != shape or value.dtype != _FLOAT64:
+                check_kernel_arguments(kernel, shapes, args, kwargs)
+                return
+    return check
+
+
 @functools.lru_cache(maxsize=None)
 def _checked_class(base):
     """``base`` (a numba dispatcher class) whose call from Python first runs the dispatcher's
@@ -76,6 +108,7 @@ def _checked_class(base):
                 check(args, kwargs)
             return super().__call__(*args, **kwargs)
 
+    CheckedKernel.unchecked_base = base
     name = f"Checked{base.__name__}"
     CheckedKernel.__qualname__ = CheckedKernel.__name__ = name
     CheckedKernel.__module__ = __name__

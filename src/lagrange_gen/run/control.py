@@ -28,6 +28,7 @@ from numba import njit, types
 from numba.extending import overload
 
 from ..errors import SimulationError
+from ..jit.python_calls import unchecked
 from .params import resolve_params
 from ..steppers.core.options import FAST
 
@@ -285,13 +286,14 @@ def attach_inputs_outputs(traj, module, p, hook, data):
     u = np.tile(p[first:], (rows, 1))
     y = np.zeros((rows, n_out))
     pk = p.copy()
+    outputs = unchecked(module.outputs) if n_out else None      # arrays made here, one call a row
     for r in range(rows):
         q, v = np.ascontiguousarray(traj.q[r]), np.ascontiguousarray(traj.v[r])
         if hook is not None:
             hook(data, float(traj.t[r]), q, v, pk)
             u[r] = pk[first:]
         if n_out:
-            module.outputs(q, v, float(traj.t[r]), pk, y[r])
+            outputs(q, v, float(traj.t[r]), pk, y[r])
     for j, name in enumerate(module.PARAMS[first:]):
         traj.saved[f"input_{name}"] = u[:, j:j + 1].copy()
     for j, name in enumerate(getattr(module, "OUTPUTS", ())):
