@@ -4,8 +4,9 @@ subprocess: without the fix it would end the test process."""
 
 import subprocess
 import sys
+from pathlib import Path
 
-from conftest import MODELS_DIR
+MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
 
 
 def test_os_exit_in_a_model_file_is_an_error_and_the_batch_goes_on(tmp_path):
