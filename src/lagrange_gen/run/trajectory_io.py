@@ -68,9 +68,12 @@ def read_npz(cls, path):
     when it is not one: unreadable, truncated or corrupted (zip, compression), metadata that is
     not the writer's, or arrays whose lengths disagree."""
     try:
-        with np.load(path, allow_pickle=False) as data:
+        # Opened here so that it is closed whatever np.load makes of it (a file that is not a
+        # zip is left open by numpy, and a ResourceWarning line follows later).
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as data:
             data = {k: data[k] for k in data.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+    except (OSError, ValueError, EOFError, TypeError, AttributeError, zipfile.BadZipFile,
+            zlib.error) as exc:        # TypeError: a .npy (an array, not an archive)
         raise LagrangeGenError(f"{path}: cannot read as a trajectory .npz "
                                f"({type(exc).__name__}: {_first_line(exc)})") from None
     try:
