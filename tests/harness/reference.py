@@ -21,6 +21,16 @@ from lagrange_gen import t
 # lambdify's numpy printer knows Abs, sign, atan2, ...; DiracDelta (from d sign/dx) is zero away
 # from the kink, where every sampled state lies.
 _MODULES = [{"DiracDelta": lambda *args: 0.0}, "numpy"]
+#: sympy leaves d floor(x)/dx unevaluated: zero away from the integers, where sampled states lie.
+_PIECEWISE_CONSTANT = (sp.floor, sp.ceiling)
+
+
+def _jumps_settled(expr):
+    """``expr`` (a sympy expression or matrix) with the derivatives of floor and ceiling at 0."""
+    return expr.replace(lambda e: isinstance(e, sp.Derivative) and isinstance(e.expr, _PIECEWISE_CONSTANT),
+                        lambda e: sp.S.Zero)
+
+
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
 VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
@@ -174,7 +184,8 @@ class Reference:
     def value(self, name, state):
         """The quantity at a state: float, or array (column vectors flattened)."""
         if name not in self._functions:
-            self._functions[name] = sp.lambdify(self.args, self.expr(name), modules=_MODULES)
+            self._functions[name] = sp.lambdify(self.args, _jumps_settled(self.expr(name)),
+                                                modules=_MODULES)
         expr = self.expr(name)
         p = [state.params[s.name] for s in self.params]
         values = [*state.q, *state.qd, state.t, *p, *state.w, *state.lam, *state.we]

@@ -7,7 +7,9 @@ construction:
 
 * angle coordinates u_i (sampled in [-2, 2]) enter only through functions defined on the whole
   real line: sin, cos, tanh, atan, exp, 2**x, Abs, x/(k + x**2), log(k + x**2), sqrt(k + x**2),
-  (k + x**2)**(-3/2), atan2(x, k + y**2), ...
+  (k + x**2)**(-3/2), atan2(x, k + y**2), and with kinks and jumps Max, Min, Piecewise,
+  Heaviside, floor (their derivatives: Heaviside, DiracDelta, d floor/dx; states land on a
+  kink with probability zero), ...
 * radial coordinates r_i (sampled in [0.5, 2.5]) may also be divided by, raised to negative and
   fractional powers (r**-4, r**(-1/2), r**2.5) and fed to log and sqrt;
 * parameters k_i have defaults in [0.5, 2] and enter as k, 1/k, k**2, 1/k**2, sqrt(k), k**-1.5.
@@ -41,6 +43,10 @@ TOTAL = [
     lambda x, k: (k + x**2)**sp.Rational(-3, 2), lambda x, k: sp.log(k + x**2),
     lambda x, k: sp.exp(x / 2), lambda x, k: sp.exp(-x**2 / k), lambda x, k: 2**x,
     lambda x, k: sp.Abs(x), lambda x, k: x * sp.Abs(x), lambda x, k: sp.sin(x) / k**2,
+    # kinks and jumps: their derivatives are Heaviside, DiracDelta, Piecewise, d floor/dx
+    lambda x, k: sp.Max(x, 0)**2, lambda x, k: sp.Min(x, k) * x,
+    lambda x, k: sp.Piecewise((x**2, x > 0), (-k * x, True)), lambda x, k: sp.Heaviside(x - k / 2) * x,
+    lambda x, k: sp.floor(x) + x / k,
 ]
 # f(r, k) real for every real r != 0 (allowed in T).
 NONZERO = [lambda r, k: 1 / r, lambda r, k: r**-2, lambda r, k: k / r**3, lambda r, k: 1 / r**4,
@@ -63,7 +69,7 @@ COEFFS = [sp.Integer(1), sp.Integer(-1), sp.Integer(2), sp.Rational(1, 2), sp.Ra
 SPEED = [lambda v, k: v, lambda v, k: -v * sp.Abs(v), lambda v, k: v / (k + v**2), lambda v, k: v**2,
          lambda v, k: sp.Integer(1)]
 TIME = [lambda k: sp.Integer(1), lambda k: sp.sin(k * t), lambda k: sp.cos(t), lambda k: sp.exp(-t / k),
-        lambda k: t, lambda k: 1 / (k + t**2)]
+        lambda k: t, lambda k: 1 / (k + t**2), lambda k: 1 + sp.Heaviside(t - k) / 2]
 
 
 @dataclass

@@ -256,9 +256,21 @@ def refuse_overwrite(model_path, target, name):
 
 
 def _record(model, key, options) -> dict:
-    """What makes re-deriving needless: the same model text, generator sources, options and KEY."""
-    return {"model": model_hash(model.source_text), "generator": generator_hash(), "options": options,
-            "key": key}
+    """What makes re-deriving needless: the same model text, data files it read (their sha256),
+    generator sources, options and KEY."""
+    data = {name: rec.get("sha256") for name, rec in getattr(model, "data_files", {}).items()}
+    return {"model": model_hash(model.source_text), "data": data, "generator": generator_hash(),
+            "options": options, "key": key}
+
+
+def _recorded(path) -> dict:
+    """The record of remember_current at ``path`` without the data files' sizes and mtimes
+    (which only make the import-time check cheap, keys.check_current); {} when unreadable."""
+    record = json.loads(path.read_text())
+    if not isinstance(record, dict):
+        return {}
+    record.pop("data_files", None)
+    return record
 
 
 def remember_current(target, model, key, options):
@@ -269,7 +281,9 @@ def remember_current(target, model, key, options):
     try:
         path.parent.mkdir(exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(_record(model, key, options), sort_keys=True))
+        record = _record(model, key, options)
+        record["data_files"] = getattr(model, "data_files", {})
+        tmp.write_text(json.dumps(record, sort_keys=True))
         os.replace(tmp, path)
     except OSError:
         pass
@@ -286,7 +300,7 @@ def module_current(model, target, header) -> bool:
     if why_stale(target, header.get("KEY"), header["SOURCES"], header.get("TEXT_SHA")):
         return False
     try:
-        if json.loads(derivation_record_path(target).read_text()) == _record(model, header["KEY"], options):
+        if _recorded(derivation_record_path(target)) == _record(model, header["KEY"], options):
             return True
     except (OSError, ValueError):
         pass

@@ -75,7 +75,7 @@ _IMPORTS = [
     "import numpy as np",
     "",
     "from lagrange_gen.codegen.keys import check_current",
-    "from lagrange_gen.jit import KERNEL_OPTIONS, njit  # numba.njit; a bad cache entry is a miss",
+    "from lagrange_gen.jit import KERNEL_OPTIONS, check_python_calls, njit  # numba.njit; a bad cache entry is a miss",
     "from lagrange_gen.run.loader import register_module",
     "from lagrange_gen.errors import SingularMass",
     "from lagrange_gen.steppers.core.linalg import SINGULAR_RTOL, cholesky_inplace, cholesky_solve_inplace",
@@ -160,6 +160,7 @@ def render_module(dyn, texts, *, sources, options, source_rel, methods, glue, wh
     for text in texts:
         parts += ["", text.function, ""]
     parts += ["", forward_source(dyn)]
+    parts += ["", "", "check_python_calls(globals())  # a call from Python checks its arguments' shapes"]
     if glue:
         parts += ["", glue]
     text = "\n".join(parts).rstrip() + "\n"

@@ -12,6 +12,7 @@ from pathlib import Path
 from ..codegen.keys import check_current, read_key
 from ..errors import GenerationError, StaleModuleError
 from . import model_cache
+from ..jit.cache import GENERATED_MODULE_PREFIX
 
 
 def import_generated(path):
@@ -21,7 +22,7 @@ def import_generated(path):
     if not path.is_file():
         raise GenerationError(f"{path}: no generated module here (run lagrange-gen on its model)")
     # The name must be the same in every process: numba's cache refers to globals by module name.
-    name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
+    name = f"{GENERATED_MODULE_PREFIX}{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
     cached = sys.modules.get(name)
     # The file may have been regenerated since this process imported it: then import it again;
     # otherwise the module's own import-time check runs again (its model may have changed).

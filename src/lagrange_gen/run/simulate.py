@@ -26,7 +26,7 @@ import numpy as np
 from . import checks as run_checks
 from .adaptive_driver import C_ACCEPTED, C_EVALS, C_REJECTED, integrate_adaptive
 from ..codegen.keys import regeneration_command_for
-from .control import attach_inputs_outputs, controlled_run, resolve_inputs
+from .control import attach_inputs_outputs, blame_inputs, controlled_run, resolve_inputs
 from .energy_check import energy_warning
 from ..errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
@@ -183,6 +183,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         initial = np.zeros(n_saved)
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    run_checks.check_events_at_start(module, q, v, t0, p)
     if spec.adaptive:
         task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit)
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
@@ -191,14 +192,31 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         return attach_inputs_outputs(_adaptive_trajectory(task, out, wanted, wall, compile_time),
                                      module, p, hook, data)
     n_steps = n_steps_to(t0, t_end, h)
+    overshoot = run_checks.step_past_end(module.NAME, method, t0, t_end, h, n_steps)
+    if overshoot:
+        warnings.warn(overshoot, stacklevel=2)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
                  jit=jit)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
-    compile_time, wall = integrate_fixed(task, q, v, out, progress)
-    return attach_inputs_outputs(_trajectory(task, out, wall, compile_time), module, p, hook, data)
+    try:
+        compile_time, wall = integrate_fixed(task, q, v, out, progress)
+    except SimulationError as exc:
+        if hook is None:
+            raise
+        raise blame_inputs(exc, module, task.p, control) from None
+    traj = _trajectory(task, out, wall, compile_time)
+    if overshoot:
+        traj.warnings.insert(0, overshoot)
+    if spec.constraints:
+        violated = run_checks.constraint_violation(module.NAME, method, traj.t, traj.q,
+                                                   traj.saved.get("constraint_error"))
+        if violated:
+            traj.warnings.append(violated)
+            warnings.warn(violated, stacklevel=2)
+    return attach_inputs_outputs(traj, module, p, hook, data)
 
 
 def _with_data(run, data):
