@@ -5,4 +5,4 @@ arguments by it."""
 #: Output arguments that are 2-D arrays even when they have one column (every other output with
 #: one column is a 1-D array).
 ALWAYS_2D = frozenset({"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef", "Ju", "Cq",
-                       "Cqd", "Du", "WN", "WT"})
+                       "Cqd", "Du", "WN", "WT", "A"})
