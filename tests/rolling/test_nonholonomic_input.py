@@ -96,3 +96,11 @@ def test_inconsistent_v0_is_projected_with_a_warning(generated):
         traj = simulate(module, "nonholonomic_rk4", [0, 0, 0], [0, 1.0, 0], t_end=0.01, h=0.01)
     np.testing.assert_allclose(traj.v[0], [0.0, 1 - 1 / 2.25, 0.5 / (0.2 * 2.25)], rtol=1e-14)
     assert traj.saved["velocity_constraint_error"][0, 0] < 1e-15
+
+
+def test_linearize_refuses_nonholonomic_models_in_one_line(generated):
+    import lagrange_gen as lg
+    module = generated("chaplygin_sleigh")
+    for call in (lambda: lg.linearize(module, [0, 0, 0]), lambda: lg.equilibrium(module, [0, 0, 0])):
+        with pytest.raises(SimulationError, match="nonholonomic constraints is not implemented yet"):
+            call()
