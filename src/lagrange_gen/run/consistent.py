@@ -21,6 +21,9 @@ scleronomic; dPhi/dt from the generated ``constraint_rate``). Every function tak
 * multipliers lam0 from the acceleration-level KKT system at (q, v), the constraint forces of
   the initial state (row 0 of Trajectory.multipliers).
 
+For nonholonomic constraints A(q, t) v + b = 0 (no position constraint) ``nonholonomic_start``
+projects v0 by the same velocity formula with A, b in place of J, dPhi/dt.
+
 Redundant constraints (rank-deficient J at q0) are refused, not handled by a least-squares
 multiplier: their multipliers are not unique, and the methods' Newton matrices are singular.
 The error names the constraints that are dependent (a left null vector of J).
