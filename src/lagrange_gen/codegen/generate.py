@@ -93,9 +93,10 @@ def generation_options(build, methods, freeze):
 
 
 def model_counts(model):
-    """(number of constraints, of nonsmooth elements, of contacts): what decides the methods
-    that apply."""
-    return len(model.constraints), len(model.elements), len(getattr(model, "contacts", ()))
+    """(number of constraints, of nonsmooth elements, of contacts, of nonholonomic constraints):
+    what decides the methods that apply."""
+    return (len(model.constraints), len(model.elements), len(getattr(model, "contacts", ())),
+            len(getattr(model, "nonholonomic", ())))
 
 
 def resolve_methods(requested, model, drop_inapplicable=False):
@@ -105,15 +106,16 @@ def resolve_methods(requested, model, drop_inapplicable=False):
     method, and for one that does not apply (one line naming it and why) unless
     ``drop_inapplicable`` (load(): simulate then refuses it with its own message)."""
     from ..steppers.core.registry import METHODS, applicable_methods, inapplicable, runs_as
-    n_constraints, n_elements, n_contacts = model_counts(model)
+    counts = model_counts(model)
+    n_elements = counts[1]
     if requested is None:
-        return list(applicable_methods(n_constraints, n_elements, n_contacts))
+        return list(applicable_methods(*counts))
     unknown = [m for m in requested if m not in METHODS]
     if unknown:
         raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
     wanted = {runs_as(m, n_elements) for m in requested}
     for method in (m for m in METHODS if m in wanted):
-        why = inapplicable(method, n_constraints, n_elements, n_contacts)
+        why = inapplicable(method, *counts)
         if why and not drop_inapplicable:
             raise GenerationError(f"method {method} does not apply to model {model.name!r}: {why}")
         if why:
@@ -181,7 +183,7 @@ def _glue(methods, dyn):
 
 def _n_saved(method, dyn):
     from ..steppers.core.registry import spec
-    return spec(method).n_saved(dyn.n, dyn.m, dyn.n_elements, dyn.n_contacts)
+    return spec(method).n_saved(dyn.n, dyn.m, dyn.n_elements, dyn.n_contacts, dyn.n_nonholonomic)
 
 
 def module_sources(methods) -> dict:

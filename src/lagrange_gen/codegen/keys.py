@@ -202,7 +202,7 @@ def regeneration_command(model_path, out_dir="generated", build=None, methods=No
     model, the default): the one source of every "run lagrange-gen ..." hint."""
     from ..steppers.core.registry import METHODS, applicable_methods
     defaults = [set(applicable_methods(*counts))
-                for counts in ((0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1))]
+                for counts in ((0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))]
     args = ["lagrange-gen", str(model_path)]
     if os.path.normpath(str(out_dir)) != "generated":
         args += ["-o", str(out_dir)]

@@ -33,6 +33,9 @@ def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
         lines += [f"    {i}: {c.name}: gap = {sp.sstr(c.gap)}, slip = {sp.sstr(c.slip)}, "
                   f"restitution = {sp.sstr(c.restitution)}, friction = {sp.sstr(c.friction)}"
                   for i, c in enumerate(m.contacts)]
+    if dyn.n_nonholonomic:
+        lines.append("Nonholonomic constraints A(q, t) qd + b(q, t) = 0 (index in mu / rows of A):")
+        lines += [f"    {i}: {sp.sstr(c)} = 0" for i, c in enumerate(m.nonholonomic)]
     if m.events:
         lines.append("Events g(q, qd, t) (index in the out of events; direction, terminal):")
         lines += [f"    {i}: {e.name}: {sp.sstr(g)} ({_DIRECTIONS[e.direction]}"
@@ -110,6 +113,7 @@ def _model_constants(dyn, methods, texts):
         f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in elements)!r}  # 0 Saint-Venant, 1 dry friction",
         f"N_CONTACTS = {dyn.n_contacts}",
         f"CONTACTS = {tuple(c.name for c in getattr(dyn.model, 'contacts', ()))!r}",
+        f"N_NONHOLONOMIC = {dyn.n_nonholonomic}",
         f"N_EVENTS = {len(events)}",
         f"EVENT_NAMES = {tuple(e.name for e in events)!r}",
         f"EVENT_TERMINAL = np.array({[e.terminal for e in events]!r}, dtype=np.bool_)",

@@ -202,7 +202,8 @@ def controlled_run(module, method, apply):
         stepper = importlib.import_module(f"lagrange_gen.steppers.methods.{method}")
         spec = registry.spec(method)
         n_saved = spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                               getattr(module, "N_CONTACTS", 0))
+                               getattr(module, "N_CONTACTS", 0),
+                               getattr(module, "N_NONHOLONOMIC", 0))
         kern, n_events = module, module.N_EVENTS
         if spec.adaptive:
             raise SimulationError(f"inputs from a controller or a signal need a fixed-step method; "

@@ -140,7 +140,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     n_steps = n_steps_to(t0, t_end, h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     n, n_saved = module.N_COORDS, spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS,
-                                               module.N_ELEMENTS, getattr(module, "N_CONTACTS", 0))
+                                               module.N_ELEMENTS, getattr(module, "N_CONTACTS", 0),
+                                               getattr(module, "N_NONHOLONOMIC", 0))
     rows = run_checks.saved_rows(n_steps, save_every)
     # Before the member tables: for 1e9 members q0 alone is 16 GB.
     check_ensemble_memory(module.NAME, M, n_steps, save_every, n, n_saved, module.N_PARAMS)
@@ -270,7 +271,8 @@ def _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time
     status, steps = out["status"][:, 0].copy(), out["status"][:, 1].copy()
     last = out["last"]
     layout = spec.saved_layout(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                               getattr(module, "N_CONTACTS", 0))
+                               getattr(module, "N_CONTACTS", 0),
+                               getattr(module, "N_NONHOLONOMIC", 0))
     saved = {name: out["extra"][:, :, a:a + w] for name, a, w in layout}
     energy = out["stats"][:, :, STAT_ENERGY].copy()
     if "element_state" in saved:

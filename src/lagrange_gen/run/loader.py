@@ -142,6 +142,7 @@ def kernel_call_args(module):
     import numpy as np
     n, m, ne = module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS
     nc = getattr(module, "N_CONTACTS", 0)
+    nr = getattr(module, "N_NONHOLONOMIC", 0)
     q, w, lam, we = np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(ne)
     p = np.ones(module.N_PARAMS)
     A, B, v = np.empty((n, n)), np.empty((n, n)), np.empty(n)
@@ -158,6 +159,7 @@ def kernel_call_args(module):
         "elements_hessian": (q, we, p, A),
         "contacts": (q, 0.0, p, np.empty(nc), np.empty((nc, n)), np.empty((nc, n)),
                      np.empty((nc, 2))),
+        "nonholonomic": (q, q, 0.0, p, np.empty((nr, n)), np.empty(nr), np.empty(nr)),
         "forward_dynamics": (q, q, 0.0, p, A, v),
         "events": (q, q, 0.0, p, np.empty(getattr(module, "N_EVENTS", 0))),
         "inverse_dynamics": (q, q, q, 0.0, p, v), "gravity_forces": (q, 0.0, p, v),

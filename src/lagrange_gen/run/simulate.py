@@ -171,7 +171,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     run_checks.check_element_coefficients(module, p)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                           getattr(module, "N_CONTACTS", 0))
+                           getattr(module, "N_CONTACTS", 0), getattr(module, "N_NONHOLONOMIC", 0))
     initial = np.zeros(0)
     if keep and not spec.constraints:
         raise SimulationError(f"{module.NAME}: keep= ({', '.join(keep)}) chooses the velocities "
@@ -180,6 +180,10 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         q, v, initial = _constrained_start(module, q, v, p, t0,
                                            getattr(config, "newton_tol", 1e-12), keep)
     elif spec.contacts:          # (its prepare fills row 0; the contact work starts at 0)
+        initial = np.zeros(n_saved)
+    elif spec.nonholonomic:      # v0 onto A v + b = 0; prepare fills row 0
+        from .consistent import nonholonomic_start
+        v = nonholonomic_start(module, q, v, p, t0, stacklevel=3)
         initial = np.zeros(n_saved)
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
@@ -331,7 +335,8 @@ def _has_work(module, spec):
 def _build(task, rows, out, steps, h, wall, compile_time):
     """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
     m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
-    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS, getattr(m, "N_CONTACTS", 0))
+    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS, getattr(m, "N_CONTACTS", 0),
+                               getattr(m, "N_NONHOLONOMIC", 0))
     saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
     energy = rows["stats"][:, STAT_ENERGY].copy()
     if "element_state" in saved:

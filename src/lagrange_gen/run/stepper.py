@@ -139,8 +139,9 @@ class Stepper:
                                   f"{', '.join(registry.METHODS)}")
         module = load_module(module, method=method)
         spec = registry.spec(method)
-        if (spec.adaptive or spec.constraints or spec.contacts or getattr(module, "N_ELEMENTS", 0)
-                or module.N_CONSTRAINTS or getattr(module, "N_CONTACTS", 0)):
+        if (spec.adaptive or spec.constraints or spec.contacts or spec.nonholonomic
+                or getattr(module, "N_ELEMENTS", 0) or module.N_CONSTRAINTS
+                or getattr(module, "N_CONTACTS", 0) or getattr(module, "N_NONHOLONOMIC", 0)):
             raise SimulationError(f"Stepper: {method} on {module.NAME}: the step API takes a "
                                   "fixed-step method on a model without constraints, elements "
                                   "or contacts")
