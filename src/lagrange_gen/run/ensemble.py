@@ -134,6 +134,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     p = member_params(module, params, M)
     for i in range(M) if getattr(module, "N_ELEMENTS", 0) else ():
         run_checks.check_element_coefficients(module, p[i])
+    for i in range(M) if getattr(module, "N_CONTACTS", 0) else ():
+        run_checks.check_contact_coefficients(module, p[i], q[i])
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_steps = n_steps_to(t0, t_end, h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
