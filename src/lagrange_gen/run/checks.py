@@ -4,6 +4,8 @@
 * Element coefficients at the parameters of this run (``check_element_coefficients``): the model
   file checks them at its defaults only, and ``--param eta=-1`` or ``--freeze eta=0`` would
   otherwise run the return map with a non-positive threshold or stiffness into garbage.
+  Likewise contact coefficients (``check_contact_coefficients``): restitution in [0, 1], friction
+  >= 0 at this run's parameters (``params={"e": 1.5}`` would otherwise gain energy at each impact).
 * The step count (``check_step_count``): at most MAX_STEPS steps.
 * The resolution of the time grid (``check_time_resolution``): the stepper evaluates forces at
   t0 + k h, and the driver saves those times; they must resolve h (TIME_RESOLUTION).
@@ -161,7 +163,8 @@ def check_element_coefficients(module, p):
                 continue
             raise SimulationError(
                 f"{module.NAME}: element {module.ELEMENTS[e]!r}: {label} = {value:g} must be a "
-                f"finite number > 0; {_coefficient_source(module, p, coef, e, col)}")
+                f"finite number > 0; "
+                f"{_coefficient_source(module, p, element_coefficients, coef, e, col)}")
 
 
 def element_coefficients(module, p):
@@ -173,13 +176,45 @@ def element_coefficients(module, p):
     return coef
 
 
-def _coefficient_source(module, p, coef, e, col):
-    """'it depends on eta = -1 (...)': the parameters whose change moves coef[e, col]."""
+def check_contact_coefficients(module, p, q=None):
+    """Refuse a restitution outside [0, 1] or a negative (or non-finite) friction of a unilateral
+    contact at the parameter vector p (n_params,), naming the contact and the parameters the
+    coefficient depends on. (The model file checks them at the defaults only.) q (n,): where
+    the kernel is evaluated (default zeros; the initial state keeps the gaps' Jacobians defined)."""
+    if not getattr(module, "N_CONTACTS", 0):
+        return
+    where = np.zeros(module.N_COORDS) if q is None else q
+    coef = contact_coefficients(module, p, where)
+    for c in range(module.N_CONTACTS):
+        for col, label, rule, ok in ((0, "restitution", "must be in [0, 1]", lambda x: 0 <= x <= 1),
+                                     (1, "friction", "must be >= 0", lambda x: x >= 0)):
+            value = coef[c, col]
+            if math.isfinite(value) and ok(value):
+                continue
+            source = _coefficient_source(module, p, lambda m, p: contact_coefficients(m, p, where),
+                                         coef, c, col)
+            raise SimulationError(f"{module.NAME}: contact {module.CONTACTS[c]!r}: {label} = "
+                                  f"{value:g} {rule}; {source}")
+
+
+def contact_coefficients(module, p, q):
+    """coef (c, 2) = (restitution, friction) of the generated ``contacts`` kernel at q (n,);
+    they depend on parameters only (model/contacts.py checks that)."""
+    nc, n = module.N_CONTACTS, module.N_COORDS
+    gap, WN, WT, coef = np.empty(nc), np.empty((nc, n)), np.empty((nc, n)), np.empty((nc, 2))
+    module.contacts(np.ascontiguousarray(q, dtype=np.float64), 0.0, np.ascontiguousarray(p, dtype=np.float64), gap, WN, WT,
+                    coef)
+    return coef
+
+
+def _coefficient_source(module, p, coefficients, coef, e, col):
+    """'it depends on eta = -1 (...)': the parameters whose change moves coef[e, col];
+    coefficients(module, p) gives coef."""
     used = []
     for j, name in enumerate(module.PARAMS):
         trial = np.array(p, dtype=np.float64)
         trial[j] += 0.5 * max(1.0, abs(trial[j]))
-        moved = element_coefficients(module, trial)[e, col]
+        moved = coefficients(module, trial)[e, col]
         if not (moved == coef[e, col] or (math.isnan(moved) and math.isnan(coef[e, col]))):
             used.append(f"{name} = {p[j]:g}")
     frozen = getattr(module, "FROZEN", None) or {}

@@ -149,6 +149,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     p = member_params(module, params, M)
     for i in range(M) if getattr(module, "N_ELEMENTS", 0) else ():
         run_checks.check_element_coefficients(module, p[i])
+    for i in range(M) if getattr(module, "N_CONTACTS", 0) else ():
+        run_checks.check_contact_coefficients(module, p[i], q[i])
     out = allocate_outputs(M, rows, n, n_saved)
     if spec.constraints:
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])

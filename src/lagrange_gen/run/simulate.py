@@ -169,6 +169,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         run = _with_data(controlled_run(module, method, hook), data)
         jit = "specialized"       # the control glue is compiled per model and controller
     run_checks.check_element_coefficients(module, p)
+    run_checks.check_contact_coefficients(module, p, q)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
                            getattr(module, "N_CONTACTS", 0), getattr(module, "N_NONHOLONOMIC", 0))
