@@ -94,3 +94,25 @@ def test_the_key_covers_the_imports_of_the_module():
     assert {"steppers/core/constrained.py", "steppers/core/linalg.py",
             "steppers/core/legendre.py"} <= set(json.loads(stamp))
     assert jit.closure_stamp(PACKAGE / "steppers" / "core" / "linalg.py") != stamp
+
+
+def test_a_moved_project_says_so_not_unreadable(tmp_path):
+    """Generated modules are imported under a name made from their path; after the project
+    folder moved, numba's entries name the old module. The warning said the cache was
+    "unreadable (ModuleNotFoundError ...)" (issue 34, item 8)."""
+    models = Path(__file__).resolve().parent.parent / "models"
+    run = ("import sys, numpy as np; from lagrange_gen.run.loader import import_generated;"
+           "m = import_generated(sys.argv[1]);"
+           "print(m.energy(np.ones(1), np.zeros(1), 0.0, m.DEFAULT_PARAMS.copy()))")
+    make = ("import sys; from lagrange_gen.codegen import generate_model;"
+            "generate_model(sys.argv[1], sys.argv[2], methods=['rk4'])")
+    subprocess.run([sys.executable, "-c", make, str(models / "damped_oscillator.py"),
+                    str(tmp_path / "old")], check=True, timeout=300)
+    subprocess.run([sys.executable, "-c", run, str(tmp_path / "old" / "damped_oscillator.py")],
+                   check=True, timeout=300, capture_output=True)
+    (tmp_path / "old").rename(tmp_path / "new")
+    out = subprocess.run([sys.executable, "-c", run, str(tmp_path / "new" / "damped_oscillator.py")],
+                         check=True, timeout=300, capture_output=True, text=True)
+    assert out.stdout.strip() == "0.5"
+    assert "unreadable" not in out.stderr and "moved" in out.stderr, out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1, out.stderr

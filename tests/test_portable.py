@@ -25,15 +25,17 @@ EVENT_MODELS = Path(__file__).resolve().parent / "events" / "models"
 
 # (method, model, q0, h, t_end): every method once, on a model that exercises the run-time
 # branches it has: driven_pendulum (explicit time, T1 = b . qd, the work W), slider_crank
-# (rheonomic constraints), prandtl (nonsmooth elements), bouncing_ball (contacts), the events
-# models of tests/events.
+# (rheonomic constraints), prandtl (nonsmooth elements), bouncing_ball (contacts),
+# chaplygin_sleigh (nonholonomic constraints), the events models of tests/events.
 CASES = [(m, "driven_pendulum", [2.9], 1e-3, 0.2) for m in registry.METHODS
          if not (registry.spec(m).constraints or registry.spec(m).elements
-                 or registry.spec(m).contacts)]
+                 or registry.spec(m).contacts or registry.spec(m).nonholonomic)]
 CASES += [(m, "slider_crank", ([0.0, 1.3, 0.1], [1.8, 0.0, 0.0]), 1e-3, 0.1)
           for m in registry.CONSTRAINED_METHODS]
 CASES += [("nonsmooth_euler", "prandtl", [0.0], 1e-3, 2.0)]
 CASES += [("moreau_jean", "bouncing_ball", [1.0], 1e-3, 1.5)]
+CASES += [(m, "chaplygin_sleigh", ([0.0, 0.0, 0.0], [0.3, 1.0, 2.0]), 1e-3, 1.0)
+          for m in registry.NONHOLONOMIC_METHODS]
 EVENT_CASES = [("verlet", "cart_pendulum_events", [0.3, 1.0], 1e-3, 3.0),
                ("dop853", "cart_pendulum_events", [0.3, 1.0], None, 3.0),
                ("rattle", "cartesian_pendulum_events", [np.sin(1.0), -np.cos(1.0)], 1e-3, 3.0)]

@@ -21,10 +21,10 @@ from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.generate import check_generated
 from lagrange_gen.errors import SimulationError, StaleModuleError
 from lagrange_gen.run.loader import import_generated
-from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, METHODS
+from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, METHODS, applicable_methods
 
 # nonsmooth_euler is implicit Euler on a model without elements: simulate accepts it there.
-UNCONSTRAINED = [m for m in METHODS if m not in CONSTRAINED_METHODS]
+UNCONSTRAINED = list(applicable_methods(0, 0))
 
 # A fresh process loads the module from the model file (load() decides it is current), runs
 # explicit_euler a few steps with the module's own (specialized) glue and prints numba's cache

@@ -45,6 +45,10 @@ def test_method_needs_are_read_from_the_stepper_sources():
     assert {"momentum_rate_jacobian", "mass_matvec_dq"} <= method_needs("midpoint")
     assert "rhs_jacobian" not in method_needs("midpoint")
     kernels = set(kernel_table(derive(load_model(MODELS_DIR / "double_pendulum.py"))))
+    # the contacts kernel only a model with unilateral contacts has, the nonholonomic kernel
+    # only a model with velocity constraints
+    kernels |= set(kernel_table(derive(load_model(MODELS_DIR / "bouncing_ball.py"))))
+    kernels |= set(kernel_table(derive(load_model(MODELS_DIR / "chaplygin_sleigh.py"))))
     for method in METHODS:
         functions = {n for n in method_needs(method) if not n.isupper()}
         assert functions <= kernels | set(MODULE_FUNCTIONS), method

@@ -120,3 +120,31 @@ def test_singular_newton_matrix_is_diagnosed_by_constraint():
     assert "linearly dependent" in text and "constraint 0 (" in text and "constraint 1 (" in text
     assert diagnose_singular(generated_model("cartesian_pendulum"), np.array([0.0, -1.0]),
                              np.array([1.0, 1.0, 9.81])) == ""
+
+
+SHRINKING = '''from lagrange_gen import Model, coordinates, parameters, t
+x, y = coordinates("x y")
+m, g = parameters("m g", defaults=(1.0, 9.81))
+model = Model("shrink", coords=[x, y], T=m * (x.d**2 + y.d**2) / 2, V=m * g * y,
+              constraints=[x**2 + y**2 - (1 - t)])
+'''
+
+
+def test_infeasible_rheonomic_constraint_warns(tmp_path):
+    """x^2 + y^2 = 1 - t has no solution past t = 1: spook ended with max|Phi| = 6.3 and no word
+    (issue 34, item 8)."""
+    path = tmp_path / "shrink.py"
+    path.write_text(SHRINKING)
+    with pytest.warns(UserWarning, match=r"max\|Phi\| = \d.*may have no solution"):
+        traj = simulate(path, "spook", [1.0, 0.0], [-0.5, 0.0], t_end=2.0, h=0.01,
+                        out_dir=tmp_path / "gen")
+    assert any("max|Phi|" in w for w in traj.warnings)
+
+
+def test_a_good_constrained_run_does_not_warn(tmp_path):
+    import warnings
+    path = tmp_path / "shrink.py"
+    path.write_text(SHRINKING)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        simulate(path, "spook", [1.0, 0.0], [-0.5, 0.0], t_end=0.5, h=0.01, out_dir=tmp_path / "gen")

@@ -132,3 +132,29 @@ def test_other_methods_refuse_a_model_with_contacts(generated, method):
 def test_moreau_jean_refuses_a_model_without_contacts(generated):
     with pytest.raises(SimulationError, match=r"moreau_jean.*unilateral contacts and this model has none"):
         simulate(generated("damped_oscillator"), method="moreau_jean", q0=[1.0], t_end=0.1, h=1e-3)
+
+
+@pytest.mark.parametrize("model, params, message", [
+    ("bouncing_ball", {"e": 1.5},
+     r"bouncing_ball: contact 'floor': restitution = 1.5 must be in \[0, 1\]; it depends on "
+     r"e = 1.5"),
+    ("bouncing_ball", {"e": -0.2}, r"restitution = -0.2 must be in \[0, 1\]"),
+    ("block_on_ramp", {"mu": -0.1},
+     r"block_on_ramp: contact 'ramp': friction = -0.1 must be >= 0; it depends on mu = -0.1"),
+])
+def test_coefficients_given_by_parameters_are_checked_at_run_time(generated, model, params,
+                                                                  message):
+    """The model file checks the coefficients at the parameters' defaults; params= can override
+    them, so simulate checks them again before it runs: one line naming contact and parameter."""
+    module = generated(model)
+    n = module.N_COORDS
+    with pytest.raises(SimulationError, match=message) as info:
+        simulate(module, method="moreau_jean", q0=[0.5] * n, t_end=0.01, h=1e-3, params=params)
+    assert "\n" not in str(info.value)
+
+
+def test_ensemble_checks_each_members_coefficients(generated):
+    from lagrange_gen.run.ensemble import ensemble
+    with pytest.raises(SimulationError, match=r"restitution = 1.5 must be in \[0, 1\]"):
+        ensemble(generated("bouncing_ball"), method="moreau_jean", q0=[[1.0], [1.0]],
+                 t_end=0.01, h=1e-3, params={"e": [0.5, 1.5]})

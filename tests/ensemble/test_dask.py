@@ -53,3 +53,14 @@ def test_worker_without_the_path_imports_the_shipped_source(cart, tmp_path):
 def test_chunks_are_long_enough_but_feed_every_thread():
     assert chunk_size(10_000, 10_000, 2) == 167         # 0.5 s of 3e-7 s steps
     assert chunk_size(40, 200, 2) == 10                 # two tasks per thread
+
+
+def test_a_closed_client_is_one_line(cart):
+    """It gave AttributeError: 'NoneType' object has no attribute 'ncores' (issue 34, item 8)."""
+    client = distributed.Client(processes=False, n_workers=1, threads_per_worker=1,
+                                dashboard_address=None)
+    client.close()
+    with pytest.raises(lg.SimulationError) as err:
+        lg.ensemble(cart, "explicit_euler", q0=np.zeros((4, 2)), t_end=0.1, h=0.01, client=client)
+    text = str(err.value)
+    assert "\n" not in text and "client" in text and "closed" in text, text

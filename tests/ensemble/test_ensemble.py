@@ -142,9 +142,9 @@ def test_adaptive_method_refused(cart):
 def test_memory_refusal_says_what_it_needs(cart, monkeypatch):
     monkeypatch.setattr(run_checks, "available_memory", lambda: 10**6)
     # 1000 members x 1001 rows x (2 n + 4 stats (energy, iterations, residual, work) + 3 copies)
-    # x 8 bytes = 88 MB
+    # x 8 bytes = 88 MB, and 1000 members x (2 n + 5 parameters) x 8 bytes of inputs
     with pytest.raises(SimulationError, match=r"1000 members saving 1001 states each needs "
-                       r"0\.0881 GB of memory and 0\.001 GB is available; use save_every >= "
+                       r"0\.0882 GB of memory and 0\.001 GB is available; use save_every >= "
                        r"177") as raised:
         lg.ensemble(cart, "rk4", q0=np.zeros((1000, 2)), t_end=10.0, h=0.01)
     assert "\n" not in str(raised.value)

@@ -43,6 +43,10 @@ def _error(tmp_path, events):
     ("{'ground': sp.Function('f')(y)}", "model bad: event ground contains an undefined function"),
     ("{'hit ground': y}", "event name 'hit ground' is not a valid Python identifier"),
     ("[y]", "model bad: events must be a dict {name: expression or Event"),
+    # issue 34, item 8: accepted, never fired
+    ("{'ground': y - y}", "model bad: event ground is the constant 0: it never crosses zero"),
+    ("{'ground': sp.nan}", "model bad: event ground is the constant nan: it never crosses zero"),
+    ("{'ground': Event(sp.Integer(3))}", "model bad: event ground is the constant 3"),
 ])
 def test_bad_events_are_one_model_error_line_naming_file_and_event(tmp_path, events, says):
     assert says in _error(tmp_path, events)
@@ -136,3 +140,15 @@ def test_the_cubic_interpolant_is_not_exact_on_a_quintic():
     q, v = np.empty(1), np.empty(1)
     hermite.interpolate(ws, 0.5, q, v)
     assert abs(q[0] - 0.5**5) > 1e-3
+
+
+def test_an_event_that_is_nan_at_the_initial_state_is_refused(tmp_path):
+    """sqrt(y) at y0 < 0 is NaN: no crossing is ever seen (issue 34, item 8)."""
+    import lagrange_gen as lg
+    path = tmp_path / "nan_event.py"
+    path.write_text(HEADER + "model = Model('nan_event', [y], T=y.d**2 / 2, V=g * y, "
+                             "events={'root': sp.sqrt(y) - 1})\n")
+    with pytest.raises(lg.SimulationError) as err:
+        lg.simulate(path, "rk4", q0=[-1.0], t_end=0.1, h=0.01, out_dir=tmp_path / "gen")
+    text = str(err.value)
+    assert "\n" not in text and "event root" in text and "nan" in text, text

@@ -31,7 +31,7 @@ STATS: Counter = Counter()
 
 _QQTP = ("q", "qd", "t", "p")
 #: kernel -> (inputs, outputs as (argument, shape), reference quantities), as documented in
-#: README / codegen.spec; shapes: n coordinates, m constraints, e elements.
+#: README / codegen.spec; shapes: n coordinates, m constraints, e elements, c contacts.
 CONTRACT = {
     "mass_matrix": (("q", "t", "p"), (("H", "nn"),), ("H",)),
     "dynamics": (_QQTP, (("H", "nn"), ("rhs", "n")), ("H", "rhs")),
@@ -50,6 +50,9 @@ CONTRACT = {
     "elements": (("q", "p"), (("s", "e"), ("G", "en"), ("coef", "e3")), ("s", "G", "coef")),
     "elements_hessian": (("q", "we", "p"), (("out_mat", "nn"),), ("hess_w",)),
     "events": (_QQTP, (("out", "g"),), ("events",)),
+    # only a model with unilateral contacts has it
+    "contacts": (("q", "t", "p"), (("gap", "c"), ("WN", "cn"), ("WT", "cn"), ("coef", "c2")),
+                 ("contact_gap", "contact_WN", "contact_WT", "contact_coef")),
     # the kernels of a module generated from bodies (README, Robots); qdd is the State's w
     "inverse_dynamics": (("q", "qd", "qdd", "t", "p"), (("tau", "n"),), ("tau_id",)),
     "gravity_forces": (("q", "t", "p"), (("out", "n"),), ("gravity",)),
@@ -57,6 +60,8 @@ CONTRACT = {
 }
 #: the kernels only a module generated from bodies has (tests/harness/test_spatial_trees.py)
 BODY_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
+#: the kernels only a module of a model with unilateral contacts has
+CONTACT_KERNELS = ("contacts",)
 
 
 @dataclass
@@ -134,13 +139,15 @@ def compare(label, got, expected, rtol=RTOL, floor=FLOOR):
 ACCUMULATING = {"transport", "transport_dq"}
 
 
-def _shape(key, n, m, ne, ng=0):
+def _shape(key, n, m, ne, ng=0, nc=0):
     return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n),
-            "e3": (ne, 3), "g": (ng,), "P": (2 * n + 2,)}[key]
+            "e3": (ne, 3), "g": (ng,), "P": (2 * n + 2,), "c": (nc,), "cn": (nc, n),
+            "c2": (nc, 2)}[key]
 
 
 def call_kernel(kern, name, state, sizes):
-    """Run kernel ``name`` of ``kern`` at a state on NaN-filled outputs: {reference name: value}."""
+    """Run kernel ``name`` of ``kern`` at a state on NaN-filled outputs: {reference name: value}.
+    sizes: (n, m, ne[, ng[, nc]]) coordinates, constraints, elements, events, contacts."""
     inputs, outputs, quantities = CONTRACT[name]
     # The accumulating kernels (out += ...) start from zeros, the others from NaN (unwritten
     # entries show).
@@ -176,7 +183,8 @@ def _check_kernel(mod, kern, name, ref, state, mode):
     actual = list(inspect.signature(getattr(mod, name).py_func).parameters)
     if actual != documented:
         return [f"{name}: arguments {actual}, documented {documented}"]
-    values = call_kernel(kern, name, state, (ref.n, ref.m, ref.ne, len(ref.drawn.events)))
+    values = call_kernel(kern, name, state,
+                         (ref.n, ref.m, ref.ne, len(ref.drawn.events), getattr(ref, "nc", 0)))
     # counted for coverage only where it computes something: constraint and element kernels
     # of a model without constraints or elements fill empty or zero arrays
     if all(np.size(v) for v in values.values()) and (ref.m or "lam" not in inputs) and (ref.ne or "we" not in inputs):
@@ -237,7 +245,7 @@ def check_model(drawn, methods, out_dir, modes, seed, n_states):
         for state in states(drawn, mod, np.random.default_rng(seed), n_states):
             failures += [f"{mode}: {f}" for f in check_kernels(mod, kern, ref, state, mode)]
             try:
-                fd = check_derivatives(mod, kern, state, (ref.n, ref.m, ref.ne), mode)
+                fd = check_derivatives(mod, kern, state, (ref.n, ref.m, ref.ne, 0, ref.nc), mode)
             except Exception as exc:      # noqa: BLE001  a kernel raising near the state
                 fd = [f"finite differences: raised {type(exc).__name__}: {exc}"]
             failures += [f"{mode}: {f}" for f in fd]

@@ -38,7 +38,7 @@ def check_derivatives(mod, kern, state, sizes, mode):
     """Every Jacobian kernel of the module at one state against central differences of the
     kernel it differentiates: a list of mismatches."""
     names = set(mod.KERNELS)
-    n, m, ne = sizes
+    n, m, ne = sizes[:3]
     value = lambda name, quantity, st: call_kernel(kern, name, st, sizes)[quantity]   # noqa: E731
     at_q = lambda q: _with(state, q=q)                                                 # noqa: E731
     out = []
@@ -61,6 +61,10 @@ def check_derivatives(mod, kern, state, sizes, mode):
         if "elements_hessian" in names:
             fd = derivative(lambda q: value("elements", "G", at_q(q)).T @ state.we, state.q)
             out.append(_compare("elements_hessian", "out_mat", value("elements_hessian", "hess_w", state), fd, mode))
+    if "contacts" in names:
+        WN = value("contacts", "contact_WN", state)
+        fd = derivative(lambda q: value("contacts", "contact_gap", at_q(q)), state.q)
+        out.append(_compare("contacts", "WN", WN, fd, mode))
     return [f for f in out if f]
 
 

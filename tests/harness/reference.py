@@ -8,7 +8,9 @@ lagrange_gen.derive or codegen, so a derivation or printing error cannot hide in
     momentum_rate = dT/dq - dV/dq + Q - dD/dqd  (dp/dt for p = dT/dqd)
 
 Shapes for n coordinates, m constraints, ne elements: H (n, n), vectors (n,), Jacobians (n, n),
-Phi (m,), J (m, n), gamma (m,), dJw_dq (m, n), s (ne,), G (ne, n), coef (ne, 3).
+Phi (m,), J (m, n), gamma (m,), dJw_dq (m, n), s (ne,), G (ne, n), coef (ne, 3); for c contacts
+contact_gap (c,), contact_WN = d gap/dq (c, n), contact_WT = d slip/d qd (c, n), contact_coef
+(c, 2) = (restitution, friction).
 """
 
 from __future__ import annotations
@@ -21,10 +23,20 @@ from lagrange_gen import t
 # lambdify's numpy printer knows Abs, sign, atan2, ...; DiracDelta (from d sign/dx) is zero away
 # from the kink, where every sampled state lies.
 _MODULES = [{"DiracDelta": lambda *args: 0.0}, "numpy"]
+#: sympy leaves d floor(x)/dx unevaluated: zero away from the integers, where sampled states lie.
+_PIECEWISE_CONSTANT = (sp.floor, sp.ceiling)
+
+
+def _jumps_settled(expr):
+    """``expr`` (a sympy expression or matrix) with the derivatives of floor and ceiling at 0."""
+    return expr.replace(lambda e: isinstance(e, sp.Derivative) and isinstance(e.expr, _PIECEWISE_CONSTANT),
+                        lambda e: sp.S.Zero)
+
+
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
 VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
-           "power", "b", "tau_id", "gravity", "bias"}
+           "power", "b", "tau_id", "gravity", "bias", "contact_gap"}
 
 
 def _vector(exprs):
@@ -42,7 +54,7 @@ class Reference:
         self.q = sp.Matrix(drawn.coords)
         self.qd = sp.Matrix([c.d for c in drawn.coords])
         n, m, ne = len(drawn.coords), len(drawn.constraints), len(drawn.elements)
-        self.n, self.m, self.ne = n, m, ne
+        self.n, self.m, self.ne, self.nc = n, m, ne, len(drawn.contacts)
         self.params = list(drawn.params)
         self.w = sp.Matrix(sp.symbols(f"ref_w0:{n}", real=True))
         self.lam = _vector(sp.symbols(f"ref_lam0:{m}", real=True)) if m else sp.zeros(0, 1)
@@ -170,11 +182,27 @@ class Reference:
             out += self.we[e] * sp.hessian(self.expr("s")[e], self.q)
         return out
 
+    def _contact_gap(self):
+        return _vector([gap for gap, _, _, _ in self.drawn.contacts])
+
+    def _contact_WN(self):
+        return self.expr("contact_gap").jacobian(self.q)
+
+    def _contact_WT(self):
+        """Rows d slip/d qd; zero for a frictionless contact without a slip velocity."""
+        slips = _vector([slip if slip is not None else 0 for _, _, _, slip in self.drawn.contacts])
+        return slips.jacobian(self.qd)
+
+    def _contact_coef(self):
+        rows = [[restitution, friction] for _, restitution, friction, _ in self.drawn.contacts]
+        return sp.Matrix(rows) if rows else sp.zeros(0, 2)
+
     # -- numbers --------------------------------------------------------------------------------
     def value(self, name, state):
         """The quantity at a state: float, or array (column vectors flattened)."""
         if name not in self._functions:
-            self._functions[name] = sp.lambdify(self.args, self.expr(name), modules=_MODULES)
+            self._functions[name] = sp.lambdify(self.args, _jumps_settled(self.expr(name)),
+                                                modules=_MODULES)
         expr = self.expr(name)
         p = [state.params[s.name] for s in self.params]
         values = [*state.q, *state.qd, state.t, *p, *state.w, *state.lam, *state.we]

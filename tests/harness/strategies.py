@@ -1,13 +1,15 @@
 """Hypothesis strategies drawing Lagrangian models over the grammar users write.
 
 A drawn model (DrawnModel) is a set of plain sympy ingredients, T, V, generalized or point forces
-Q(q, qd, t), a Rayleigh function, holonomic constraints and nonsmooth element strains, plus the
-box its states are sampled from (sample_state). Everything is well defined on that box by
+Q(q, qd, t), a Rayleigh function, holonomic constraints, nonsmooth element strains and
+unilateral contacts, plus the box its states are sampled from (sample_state). Everything is well defined on that box by
 construction:
 
 * angle coordinates u_i (sampled in [-2, 2]) enter only through functions defined on the whole
   real line: sin, cos, tanh, atan, exp, 2**x, Abs, x/(k + x**2), log(k + x**2), sqrt(k + x**2),
-  (k + x**2)**(-3/2), atan2(x, k + y**2), ...
+  (k + x**2)**(-3/2), atan2(x, k + y**2), and with kinks and jumps Max, Min, Piecewise,
+  Heaviside, floor (their derivatives: Heaviside, DiracDelta, d floor/dx; states land on a
+  kink with probability zero), ...
 * radial coordinates r_i (sampled in [0.5, 2.5]) may also be divided by, raised to negative and
   fractional powers (r**-4, r**(-1/2), r**2.5) and fed to log and sqrt;
 * parameters k_i have defaults in [0.5, 2] and enter as k, 1/k, k**2, 1/k**2, sqrt(k), k**-1.5.
@@ -27,7 +29,7 @@ import numpy as np
 import sympy as sp
 from hypothesis import strategies as st
 
-from lagrange_gen import DryFriction, Model, PointForce, SaintVenant, coordinates, parameters, t
+from lagrange_gen import Contact, DryFriction, Model, PointForce, SaintVenant, coordinates, parameters, t
 
 RADIAL_BOX, ANGLE_BOX, SPEED_BOX, TIME_BOX = (0.5, 2.5), (-2.0, 2.0), (-1.5, 1.5), (0.0, 3.0)
 N_PARAMS = 5
@@ -41,6 +43,10 @@ TOTAL = [
     lambda x, k: (k + x**2)**sp.Rational(-3, 2), lambda x, k: sp.log(k + x**2),
     lambda x, k: sp.exp(x / 2), lambda x, k: sp.exp(-x**2 / k), lambda x, k: 2**x,
     lambda x, k: sp.Abs(x), lambda x, k: x * sp.Abs(x), lambda x, k: sp.sin(x) / k**2,
+    # kinks and jumps: their derivatives are Heaviside, DiracDelta, Piecewise, d floor/dx
+    lambda x, k: sp.Max(x, 0)**2, lambda x, k: sp.Min(x, k) * x,
+    lambda x, k: sp.Piecewise((x**2, x > 0), (-k * x, True)), lambda x, k: sp.Heaviside(x - k / 2) * x,
+    lambda x, k: sp.floor(x) + x / k,
 ]
 # f(r, k) real for every real r != 0 (allowed in T).
 NONZERO = [lambda r, k: 1 / r, lambda r, k: r**-2, lambda r, k: k / r**3, lambda r, k: 1 / r**4,
@@ -63,7 +69,7 @@ COEFFS = [sp.Integer(1), sp.Integer(-1), sp.Integer(2), sp.Rational(1, 2), sp.Ra
 SPEED = [lambda v, k: v, lambda v, k: -v * sp.Abs(v), lambda v, k: v / (k + v**2), lambda v, k: v**2,
          lambda v, k: sp.Integer(1)]
 TIME = [lambda k: sp.Integer(1), lambda k: sp.sin(k * t), lambda k: sp.cos(t), lambda k: sp.exp(-t / k),
-        lambda k: t, lambda k: 1 / (k + t**2)]
+        lambda k: t, lambda k: 1 / (k + t**2), lambda k: 1 + sp.Heaviside(t - k) / 2]
 
 
 @dataclass
@@ -72,7 +78,8 @@ class DrawnModel:
 
     radial[i]: coordinate i is sampled in RADIAL_BOX (else ANGLE_BOX); params: the declared
     Parameters (each carries its default); forces: n expressions or None; point_forces: [(point, force)] tuples;
-    elements: [(kind, strain, coefficient, threshold or None, yield force or None)].
+    elements: [(kind, strain, coefficient, threshold or None, yield force or None)];
+    contacts: [(gap, restitution, friction, slip or None)].
     """
 
     name: str
@@ -87,6 +94,7 @@ class DrawnModel:
     constraints: list = field(default_factory=list)
     elements: list = field(default_factory=list)
     events: list = field(default_factory=list)
+    contacts: list = field(default_factory=list)
 
     @property
     def defaults(self):
@@ -104,7 +112,9 @@ class DrawnModel:
                 elements.append(DryFriction(rate_of=strain, bound=coef))
         return Model(self.name, coords=self.coords, T=self.T, V=self.V, forces=forces,
                      dissipation=self.dissipation, constraints=self.constraints, elements=elements,
-                     events={f"g{i}": g for i, g in enumerate(self.events)})
+                     events={f"g{i}": g for i, g in enumerate(self.events)},
+                     contacts=[Contact(gap, restitution, friction, slip)
+                               for gap, restitution, friction, slip in self.contacts])
 
 
 def sample_state(drawn, rng):
@@ -241,10 +251,31 @@ def _elements(g):
     return out
 
 
+def _contacts(g):
+    """One or two unilateral contacts: a gap g(q) from the grammar minus a constant, restitution
+    k / (k + k') in (0, 1) or a number in [0, 1], and either no friction or friction k with a
+    slip velocity sum_i f_i(q) qd_i (f_i from the grammar, some zero)."""
+    out = []
+    speeds = [c.d for c in g.coords]
+    for _ in range(g.draw(st.integers(1, 2))):
+        gap = g.term() - g.pick(COEFFS)
+        if g.draw(st.booleans()):
+            restitution = g.pick(g.params) / (g.pick(g.params) + g.pick(g.params))
+        else:
+            restitution = g.pick([sp.Integer(0), sp.Rational(1, 2), sp.Integer(1)])
+        friction, slip = sp.S.Zero, None
+        if g.draw(st.booleans()):
+            friction = g.param()
+            slip = sp.Add(*[g.factor() * v for v in speeds if g.draw(st.booleans())])
+            slip = slip if slip != 0 else g.pick(COEFFS) * speeds[0]
+        out.append((gap, restitution, friction, slip))
+    return out
+
+
 @st.composite
-def models(draw, constant_mass=False, constrained=False, elements=False):
+def models(draw, constant_mass=False, constrained=False, elements=False, contacts=False):
     """A DrawnModel of 1-3 coordinates (2-3 when constrained): T, V (possibly time-dependent),
-    forces, Rayleigh dissipation, and constraints / elements when asked."""
+    forces, Rayleigh dissipation, and constraints / elements / contacts when asked."""
     tag, coords, radial, params, g = _setup(draw, 2 if constrained else 1, 3)
     V = g.sum(1, 3)
     if draw(st.integers(0, 3)) == 0:
@@ -258,7 +289,7 @@ def models(draw, constant_mass=False, constrained=False, elements=False):
         name=f"harness_{tag}", coords=coords, radial=radial, params=params,
         T=_kinetic(g, constant_mass), V=V, forces=forces, point_forces=point_forces,
         dissipation=_rayleigh(g), constraints=constraints, elements=_elements(g) if elements else [],
-        events=events)
+        events=events, contacts=_contacts(g) if contacts else [])
 
 
 def kepler():

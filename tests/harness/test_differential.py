@@ -7,7 +7,8 @@ the symbolic kernels, constrained ones generated for rattle (whose callers of th
 use the momentum rate, as verlet's and midpoint's do) get the composed dynamics and
 momentum_rate_jacobian,
 constant-H models the rhs kernel and the pre-factored forward dynamics,
-constrained models the constraint kernels, models with elements the element kernels;
+constrained models the constraint kernels, models with elements the element kernels, models
+with unilateral contacts the contacts kernel (gap, W_N, W_T, coefficients);
 test_every_kernel_kind_was_checked asserts it. Profiles: profiles.py.
 """
 
@@ -21,7 +22,7 @@ from lagrange_gen.codegen.spec import kernel_table
 from lagrange_gen.derive import derive
 
 from . import profiles
-from .check import BODY_KERNELS, CHECKED, CONTRACT, STATS, check_model
+from .check import BODY_KERNELS, CHECKED, CONTACT_KERNELS, CONTRACT, STATS, check_model
 from .printer_bug import put_back
 from .strategies import kepler, models
 
@@ -33,6 +34,7 @@ CASES = {
     "constant mass": (dict(constant_mass=True), []),
     "constrained": (dict(constrained=True), []),
     "elements": (dict(elements=True), []),
+    "contacts": (dict(contacts=True), []),
 }
 HARNESS_TESTS = ("test_kernels_as_python_match_reference", "test_compiled_kernels_match_reference",
                  "test_kepler_kernels_match_reference")
@@ -88,8 +90,9 @@ def _expected_kinds():
     dyn = derive(drawn.build())
     table = kernel_table(dyn)
     # the kernels of body models are checked on spatial trees (test_spatial_trees.py)
-    assert set(table) | set(BODY_KERNELS) == set(CONTRACT), "a kernel was added or removed: update check.CONTRACT"
-    kinds = set(table) | {"accelerations", "forward_dynamics[general]", "forward_dynamics[factored]",
+    assert set(table) | set(BODY_KERNELS) | set(CONTACT_KERNELS) == set(CONTRACT), \
+        "a kernel was added or removed: update check.CONTRACT"
+    kinds = set(table) | set(CONTACT_KERNELS) | {"accelerations", "forward_dynamics[general]", "forward_dynamics[factored]",
                           "forward_dynamics[factored, other parameters]"}
     for name in table:
         try:
@@ -98,7 +101,8 @@ def _expected_kinds():
             continue
         kinds.add(f"{name}[composed]")
     kinds |= {f"fd:{name}" for name in ("rhs_jacobian", "momentum_rate_jacobian", "mass_matvec_dq",
-                                        "constraints", "constraint_dq", "elements", "elements_hessian")}
+                                        "constraints", "constraint_dq", "elements", "elements_hessian",
+                                        "contacts")}
     return kinds
 
 

@@ -95,3 +95,37 @@ def test_a_fresh_process_loads_without_running_the_file_or_importing_sympy(tmp_p
     out_text = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out_text.split() == ["counted_spring", "False"]
     assert _runs(path) == ran
+
+
+DATA_SPRING = textwrap.dedent("""\
+    import json
+    from pathlib import Path
+    from lagrange_gen import Model, coordinates, parameters
+    here = Path(__file__)
+    runs = here.with_suffix(".runs")
+    runs.write_text(runs.read_text() + "x" if runs.exists() else "x")
+    k0 = json.loads(here.with_name("stiffness.json").read_text())["k"]
+    x = coordinates("x")
+    k = parameters("k", defaults=(float(k0),))
+    model = Model("data_spring", coords=[x], T=x.d**2 / 2, V=k * x**2 / 2)
+    """)
+
+
+def test_a_model_that_reads_a_data_file_is_served_until_the_file_changes(tmp_path):
+    """The data files a model read are part of what the cache compares (their record, from the
+    generation): unchanged, load does not run the file; changed, it runs it and regenerates."""
+    import os
+    path = tmp_path / "data_spring.py"
+    path.write_text(DATA_SPRING)
+    data = tmp_path / "stiffness.json"
+    data.write_text('{"k": 2.0}')
+    out = tmp_path / "gen"
+    first = load(path, out_dir=out, methods=["rk4"])
+    ran = _runs(path)
+    assert load(path, out_dir=out, methods=["rk4"]) is first and _runs(path) == ran
+    before = data.stat().st_mtime_ns
+    data.write_text('{"k": 5.0}')
+    os.utime(data, ns=(before + 10**9, before + 10**9))
+    mod = load(path, out_dir=out, methods=["rk4"])
+    assert _runs(path) > ran
+    assert mod.DEFAULTS == (5.0,)

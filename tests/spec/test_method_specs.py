@@ -33,8 +33,9 @@ def test_spec_is_complete(method):
     spec = registry.spec(method)
     assert spec.name == method and spec.family in FAMILIES and spec.order >= 1
     assert spec.summary and "blowup_bound" in spec.settings._fields
-    assert all(isinstance(w, int) or w in ("n", "m", "ne", "c") for _, w in spec.saved)
-    if not (spec.constraints or spec.elements or spec.adaptive or spec.contacts):
+    assert all(isinstance(w, int) or w in ("n", "m", "ne", "c", "r") for _, w in spec.saved)
+    if not (spec.constraints or spec.elements or spec.adaptive or spec.contacts
+            or spec.nonholonomic):
         assert spec.stable_tau is not None and spec.rho is not None, \
             "a fixed-step unconstrained method declares its linear stability"
     if spec.constraints:
@@ -100,9 +101,10 @@ def test_applicability_comes_from_the_specs():
     for method in registry.METHODS:
         spec = registry.spec(method)
         on_plain = registry.inapplicable(method, 0, 0)
-        assert bool(on_plain) == (spec.constraints or spec.contacts)
+        assert bool(on_plain) == (spec.constraints or spec.contacts or spec.nonholonomic)
         assert bool(registry.inapplicable(method, 2, 0)) != spec.constraints
         assert bool(registry.inapplicable(method, 0, 0, 1)) != spec.contacts
+        assert bool(registry.inapplicable(method, 0, 0, 0, 1)) != spec.nonholonomic
         assert not registry.inapplicable(method, 0, 1) or not spec.elements
     assert registry.runs_as("implicit_euler", 1) == "nonsmooth_euler"
     assert registry.runs_as("implicit_euler", 0) == "implicit_euler"

@@ -48,7 +48,8 @@ def fitted_order(mod, method, q0, v0, q_ref, v_ref):
 # The constrained methods need a model with constraints (tests/constraints/ fits their order).
 # dop853 chooses its own steps: tests/steppers/test_dop853.py checks its orders.
 @pytest.mark.parametrize("method", [m for m in METHODS if m not in CONSTRAINED_METHODS
-                                    and not INFO[m].adaptive])
+                                    and not INFO[m].adaptive and not INFO[m].contacts
+                                    and not INFO[m].nonholonomic])
 def test_fitted_order(model, reference, name, method):
     mod = model(name)
     q0, v0 = (np.array(x, dtype=float) for x in CASES[name])

@@ -18,7 +18,7 @@ from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, INFO, METHO
 from time_util import ROOT
 
 UNCONSTRAINED = [m for m in METHODS if not INFO[m].adaptive and m not in NONSMOOTH_METHODS
-                 and m not in CONSTRAINED_METHODS]
+                 and m not in CONSTRAINED_METHODS and not INFO[m].contacts and not INFO[m].nonholonomic]
 STEPS = {1: (128, 256, 512, 1024), 2: (32, 64, 128, 256), 4: (128, 256, 512, 1024), 6: (16, 32, 64, 128)}
 Q0, V0, T_END = [0.3, 0.8], [0.2, -0.5], 2.0
 

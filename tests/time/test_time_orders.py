@@ -24,7 +24,8 @@ from time_util import dop853, generated_rhs
 
 T_END = 1.0
 STEPS = {1: (256, 512, 1024, 2048), 2: (32, 64, 128, 256), 4: (16, 32, 64, 128), 6: (8, 12, 16, 24)}
-FIXED = [m for m in METHODS if not INFO[m].adaptive and m not in NONSMOOTH_METHODS]
+FIXED = [m for m in METHODS if not INFO[m].adaptive and m not in NONSMOOTH_METHODS
+         and not INFO[m].contacts and not INFO[m].nonholonomic]
 UNCONSTRAINED = [m for m in FIXED if m not in CONSTRAINED_METHODS]
 PB = dict(m=1.0, k=4.0, F=0.5, w=1.5, nu=2.0, e=0.3)
 Q0, V0 = np.array([0.4, -0.2]), np.array([0.1, 0.3])

@@ -42,3 +42,13 @@ def test_velocity_dependent_constraint_is_refused_time_dependent_accepted():
     with pytest.raises(ModelError, match=r"constraint 0 .* depends on x_d"):
         Model("bad", coords=[x, z], T=T.subs(y0.d, 0) + z.d**2, constraints=[x - x.d])
     Model("ok", coords=[x, z], T=T.subs(y0.d, 0) + z.d**2, constraints=[x - z * sp.sin(t)])
+
+
+def test_mass_that_turns_negative_in_time_names_t():
+    """T = (1 - t) x'^2 / 2 was refused with "check the terms in x.d"; the cause is t (issue 34,
+    item 8)."""
+    model = Model("fading", coords=[x], T=(1 - t) * x.d**2 / 2)
+    with pytest.raises(ModelError) as err:
+        derive(model)
+    text = str(err.value)
+    assert "depends on t" in text and "t = " in text and "x.d" not in text, text

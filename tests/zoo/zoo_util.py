@@ -19,7 +19,7 @@ from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, INFO, METHO
 # checked in tests/steppers/test_dop853.py and tests/events.
 UNCONSTRAINED_METHODS = tuple(m for m in METHODS
                               if m not in CONSTRAINED_METHODS and m not in NONSMOOTH_METHODS
-                              and not INFO[m].adaptive)
+                              and not INFO[m].adaptive and not INFO[m].contacts and not INFO[m].nonholonomic)
 SYMPLECTIC_METHODS = tuple(m for m in UNCONSTRAINED_METHODS if INFO[m].symplectic)
 EPS = np.finfo(np.float64).eps
 

@@ -27,10 +27,11 @@ def constrained_methods():
 
 def unconstrained_methods():
     """Fixed-step methods for unconstrained smooth models: not the constrained, the nonsmooth,
-    the contact or the adaptive ones (the hard cases compare methods at a given step h)."""
+    the contact, the nonholonomic or the adaptive ones (the hard cases compare methods at a
+    given step h)."""
     return tuple(m for m in registry.METHODS if not (
         registry.spec(m).constraints or registry.spec(m).elements or registry.spec(m).adaptive
-        or registry.spec(m).contacts))
+        or registry.spec(m).contacts or registry.spec(m).nonholonomic))
 
 
 def methods_for(mod, methods=None):

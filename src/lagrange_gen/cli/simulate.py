@@ -180,7 +180,12 @@ def _summary(traj):
     print(f"wall time {traj.wall_time:.3f} s ({per_step * 1e9:.0f} ns/step), "
           f"compile/load {traj.compile_time:.2f} s ({traj.jit} loop)")
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")
-    if traj.work is None:
+    contact_work = traj.saved.get("contact_work")
+    if contact_work is not None:     # impacts and friction: E changes by the impulses' work
+        balance = float(abs(traj.energy_error - contact_work[:, 0]).max())
+        print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
+              f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
+    elif traj.work is None:
         print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
     else:       # forced, damped or rheonomic: E changes by the work W done on the system
         print(f"max |E - E0 - W| = {traj.max_energy_balance_error:.3e} (E0 = {traj.energy[0]:.9g}, "
@@ -188,8 +193,9 @@ def _summary(traj):
     if traj.constraint_names:
         print(f"max |Phi| = {traj.constraint_error.max():.3e}, "
               f"max |J v| = {traj.velocity_constraint_error.max():.3e}")
-    if traj.newton_iters.sum():
-        print(f"Newton iterations per step: {traj.newton_iters.sum() / max(traj.n_steps, 1):.2f}")
+    if traj.newton_iters.sum():      # the contact methods count their solver's sweeps there
+        what = "Gauss-Seidel sweeps" if contact_work is not None else "Newton iterations"
+        print(f"{what} per step: {traj.newton_iters.sum() / max(traj.n_steps, 1):.2f}")
 
 
 def _write_outputs(traj, out, plot):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..derive.backend import BACKEND
+from ..derive.kinks import settle_derivatives
 
 try:  # optional accelerator (a dependency, but the sympy path must keep working without it)
     import symengine as _se
@@ -28,7 +29,8 @@ def cse(exprs, rename, backend=None):
     expr)] in evaluation order; reduced: one sympy expression per input expression, both over
     plain Symbols named by placeholders and temporaries. Deterministic for the same input.
     """
-    exprs = list(exprs)
+    # Before symengine sees them: it drops some unevaluated derivatives (derive/kinks.py).
+    exprs = [settle_derivatives(e, "a generated kernel") for e in exprs]
     if not exprs:
         return [], []
     if (backend or BACKEND) == "symengine" and _se is not None:

@@ -93,9 +93,10 @@ def generation_options(build, methods, freeze):
 
 
 def model_counts(model):
-    """(number of constraints, of nonsmooth elements, of contacts): what decides the methods
-    that apply."""
-    return len(model.constraints), len(model.elements), len(getattr(model, "contacts", ()))
+    """(number of constraints, of nonsmooth elements, of contacts, of nonholonomic constraints):
+    what decides the methods that apply."""
+    return (len(model.constraints), len(model.elements), len(getattr(model, "contacts", ())),
+            len(getattr(model, "nonholonomic", ())))
 
 
 def resolve_methods(requested, model, drop_inapplicable=False):
@@ -105,15 +106,16 @@ def resolve_methods(requested, model, drop_inapplicable=False):
     method, and for one that does not apply (one line naming it and why) unless
     ``drop_inapplicable`` (load(): simulate then refuses it with its own message)."""
     from ..steppers.core.registry import METHODS, applicable_methods, inapplicable, runs_as
-    n_constraints, n_elements, n_contacts = model_counts(model)
+    counts = model_counts(model)
+    n_elements = counts[1]
     if requested is None:
-        return list(applicable_methods(n_constraints, n_elements, n_contacts))
+        return list(applicable_methods(*counts))
     unknown = [m for m in requested if m not in METHODS]
     if unknown:
         raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
     wanted = {runs_as(m, n_elements) for m in requested}
     for method in (m for m in METHODS if m in wanted):
-        why = inapplicable(method, n_constraints, n_elements, n_contacts)
+        why = inapplicable(method, *counts)
         if why and not drop_inapplicable:
             raise GenerationError(f"method {method} does not apply to model {model.name!r}: {why}")
         if why:
@@ -181,7 +183,7 @@ def _glue(methods, dyn):
 
 def _n_saved(method, dyn):
     from ..steppers.core.registry import spec
-    return spec(method).n_saved(dyn.n, dyn.m, dyn.n_elements, dyn.n_contacts)
+    return spec(method).n_saved(dyn.n, dyn.m, dyn.n_elements, dyn.n_contacts, dyn.n_nonholonomic)
 
 
 def module_sources(methods) -> dict:
@@ -256,9 +258,21 @@ def refuse_overwrite(model_path, target, name):
 
 
 def _record(model, key, options) -> dict:
-    """What makes re-deriving needless: the same model text, generator sources, options and KEY."""
-    return {"model": model_hash(model.source_text), "generator": generator_hash(), "options": options,
-            "key": key}
+    """What makes re-deriving needless: the same model text, data files it read (their sha256),
+    generator sources, options and KEY."""
+    data = {name: rec.get("sha256") for name, rec in getattr(model, "data_files", {}).items()}
+    return {"model": model_hash(model.source_text), "data": data, "generator": generator_hash(),
+            "options": options, "key": key}
+
+
+def _recorded(path) -> dict:
+    """The record of remember_current at ``path`` without the data files' sizes and mtimes
+    (which only make the import-time check cheap, keys.check_current); {} when unreadable."""
+    record = json.loads(path.read_text())
+    if not isinstance(record, dict):
+        return {}
+    record.pop("data_files", None)
+    return record
 
 
 def remember_current(target, model, key, options):
@@ -269,7 +283,9 @@ def remember_current(target, model, key, options):
     try:
         path.parent.mkdir(exist_ok=True)
         tmp = path.with_suffix(f".{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(_record(model, key, options), sort_keys=True))
+        record = _record(model, key, options)
+        record["data_files"] = getattr(model, "data_files", {})
+        tmp.write_text(json.dumps(record, sort_keys=True))
         os.replace(tmp, path)
     except OSError:
         pass
@@ -286,7 +302,7 @@ def module_current(model, target, header) -> bool:
     if why_stale(target, header.get("KEY"), header["SOURCES"], header.get("TEXT_SHA")):
         return False
     try:
-        if json.loads(derivation_record_path(target).read_text()) == _record(model, header["KEY"], options):
+        if _recorded(derivation_record_path(target)) == _record(model, header["KEY"], options):
             return True
     except (OSError, ValueError):
         pass

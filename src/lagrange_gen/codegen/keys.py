@@ -105,10 +105,39 @@ def _model_changed(here, model_relpath, key):
         text = (here.parent / model_relpath).read_text()
     except (OSError, ValueError, UnicodeDecodeError):
         return None
-    if not isinstance(record, dict) or record.get("key") != key or record.get("model") == model_hash(text):
+    if not isinstance(record, dict) or record.get("key") != key:
         return None
-    return (f"{_shown(here.parent / model_relpath)} changed since {here} was generated (if only "
-            "comments changed, regenerating leaves the module as it is)")
+    if record.get("model") != model_hash(text):
+        return (f"{_shown(here.parent / model_relpath)} changed since {here} was generated (if "
+                "only comments changed, regenerating leaves the module as it is)")
+    data_files = record.get("data_files")
+    changed = changed_data_file(data_files) if isinstance(data_files, dict) else None
+    if changed is not None:
+        return (f"{_shown(changed)} changed since {here} was generated (a data file that "
+                f"{_shown(here.parent / model_relpath)} reads)")
+    return None
+
+
+def changed_data_file(records) -> str | None:
+    """The first path of ``records`` {path: {"sha256", "size", "mtime_ns"}} (model.data_files)
+    whose content differs from the one recorded, or that is gone; else None. Cheap: a file whose
+    size and mtime are the recorded ones is not read."""
+    for path, old in sorted(records.items()):
+        if not isinstance(old, dict) or not old:
+            return path
+        try:
+            stat = os.stat(path)
+            if stat.st_size == old.get("size") and stat.st_mtime_ns == old.get("mtime_ns"):
+                continue
+            digest = hashlib.sha256()
+            with open(path, "rb") as fh:
+                for block in iter(lambda: fh.read(1 << 20), b""):
+                    digest.update(block)
+        except OSError:
+            return path
+        if digest.hexdigest() != old.get("sha256"):
+            return path
+    return None
 
 
 def check_fresh(module_file, key, model_sha, gen_sha, model_relpath, options, text_sha=None):
@@ -173,7 +202,7 @@ def regeneration_command(model_path, out_dir="generated", build=None, methods=No
     model, the default): the one source of every "run lagrange-gen ..." hint."""
     from ..steppers.core.registry import METHODS, applicable_methods
     defaults = [set(applicable_methods(*counts))
-                for counts in ((0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1))]
+                for counts in ((0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))]
     args = ["lagrange-gen", str(model_path)]
     if os.path.normpath(str(out_dir)) != "generated":
         args += ["-o", str(out_dir)]

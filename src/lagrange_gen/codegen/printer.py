@@ -10,6 +10,8 @@ import sympy as sp
 from sympy.printing.precedence import PRECEDENCE
 from sympy.printing.pycode import PythonCodePrinter
 
+from ..derive.kinks import settle_derivatives
+
 
 class KernelPrinter(PythonCodePrinter):
     """PythonCodePrinter with math.* calls; Symbols (placeholders, CSE temporaries) by name.
@@ -27,6 +29,14 @@ class KernelPrinter(PythonCodePrinter):
         # Derivatives of sign/Heaviside (e.g. the Jacobian of a drag -c |v| v): zero everywhere
         # except at the kink, where any element of the generalized Jacobian will do for Newton.
         return "0.0"
+
+    def _print_frac(self, expr):
+        # sympy prints frac(x) as ``x % 1`` unparenthesized: a*frac(x) read (a*x) % 1.
+        return f"({self._print(expr.args[0])} % 1)"
+
+    def _print_Derivative(self, expr):
+        # What sympy leaves unevaluated: 0 for floor/ceiling (derive/kinks.py), else refused.
+        return self._print(settle_derivatives(expr, "a generated kernel"))
 
     def _print_Rational(self, expr):
         return f"{float(expr)!r}"

@@ -33,6 +33,9 @@ def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
         lines += [f"    {i}: {c.name}: gap = {sp.sstr(c.gap)}, slip = {sp.sstr(c.slip)}, "
                   f"restitution = {sp.sstr(c.restitution)}, friction = {sp.sstr(c.friction)}"
                   for i, c in enumerate(m.contacts)]
+    if dyn.n_nonholonomic:
+        lines.append("Nonholonomic constraints A(q, t) qd + b(q, t) = 0 (index in mu / rows of A):")
+        lines += [f"    {i}: {sp.sstr(c)} = 0" for i, c in enumerate(m.nonholonomic)]
     if m.events:
         lines.append("Events g(q, qd, t) (index in the out of events; direction, terminal):")
         lines += [f"    {i}: {e.name}: {sp.sstr(g)} ({_DIRECTIONS[e.direction]}"
@@ -75,7 +78,7 @@ _IMPORTS = [
     "import numpy as np",
     "",
     "from lagrange_gen.codegen.keys import check_current",
-    "from lagrange_gen.jit import KERNEL_OPTIONS, njit  # numba.njit; a bad cache entry is a miss",
+    "from lagrange_gen.jit import KERNEL_OPTIONS, check_python_calls, njit  # numba.njit; a bad cache entry is a miss",
     "from lagrange_gen.run.loader import register_module",
     "from lagrange_gen.errors import SingularMass",
     "from lagrange_gen.steppers.core.linalg import SINGULAR_RTOL, cholesky_inplace, cholesky_solve_inplace",
@@ -110,6 +113,7 @@ def _model_constants(dyn, methods, texts):
         f"ELEMENT_KINDS = {tuple(KIND_CODES[e.kind] for e in elements)!r}  # 0 Saint-Venant, 1 dry friction",
         f"N_CONTACTS = {dyn.n_contacts}",
         f"CONTACTS = {tuple(c.name for c in getattr(dyn.model, 'contacts', ()))!r}",
+        f"N_NONHOLONOMIC = {dyn.n_nonholonomic}",
         f"N_EVENTS = {len(events)}",
         f"EVENT_NAMES = {tuple(e.name for e in events)!r}",
         f"EVENT_TERMINAL = np.array({[e.terminal for e in events]!r}, dtype=np.bool_)",
@@ -160,6 +164,7 @@ def render_module(dyn, texts, *, sources, options, source_rel, methods, glue, wh
     for text in texts:
         parts += ["", text.function, ""]
     parts += ["", forward_source(dyn)]
+    parts += ["", "", "check_python_calls(globals())  # a call from Python checks its arguments' shapes"]
     if glue:
         parts += ["", glue]
     text = "\n".join(parts).rstrip() + "\n"

@@ -132,6 +132,7 @@ def kernel_table(dyn) -> dict:
     }
     table.update(io_kernels(dyn))
     table.update(contact_kernels(dyn))
+    table.update(nonholonomic_kernels(dyn))
     if hasattr(dyn.jac, "columns"):
         table.update(column_kernels(dyn))
         table.update(robot_kernels(dyn))
@@ -184,6 +185,18 @@ def contact_kernels(dyn) -> dict:
          Output("WT", nat["contact_WT"]), Output("coef", nat["contact_coef"])],
         doc="unilateral contacts: gaps g (c,), W_N = dg/dq (c, n), W_T = d slip/d qd (c, n), "
             "coef (c, 2) = (restitution, friction)")}
+
+
+def nonholonomic_kernels(dyn) -> dict:
+    """The ``nonholonomic`` kernel of a model with velocity constraints ({} without any)."""
+    if not dyn.n_nonholonomic:
+        return {}
+    nat = dyn.native
+    return {"nonholonomic": lambda: KernelSpec(
+        "nonholonomic", ["q", "qd", "t", "p"],
+        [Output("A", nat["nh_A"]), Output("b", nat["nh_b"]), Output("gamma", nat["nh_gamma"])],
+        doc="nonholonomic constraints A qd + b = 0: A(q, t) (r, n), b(q, t) (r,), gamma (r,) "
+            "with A qdd = gamma along a motion")}
 
 
 def column_kernels(dyn) -> dict:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
+from .kinks import NUMERIC_FUNCTIONS, settle_derivatives
+
 try:  # optional accelerator
     import symengine as _se
 except ImportError:  # pragma: no cover - exercised only where symengine is absent
@@ -61,7 +63,8 @@ class Ops:
             except Exception:  # noqa: BLE001  a function symengine cannot evaluate: use sympy
                 pass
         names = {str(a): sp.Symbol(str(a)) for a in args}
-        f = sp.lambdify([list(names.values())], [self.to_sympy(e, names) for e in exprs], modules="numpy")
+        exprs = [settle_derivatives(self.to_sympy(e, names)) for e in exprs]
+        f = sp.lambdify([list(names.values())], exprs, modules=[NUMERIC_FUNCTIONS, "numpy"])
         return lambda values: np.asarray(f(list(values)), dtype=float).ravel()
 
     def to_sympy(self, obj, names):

@@ -7,6 +7,7 @@ import sympy as sp
 from .backend import backend_for, ops
 from .constraints import derive_constraints
 from .contacts import derive_contacts
+from .nonholonomic import derive_nonholonomic
 from .elements import derive_elements
 from .freeze import freeze_model
 from .jacobians import Jacobians
@@ -20,7 +21,7 @@ from .recursive import recursive_dynamics
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
           "elem_s", "elem_grad", "elem_coef", "elem_hess_w",
-          "contact_gap", "contact_WN", "contact_WT", "contact_coef")
+          "contact_gap", "contact_WN", "contact_WT", "contact_coef", "nh_A", "nh_b", "nh_gamma")
 
 
 class Dynamics:
@@ -34,6 +35,8 @@ class Dynamics:
     Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 3),
     elem_hess_w (n, n). Contacts (c of them): contact_gap (c, 1), contact_WN = d gap/dq (c, n),
     contact_WT = d slip/d qdot (c, n), contact_coef (c, 2) = (restitution, friction).
+    Nonholonomic constraints (r of them, A qdot + b = 0, forces A^T mu): nh_A (r, n), nh_b
+    (r, 1), nh_gamma (r, 1) with A qddot = gamma along a motion (derive/nonholonomic.py).
     ``momentum_rate`` = dL/dq + Q_nc is dp/dt for the canonical momentum
     p = H qdot + b, b (n, 1) = dT/dqdot at qdot = 0 (T1 = b . qdot), db = db/dq (n, n).
 
@@ -80,6 +83,10 @@ class Dynamics:
     @property
     def n_contacts(self):
         return self.native["contact_gap"].shape[0]
+
+    @property
+    def n_nonholonomic(self):
+        return self.native["nh_A"].shape[0]
 
     @property
     def mass_is_constant(self):
@@ -150,7 +157,7 @@ def _finish(model, o, parts, frozen, jacobians):
            "we": input_symbols("we", len(model.elements))}
     for key, value in derive_elements(model, aux["we"]).items():
         parts[key] = o.matrix(*value.shape, list(value))
-    for key, value in derive_contacts(model).items():
+    for key, value in (*derive_contacts(model).items(), *derive_nonholonomic(model).items()):
         parts[key] = o.matrix(*value.shape, list(value))
     native = {k: parts[k] for k in FIELDS}
     return Dynamics(model, o, native, parts, aux, frozen, jacobians)

@@ -17,7 +17,7 @@ def freeze_model(model, frozen):
     """A copy of ``model`` with the parameters named in ``frozen`` replaced by their values.
 
     The copy's params and defaults no longer list them; every expression (T, V, dissipation,
-    forces, constraints, element strains and coefficients, contacts) has them substituted.
+    forces, constraints, nonholonomic constraints, element strains and coefficients, contacts) has them substituted.
     """
     by_name = {p.name: p for p in model.params}
     unknown = sorted(set(frozen) - set(by_name))
@@ -30,6 +30,7 @@ def freeze_model(model, frozen):
     out.dissipation = model.dissipation.xreplace(sub)
     out.forces = [f.xreplace(sub) for f in model.forces]
     out.constraints = [c.xreplace(sub) for c in model.constraints]
+    out.nonholonomic = [c.xreplace(sub) for c in getattr(model, "nonholonomic", ())]
     out.elements = [_freeze_element(e, sub) for e in model.elements]
     out.contacts = [_freeze_element(c, sub) for c in getattr(model, "contacts", ())]
     out.params = [p for p in model.params if p.name not in frozen]

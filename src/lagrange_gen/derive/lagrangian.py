@@ -146,9 +146,28 @@ def _check_quadratic_and_definite(model, o, H, T, b, T0, samples):
             np.linalg.cholesky(Hs)
         except np.linalg.LinAlgError:
             eig, vectors = np.linalg.eigh(Hs)
+            at_start = _time_where_definite(f_H, qs, vs, pvals, n)
+            if at_start is not None:
+                raise ModelError(
+                    f"model {model.name}: H = d2T/dqdot2 depends on t and is not positive definite "
+                    f"at t = {ts:.3g} ({state}; smallest eigenvalue {eig[0]:.3g}), though it is at "
+                    f"t = {at_start:g}: the time-dependent terms of T must keep it positive for "
+                    f"every t (checked for t in [0, 2])") from None
             raise ModelError(f"model {model.name}: H = d2T/dqdot2 is not positive definite at {state} "
                              f"(smallest eigenvalue {eig[0]:.3g}; check the terms in "
                              f"{weakest_direction(model.coords, vectors[:, 0])})") from None
+
+
+def _time_where_definite(f_H, qs, vs, pvals, n):
+    """A time of [0, 2] at which H (n, n) at the same q is positive definite (so that what fails
+    at another time is the time dependence), or None."""
+    for time in (0.0, 0.5, 1.0, 1.5, 2.0):
+        try:
+            np.linalg.cholesky(np.asarray(f_H([*qs, *vs, *pvals, time]), dtype=float).reshape(n, n))
+            return time
+        except np.linalg.LinAlgError:
+            continue
+    return None
 
 
 def weakest_direction(coords, vector):

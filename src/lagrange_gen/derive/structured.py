@@ -87,7 +87,8 @@ def uses_graph(model) -> bool:
 
 
 def graph_model(model, expand_all=False):
-    """A shallow copy of ``model`` whose constraints, element strains, events, contacts and outputs have
+    """A shallow copy of ``model`` whose constraints (holonomic and nonholonomic), element strains,
+    events, contacts and outputs have
     their Intermediates expanded (those are derived or printed from their own expressions);
     with ``expand_all`` T, V, the dissipation and the forces too, and no Intermediates remain
     (the expression path of derive/lagrangian.py)."""
@@ -98,6 +99,7 @@ def graph_model(model, expand_all=False):
         out.forces = [expand_intermediates(f) for f in model.forces]
         out.intermediates = []
     out.constraints = [expand_intermediates(c) for c in model.constraints]
+    out.nonholonomic = [expand_intermediates(c) for c in getattr(model, "nonholonomic", ())]
     out.elements = []
     for e in model.elements:
         e = copy.copy(e)

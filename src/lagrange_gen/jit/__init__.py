@@ -16,6 +16,7 @@ from .speedups import check_numba_version as _check_numba_version
 _check_numba_version()
 
 from .cache import CALLEE_MODULES, closure_stamp, compiled_for_jitted_callers, njit  # noqa: E402
+from .python_calls import check_python_calls  # noqa: E402
 
 #: numba options of a function that never allocates: no reference counting (every call from a
 #: stepper would pay for it).
@@ -27,4 +28,4 @@ NO_REFCOUNT = {"_nrt": False}
 KERNEL_OPTIONS = dict(cache=True, **NO_REFCOUNT, error_model="numpy")
 
 __all__ = ["njit", "closure_stamp", "compiled_for_jitted_callers", "CALLEE_MODULES",
-           "KERNEL_OPTIONS", "NO_REFCOUNT"]
+           "KERNEL_OPTIONS", "NO_REFCOUNT", "check_python_calls"]

@@ -207,6 +207,23 @@ def _discard_entry(cache, exc):
     source = source.co_filename if source else "?"
     if source not in _WARNED:
         _WARNED.add(source)
+        if _written_at_another_path(exc):
+            print(f"lagrange-gen: warning: numba cache of {source} was written where the file "
+                  f"was before (the project moved or was copied); removed {removed} file(s) in "
+                  f"{directory} and compiling again, once", file=sys.stderr)
+            return
         what = f"{type(exc).__name__}: {exc}".splitlines()[0]
         print(f"lagrange-gen: warning: numba cache of {source} unreadable ({what}); removed "
               f"{removed} file(s) in {directory} and compiling again", file=sys.stderr)
+
+
+#: The start of the module name run.loader.import_generated gives a generated module (made
+#: from its absolute path, so a moved file gets another name).
+GENERATED_MODULE_PREFIX = "lagrange_gen_generated_"
+
+
+def _written_at_another_path(exc) -> bool:
+    """Whether a cache load failed because the entry names a generated module by the name it had
+    at another path: numba's entries refer to the module by name."""
+    return isinstance(exc, ModuleNotFoundError) and str(exc.name or "").startswith(
+        GENERATED_MODULE_PREFIX)

@@ -229,7 +229,8 @@ def _bound(module, method, function):
     from ..steppers.core.registry import spec
     run, table = getattr(_glue_module(method), function), kernel_table(module, method)
     n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                                   getattr(module, "N_CONTACTS", 0))
+                                   getattr(module, "N_CONTACTS", 0),
+                                   getattr(module, "N_NONHOLONOMIC", 0))
 
     def bound(*args):
         return run(table, n_saved, *args)

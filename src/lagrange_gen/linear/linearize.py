@@ -56,6 +56,14 @@ def parameter_vector(module, params=None, u=None):
     return p
 
 
+def _refuse_nonholonomic(module, what):
+    """Velocity constraints change the linearization (minimal velocities in the null space of
+    A): not implemented, so refused rather than answered without them."""
+    if getattr(module, "N_NONHOLONOMIC", 0):
+        raise SimulationError(f"{module.NAME}: {what} of a model with nonholonomic constraints "
+                              "is not implemented yet")
+
+
 def _need(module, *names):
     missing = [n for n in names if not hasattr(module, n)]
     if missing:
@@ -138,6 +146,7 @@ def linearize(module, q, qd=None, u=None, t=0.0, params=None) -> Linearization:
     generated module or a model file. C, D have 0 rows for a model without outputs."""
     from ..run.simulate import load_module
     module = load_module(module)
+    _refuse_nonholonomic(module, "linearize")
     _need(module, "rhs_jacobian", "mass_matvec_dq",
           *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n = module.N_COORDS
@@ -163,6 +172,7 @@ def equilibrium(module, q, u=None, t=0.0, params=None, tol=1e-12, max_iter=50):
     converge."""
     from ..run.simulate import load_module
     module = load_module(module)
+    _refuse_nonholonomic(module, "equilibrium")
     _need(module, "rhs_jacobian", *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n, m = module.N_COORDS, module.N_CONSTRAINTS
     x = np.concatenate((as_vector(q, n, "q", module), np.zeros(m)))

@@ -195,6 +195,9 @@ def named_events(model_name, events, replace):
             expr = sympify_scalar(event.expr, f"event {name}", replace)
         except ModelError as exc:
             raise ModelError(f"model {model_name}: {exc}") from None
+        if not expr.free_symbols:
+            raise ModelError(f"model {model_name}: event {name} is the constant {expr}: it never "
+                             f"crosses zero (an event function must depend on q, qdot or t)")
         named = Event(expr, bool(terminal), int(direction))
         named.name = name
         out.append(named)

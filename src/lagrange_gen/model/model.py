@@ -19,6 +19,7 @@ from .expressions import (Event, convert_dynamicsymbols, equation_as_expr, is_me
                           mechanics_speeds, named_events, prescriptions, sympify_scalar)
 from .loads import DryFriction, PointForce, SaintVenant
 from .contacts import Contact, check_contacts, named_contacts
+from .nonholonomic import check_nonholonomic
 from .symbols import Coordinate, Parameter, Velocity, check_name, coordinates, parameters, t
 
 __all__ = [
@@ -55,6 +56,9 @@ class Model:
     dissipation : Rayleigh function D(q, qdot); contributes Q = -dD/dqdot.
     constraints : list of holonomic constraints Phi(q) = 0 or Phi(q, t) = 0 (rheonomic; an
         sp.Eq(lhs, rhs) means lhs - rhs).
+    nonholonomic : list of velocity constraints A(q, t) . qdot + b(q, t) = 0, each an expression
+        linear in the velocities (or an sp.Eq): rolling without slipping, knife edges
+        (model/nonholonomic.py); stepped by the methods for nonholonomic models.
     elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
     contacts : unilateral contacts Contact(gap=g(q), restitution=e, friction=mu, slip=u_T):
         g >= 0 with impacts (Newton's law) and Coulomb friction on the slip velocity u_T
@@ -78,7 +82,7 @@ class Model:
 
     def __init__(self, name, coords, T, V=0, forces=None, dissipation=0, constraints=(),
                  elements=(), params=None, description="", events=None, prescribed=None, frame=None,
-                 inputs=(), outputs=None, draw=None, contacts=()):
+                 inputs=(), outputs=None, draw=None, contacts=(), nonholonomic=()):
         check_name("model", str(name))
         self.name = str(name)
         self.description = description
@@ -94,6 +98,10 @@ class Model:
         self.forces = self._generalized_forces(forces, replace, frame, speeds)
         self.constraints = [self._scalar(equation_as_expr(c), f"constraint {i}", replace)
                             for i, c in enumerate(self._sequence(constraints, "constraints", "expressions Phi(q)"))]
+        self.nonholonomic = [
+            self._scalar(equation_as_expr(c), f"nonholonomic constraint {i}", replace)
+            for i, c in enumerate(self._sequence(nonholonomic, "nonholonomic",
+                                                 "expressions A(q, t) . qdot + b(q, t)"))]
         self.elements = self._elements(elements, replace)
         self.contacts = self._contacts(contacts, replace)
         self.events = named_events(self.name, events, replace)
@@ -109,6 +117,7 @@ class Model:
         self.build_options = {}
         check_model(self)
         check_contacts(self)
+        check_nonholonomic(self)
         # A drawing may show a prescribed coordinate (the driven pivot): substituted like the rest.
         sub = getattr(self, "_prescribed_sub", {})
         self.draw = check_drawing(self, draw, lambda e, what: self._scalar(e, what, replace).xreplace(sub))
@@ -128,6 +137,7 @@ class Model:
         self.dissipation = self.dissipation.xreplace(sub)
         self.forces = [f.xreplace(sub) for f in self.forces]
         self.constraints = [c.xreplace(sub) for c in self.constraints]
+        self.nonholonomic = [c.xreplace(sub) for c in self.nonholonomic]
         for e in self.elements:
             e.strain = e.strain.xreplace(sub)
         for e in self.events:
@@ -248,6 +258,10 @@ class Model:
     def n_contacts(self):
         return len(self.contacts)
 
+    @property
+    def n_nonholonomic(self):
+        return len(self.nonholonomic)
+
     def _all_expressions(self):
         yield "T", self.T
         yield "V", self.V
@@ -256,6 +270,8 @@ class Model:
             yield f"force on {c}", f
         for i, c in enumerate(self.constraints):
             yield f"constraint {i}", c
+        for i, c in enumerate(self.nonholonomic):
+            yield f"nonholonomic constraint {i}", c
         for e in self.elements:
             yield f"strain of element {e.name}", e.strain
             for c in e.coefficients():
@@ -308,6 +324,7 @@ class Model:
         self.dissipation = expand_intermediates(self.dissipation)
         self.forces = [expand_intermediates(f) for f in self.forces]
         self.constraints = [expand_intermediates(c) for c in self.constraints]
+        self.nonholonomic = [expand_intermediates(c) for c in self.nonholonomic]
         for e in self.elements:
             e.strain = expand_intermediates(e.strain)
         for e in self.events:

@@ -51,7 +51,8 @@ def check_model(model):
         bad = sorted(str(s) for s in model.symbols_of(c) & qd)
         if bad:
             raise ModelError(f"model {model.name}: constraint {i} ({c}) depends on {', '.join(bad)}; "
-                             "only holonomic constraints Phi(q, t) = 0 are supported")
+                             "constraints= takes holonomic constraints Phi(q, t) = 0; velocity "
+                             "constraints A(q, t) . qdot + b = 0 go in nonholonomic=")
     _check_elements(model, qd)
     if not (model.symbols_of(model.T) & qd):
         raise ModelError(f"model {model.name}: T does not depend on any velocity")

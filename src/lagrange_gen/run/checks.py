@@ -4,20 +4,23 @@
 * Element coefficients at the parameters of this run (``check_element_coefficients``): the model
   file checks them at its defaults only, and ``--param eta=-1`` or ``--freeze eta=0`` would
   otherwise run the return map with a non-positive threshold or stiffness into garbage.
+  Likewise contact coefficients (``check_contact_coefficients``): restitution in [0, 1], friction
+  >= 0 at this run's parameters (``params={"e": 1.5}`` would otherwise gain energy at each impact).
 * The step count (``check_step_count``): at most MAX_STEPS steps.
 * The resolution of the time grid (``check_time_resolution``): the stepper evaluates forces at
   t0 + k h, and the driver saves those times; they must resolve h (TIME_RESOLUTION).
-* Memory for the saved rows (``check_memory``), against the memory the system has available now.
+* Memory for the saved rows (``check_memory``), against the memory this process can still take
+  now: MemAvailable, its cgroup's memory limit and RLIMIT_AS (run/memory.py).
 """
 
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
 from ..errors import SimulationError
+from . import memory
 from .params import is_number
 
 #: Largest step count simulate runs. At the fastest measured step (tens of ns, reports/steppers.md)
@@ -90,6 +93,59 @@ def vector(name, value, n, coords):
     return np.ascontiguousarray(arr)
 
 
+def state_vector(name, value, n, coords):
+    """value as a float64 vector (n,) like ``vector``, refusing also an array of more than one
+    dimension (a (2, 2) q0 is not the 4 coordinates of a 4-coordinate model)."""
+    try:
+        ndim = 0 if value is None else np.ndim(value)
+    except ValueError:          # a ragged sequence: vector() names it
+        ndim = 1
+    if ndim > 1:
+        raise SimulationError(f"{name} must be a flat sequence of {n} numbers ({', '.join(coords)}), "
+                              f"got an array of shape {np.shape(value)}")
+    return vector(name, value, n, coords)
+
+
+#: A constrained run whose max|Phi| passes this fraction of max(1, max|q|) warns: a method
+#: that keeps the constraints (rattle, index1) holds them to its Newton tolerance and spook's
+#: drift stays within a few times h^2 (6e-4 on the Cartesian pendulum at h = 0.01, 0.05 at
+#: h = 0.1); 6.3 on x^2 + y^2 = 1 - t past t = 1 means the constraints have no solution there.
+CONSTRAINT_WARNING = 0.01
+
+
+def constraint_violation(model, method, t, q, phi):
+    """The warning (one line) for a constrained run whose max|Phi| (S,) over the saved rows
+    passes CONSTRAINT_WARNING * max(1, max|q|) (q (S, n), times t (S,)), naming the first time it
+    does; None otherwise."""
+    if phi is None or not len(phi):
+        return None
+    phi = np.asarray(phi, dtype=float).reshape(len(phi), -1).max(axis=1)
+    bound = CONSTRAINT_WARNING * max(1.0, float(np.nanmax(np.abs(q))) if np.size(q) else 1.0)
+    over = np.flatnonzero(~(phi <= bound))
+    if not over.size:
+        return None
+    first = over[0]
+    return (f"{model}, {method}: the constraints are violated by max|Phi| = {np.nanmax(phi):.3g} "
+            f"(above {bound:.3g} from t = {t[first]:g}): they may have no solution there (a "
+            f"time-dependent constraint that becomes infeasible), or h is too large")
+
+
+def check_events_at_start(module, q, v, t0, p):
+    """Refuse a run whose event functions are not finite at the initial state (q, v (n,), t0):
+    NaN compares false with everything, so such an event would never fire."""
+    names = tuple(getattr(module, "EVENT_NAMES", ()))
+    if not names:
+        return
+    values = np.empty(len(names))
+    module.events(np.ascontiguousarray(q, dtype=np.float64), np.ascontiguousarray(v, dtype=np.float64),
+                  float(t0), np.ascontiguousarray(p, dtype=np.float64), values)
+    for name, value in zip(names, values.tolist()):
+        if not math.isfinite(value):
+            raise SimulationError(f"{module.NAME}: event {name} is {value} at the initial state "
+                                  f"(t0 = {t0:g}, q0 = {np.asarray(q).tolist()}): it would never "
+                                  f"fire; check where its function is defined")
+
+
 def check_element_coefficients(module, p):
     """Refuse a non-positive (or non-finite) stiffness, threshold or friction bound of a
     nonsmooth element at the parameter vector p (n_params,), naming the element and the
@@ -107,7 +163,8 @@ def check_element_coefficients(module, p):
                 continue
             raise SimulationError(
                 f"{module.NAME}: element {module.ELEMENTS[e]!r}: {label} = {value:g} must be a "
-                f"finite number > 0; {_coefficient_source(module, p, coef, e, col)}")
+                f"finite number > 0; "
+                f"{_coefficient_source(module, p, element_coefficients, coef, e, col)}")
 
 
 def element_coefficients(module, p):
@@ -119,13 +176,45 @@ def element_coefficients(module, p):
     return coef
 
 
-def _coefficient_source(module, p, coef, e, col):
-    """'it depends on eta = -1 (...)': the parameters whose change moves coef[e, col]."""
+def check_contact_coefficients(module, p, q=None):
+    """Refuse a restitution outside [0, 1] or a negative (or non-finite) friction of a unilateral
+    contact at the parameter vector p (n_params,), naming the contact and the parameters the
+    coefficient depends on. (The model file checks them at the defaults only.) q (n,): where
+    the kernel is evaluated (default zeros; the initial state keeps the gaps' Jacobians defined)."""
+    if not getattr(module, "N_CONTACTS", 0):
+        return
+    where = np.zeros(module.N_COORDS) if q is None else q
+    coef = contact_coefficients(module, p, where)
+    for c in range(module.N_CONTACTS):
+        for col, label, rule, ok in ((0, "restitution", "must be in [0, 1]", lambda x: 0 <= x <= 1),
+                                     (1, "friction", "must be >= 0", lambda x: x >= 0)):
+            value = coef[c, col]
+            if math.isfinite(value) and ok(value):
+                continue
+            source = _coefficient_source(module, p, lambda m, p: contact_coefficients(m, p, where),
+                                         coef, c, col)
+            raise SimulationError(f"{module.NAME}: contact {module.CONTACTS[c]!r}: {label} = "
+                                  f"{value:g} {rule}; {source}")
+
+
+def contact_coefficients(module, p, q):
+    """coef (c, 2) = (restitution, friction) of the generated ``contacts`` kernel at q (n,);
+    they depend on parameters only (model/contacts.py checks that)."""
+    nc, n = module.N_CONTACTS, module.N_COORDS
+    gap, WN, WT, coef = np.empty(nc), np.empty((nc, n)), np.empty((nc, n)), np.empty((nc, 2))
+    module.contacts(np.ascontiguousarray(q, dtype=np.float64), 0.0, np.ascontiguousarray(p, dtype=np.float64), gap, WN, WT,
+                    coef)
+    return coef
+
+
+def _coefficient_source(module, p, coefficients, coef, e, col):
+    """'it depends on eta = -1 (...)': the parameters whose change moves coef[e, col];
+    coefficients(module, p) gives coef."""
     used = []
     for j, name in enumerate(module.PARAMS):
         trial = np.array(p, dtype=np.float64)
         trial[j] += 0.5 * max(1.0, abs(trial[j]))
-        moved = element_coefficients(module, trial)[e, col]
+        moved = coefficients(module, trial)[e, col]
         if not (moved == coef[e, col] or (math.isnan(moved) and math.isnan(coef[e, col]))):
             used.append(f"{name} = {p[j]:g}")
     frozen = getattr(module, "FROZEN", None) or {}
@@ -150,6 +239,17 @@ def check_step_count(t0, t_end, h):
             f"2.2e-16, outgrow any gain from a smaller h); use a larger h or a shorter run")
 
 
+def step_past_end(model, method, t0, t_end, h, n_steps):
+    """The warning (one line) for a step longer than the whole run: the run's only step ends
+    past t_end (h = 1 with t_end = 0.5 ends at t = 1); None otherwise. (A step that divides the
+    span unevenly overshoots by less than h, as simulate documents.)"""
+    if not (t_end > t0 and h > t_end - t0):
+        return None
+    return (f"{model}, {method}: the step h = {h:g} is longer than the run (t_end - t0 = "
+            f"{t_end - t0:g}): it ends at t = {t0 + n_steps * h:g}, past t_end = {t_end:g}; "
+            f"use h <= {t_end - t0:g}")
+
+
 def check_time_resolution(t0, t_last, h, n_steps):
     """Refuse a run whose times t0 + k h (up to t_last) cannot be told apart to
     max(TIME_RESOLUTION, 2 n_steps eps) h in float64 (e.g. t0 = 1.7e9 with h = 1e-7: saved
@@ -166,19 +266,21 @@ def check_time_resolution(t0, t_last, h, n_steps):
 
 
 def available_memory():
-    """Bytes the system can give a new allocation now: MemAvailable from /proc/meminfo, else
-    the free physical pages (os.sysconf); None when neither is known."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
+    """Bytes a new allocation can take now: the least of MemAvailable, the cgroup memory limits
+    and RLIMIT_AS (run/memory.py); None when none is known."""
+    return memory.available_memory()
+
+
+def _binding_bound(free):
+    """" (the cgroup limit (PATH))" when a process limit, not the machine's MemAvailable, is what
+    leaves ``free`` bytes; else ""."""
+    bounds = memory.memory_bounds()
+    if not bounds or free is None:
+        return ""
+    name = min(bounds, key=bounds.get)
+    if name == "MemAvailable" or abs(bounds[name] - free) > 0.05 * free + 2**20:
+        return ""
+    return f" (the {name})"
 
 
 def saved_rows(n_steps, save_every):
@@ -206,7 +308,8 @@ def check_memory(model, n_steps, save_every, n, n_saved, need=None, what=None):
     suggest = save_every * math.ceil(need / (0.5 * free))
     what = what or f"saving {rows} states ({n_steps} steps, save_every = {save_every})"
     raise SimulationError(
-        f"{model}: {what} needs {_gb(need)} of memory and {_gb(free)} is available; use "
+        f"{model}: {what} needs {_gb(need)} of memory and {_gb(free)} is available"
+        f"{_binding_bound(free)}; use "
         f"save_every >= {suggest} (--save-every {suggest})")
 
 

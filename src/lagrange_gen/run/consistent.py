@@ -21,6 +21,9 @@ scleronomic; dPhi/dt from the generated ``constraint_rate``). Every function tak
 * multipliers lam0 from the acceleration-level KKT system at (q, v), the constraint forces of
   the initial state (row 0 of Trajectory.multipliers).
 
+For nonholonomic constraints A(q, t) v + b = 0 (no position constraint) ``nonholonomic_start``
+projects v0 by the same velocity formula with A, b in place of J, dPhi/dt.
+
 Redundant constraints (rank-deficient J at q0) are refused, not handled by a least-squares
 multiplier: their multipliers are not unique, and the methods' Newton matrices are singular.
 The error names the constraints that are dependent (a left null vector of J).
@@ -262,7 +265,8 @@ def check_method(module, method):
     from ..steppers.core import registry
     m = getattr(module, "N_CONSTRAINTS", 0)
     why = registry.inapplicable(method, m, getattr(module, "N_ELEMENTS", 0),
-                                getattr(module, "N_CONTACTS", 0))
+                                getattr(module, "N_CONTACTS", 0),
+                                getattr(module, "N_NONHOLONOMIC", 0))
     if not why:
         return
     if m and not registry.spec(method).constraints:
@@ -285,3 +289,28 @@ def diagnose_singular(module, q, p):
         return ""
     return ("; the constraint gradients are linearly dependent there (redundant constraints or "
             "a singular configuration): " + "; ".join(constraint_label(module, i) for i in bad))
+
+
+def nonholonomic_start(module, q, v0, p, t0=0.0, tol=1e-12, stacklevel=2):
+    """v0 projected onto the nonholonomic constraints A(q, t0) v + b(q, t0) = 0 (generated
+    ``nonholonomic`` kernel) in the kinetic-energy metric, v = v0 - H^-1 A^T (A H^-1 A^T)^-1
+    (A v0 + b): the velocity the constraints leave after an impulse that imposes them. Warns
+    with the violation and the change when v0 was off by more than tol (relative to
+    max(1, |v0|) and the rows' scale). q, v0 (n,); returns v (n,)."""
+    n, r = module.N_COORDS, module.N_NONHOLONOMIC
+    q, v0 = np.asarray(q, dtype=float), np.asarray(v0, dtype=float)
+    A, b, gamma = np.empty((r, n)), np.empty(r), np.empty(r)
+    module.nonholonomic(q, v0, float(t0), p, A, b, gamma)
+    residual = A @ v0 + b
+    scale = np.maximum(np.abs(A).max(axis=1), 1e-300) * max(1.0, float(np.abs(v0).max()))
+    if float((np.abs(residual) / scale).max(initial=0.0)) <= tol:
+        return v0
+    if np.linalg.matrix_rank(A) < r:
+        raise ConstraintError(f"{module.NAME}: the nonholonomic constraints are dependent at "
+                              f"q0 = {q.tolist()} (A has rank {np.linalg.matrix_rank(A)} < {r})")
+    v = v0 - _min_norm_step(mass(module, q, p, t0), A, residual)
+    warnings.warn(f"{module.NAME}: v0 violates the nonholonomic constraints (max|A v0 + b| = "
+                  f"{np.abs(residual).max():.3g}); replaced by the closest velocity that meets "
+                  f"them in the kinetic-energy metric, changing v0 by max|dv| = "
+                  f"{np.abs(v - v0).max():.3g}", stacklevel=stacklevel)
+    return v

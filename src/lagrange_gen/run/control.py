@@ -21,10 +21,13 @@ saved row) and, with outputs, ``saved["output_<name>"]`` (the generated ``output
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from ..errors import SimulationError
 from ..jit import njit
 from ..jit.api import overload, types
+from ..jit.python_calls import unchecked
 from .params import resolve_params
 from ..steppers.core.options import FAST
 
@@ -38,15 +41,30 @@ class Signal:
     last sample)."""
 
     def __init__(self, times, values, hold="zoh"):
-        self.times = np.ascontiguousarray(times, dtype=np.float64)
-        values = np.asarray(values, dtype=np.float64)
-        self.values = np.ascontiguousarray(values.reshape(len(values), -1))
         if hold not in ("zoh", "linear"):
             raise SimulationError(f"Signal: hold={hold!r}; use 'zoh' or 'linear'")
-        if self.times.ndim != 1 or len(self.times) == 0 or len(self.values) != len(self.times):
-            raise SimulationError(f"Signal: {len(self.times)} times for {len(self.values)} samples")
-        if np.any(np.diff(self.times) <= 0) or not np.all(np.isfinite(self.values)):
-            raise SimulationError("Signal: times must increase and values be finite")
+        self.times = _samples("times", times)
+        values = _samples("values", values)
+        if self.times.ndim != 1:
+            raise SimulationError(f"Signal: times must be a 1-d sequence, got shape {self.times.shape}")
+        if values.ndim not in (1, 2):
+            raise SimulationError(f"Signal: values must be (S,) or (S, n_inputs), got shape "
+                                  f"{values.shape}")
+        if len(self.times) == 0:
+            raise SimulationError("Signal: no samples (give at least one time and value)")
+        if len(values) != len(self.times):
+            raise SimulationError(f"Signal: {len(self.times)} times for {len(values)} samples")
+        for name, arr in (("times", self.times), ("values", values)):
+            bad = np.argwhere(~np.isfinite(arr))
+            if bad.size:
+                raise SimulationError(f"Signal: {name} must be finite; {name}[{bad[0][0]}] = "
+                                      f"{arr[tuple(bad[0])]!r}")
+        steps = np.diff(self.times)
+        if np.any(steps <= 0):
+            k = int(np.argmax(steps <= 0)) + 1
+            raise SimulationError(f"Signal: times must increase; times[{k}] = {self.times[k]:g} "
+                                  f"after {self.times[k - 1]:g}")
+        self.values = np.ascontiguousarray(values.reshape(len(values), -1))
         self.hold = hold
 
     def __call__(self, t):
@@ -54,6 +72,14 @@ class Signal:
         out = np.zeros(self.values.shape[1] + 1)
         _signal_apply((self.times, self.values, self.hold == "linear", 1, 0.0), t, None, None, out)
         return out[1:]
+
+
+def _samples(name, value):
+    """``value`` as a C-contiguous float64 array, or a one-line SimulationError naming it."""
+    try:
+        return np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SimulationError(f"Signal: {name} must be numbers, got {value!r}") from None
 
 
 def _write_inputs(u, p, first):
@@ -117,12 +143,42 @@ def make_apply(controller):
     if not hasattr(controller, "py_func"):
         raise SimulationError(f"control: {getattr(controller, '__name__', controller)!r} is not "
                               "numba-jitted; decorate it with @numba.njit (it runs inside the loop)")
+    _check_arity(controller)
     if controller not in _APPLY:
         @njit(**FAST)
         def apply(data, t, q, v, p):
             return _write_inputs(controller(t, q, v, p), p, data[0])
         _APPLY[controller] = apply
     return _APPLY[controller]
+
+
+def _check_arity(controller):
+    """numba's "too many arguments" would come from inside the loop's compile: a controller must
+    take (t, q, qd, p), checked on its Python function."""
+    import inspect
+    try:
+        inspect.signature(controller.py_func).bind(0.0, None, None, None)
+    except TypeError:
+        raise SimulationError(f"control: the controller {controller.__name__}"
+                              f"{inspect.signature(controller.py_func)} must take (t, q, qd, p)") from None
+    except ValueError:         # no signature to read: numba tells
+        pass
+
+
+def blame_inputs(error, module, p, control):
+    """``error`` (a SimulationError of a run with inputs from ``control``) as one line that also
+    names the inputs when the last values written to p (n_params,) are not finite: the failure
+    (NaN state, singular matrix) then comes from them, not from the model. Else ``error``."""
+    first, k = input_slots(module)
+    bad = [f"{name} = {value!r}" for name, value in zip(module.PARAMS[first:], p[first:].tolist())
+           if not math.isfinite(value)]
+    if not bad:
+        return error
+    source = (f"the controller {control.__name__}" if not isinstance(control, Signal)
+              else "the Signal")
+    return type(error)(f"{error}; the input {', '.join(bad)} from {source} is not finite there",
+                       step=error.step, time=error.time, state=error.state,
+                       residual=error.residual)
 
 
 def input_slots(module):
@@ -146,7 +202,8 @@ def controlled_run(module, method, apply):
         stepper = importlib.import_module(f"lagrange_gen.steppers.methods.{method}")
         spec = registry.spec(method)
         n_saved = spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                               getattr(module, "N_CONTACTS", 0))
+                               getattr(module, "N_CONTACTS", 0),
+                               getattr(module, "N_NONHOLONOMIC", 0))
         kern, n_events = module, module.N_EVENTS
         if spec.adaptive:
             raise SimulationError(f"inputs from a controller or a signal need a fixed-step method; "
@@ -212,6 +269,10 @@ def _check_size(module, controller, t0, q0, v0, p, names):
         raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns "
                               f"{u.size} value(s) at t0 for {len(names)} input(s) "
                               f"({', '.join(names)})")
+    bad = [f"{name} = {value!r}" for name, value in zip(names, u.tolist()) if not math.isfinite(value)]
+    if bad:
+        raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns a "
+                              f"non-finite input at t0 = {t0:g}: input {', '.join(bad)}")
 
 
 def attach_inputs_outputs(traj, module, p, hook, data):
@@ -226,13 +287,14 @@ def attach_inputs_outputs(traj, module, p, hook, data):
     u = np.tile(p[first:], (rows, 1))
     y = np.zeros((rows, n_out))
     pk = p.copy()
+    outputs = unchecked(module.outputs) if n_out else None      # arrays made here, one call a row
     for r in range(rows):
         q, v = np.ascontiguousarray(traj.q[r]), np.ascontiguousarray(traj.v[r])
         if hook is not None:
             hook(data, float(traj.t[r]), q, v, pk)
             u[r] = pk[first:]
         if n_out:
-            module.outputs(q, v, float(traj.t[r]), pk, y[r])
+            outputs(q, v, float(traj.t[r]), pk, y[r])
     for j, name in enumerate(module.PARAMS[first:]):
         traj.saved[f"input_{name}"] = u[:, j:j + 1].copy()
     for j, name in enumerate(getattr(module, "OUTPUTS", ())):

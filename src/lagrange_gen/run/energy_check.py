@@ -73,7 +73,8 @@ def energy_scale(module, q, t, energy, p):
 def is_conservative(module, q0, v0, t0, p):
     """True when the model's energy E(q, v, t) is conserved by its flow (module docstring)."""
     if (getattr(module, "N_ELEMENTS", 0) or getattr(module, "N_CONSTRAINTS", 0)
-            or getattr(module, "N_CONTACTS", 0)):       # impacts and friction dissipate
+            or getattr(module, "N_CONTACTS", 0)         # impacts and friction dissipate
+            or getattr(module, "N_NONHOLONOMIC", 0)):   # rheonomic ones do work
         return False
     rng = np.random.default_rng(0)
     n = module.N_COORDS

@@ -124,23 +124,33 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
                               f"fixed-step methods only (e.g. rk4, midpoint, verlet)")
     on_gpu = _check_device(device, dtype, client)
     run = None if on_gpu else _ensemble_glue(module, method)
+    if client is not None:
+        from .ensemble_dask import check_client
+        check_client(client)
     h = check_times(spec, h, t0, t_end, save_every, None)
     config = make_settings(spec, settings)
     if on_gpu:
         from ..gpu.launch import check_gpu_request
         check_gpu_request(module, method, dtype, config)
     M = member_count(module, q0, v0, params)
-    q, v = member_states(module, "q0", q0, M), member_states(module, "v0", v0, M)
-    p = member_params(module, params, M)
-    for i in range(M) if getattr(module, "N_ELEMENTS", 0) else ():
-        run_checks.check_element_coefficients(module, p[i])
+    if M < 1:
+        raise SimulationError(f"{module.NAME}: an ensemble of 0 members: the per-member inputs "
+                              f"(q0, v0 (M, n), params arrays (M,)) are empty")
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_steps = n_steps_to(t0, t_end, h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     n, n_saved = module.N_COORDS, spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS,
-                                               module.N_ELEMENTS, getattr(module, "N_CONTACTS", 0))
+                                               module.N_ELEMENTS, getattr(module, "N_CONTACTS", 0),
+                                               getattr(module, "N_NONHOLONOMIC", 0))
     rows = run_checks.saved_rows(n_steps, save_every)
-    check_ensemble_memory(module.NAME, M, n_steps, save_every, n, n_saved)
+    # Before the member tables: for 1e9 members q0 alone is 16 GB.
+    check_ensemble_memory(module.NAME, M, n_steps, save_every, n, n_saved, module.N_PARAMS)
+    q, v = member_states(module, "q0", q0, M), member_states(module, "v0", v0, M)
+    p = member_params(module, params, M)
+    for i in range(M) if getattr(module, "N_ELEMENTS", 0) else ():
+        run_checks.check_element_coefficients(module, p[i])
+    for i in range(M) if getattr(module, "N_CONTACTS", 0) else ():
+        run_checks.check_contact_coefficients(module, p[i], q[i])
     out = allocate_outputs(M, rows, n, n_saved)
     if spec.constraints:
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
@@ -194,19 +204,19 @@ def _ensemble_glue(module, method):
     return run
 
 
-def ensemble_bytes(M, rows, n, n_saved):
+def ensemble_bytes(M, rows, n, n_saved, n_params=0):
     """Bytes an ensemble holds at its peak: per member and row q, v, stats, extra, and the
-    energy / Newton copies of the result."""
-    return M * rows * 8 * (2 * n + N_STATS + n_saved + 3)
+    energy / Newton copies of the result; per member its q0, v0 and parameters."""
+    return M * rows * 8 * (2 * n + N_STATS + n_saved + 3) + M * 8 * (2 * n + n_params)
 
 
-def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved):
+def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved, n_params=0):
     """Refuse, before allocating, an ensemble whose saved rows do not fit in the memory available
     now (run_checks.check_memory with the ensemble's bytes), saying how much it needs and which
     save_every fits."""
     rows = run_checks.saved_rows(n_steps, save_every)
     run_checks.check_memory(model, n_steps, save_every, n, n_saved,
-                            need=ensemble_bytes(M, rows, n, n_saved),
+                            need=ensemble_bytes(M, rows, n, n_saved, n_params),
                             what=f"an ensemble of {M} members saving {rows} states each")
 
 
@@ -263,7 +273,8 @@ def _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time
     status, steps = out["status"][:, 0].copy(), out["status"][:, 1].copy()
     last = out["last"]
     layout = spec.saved_layout(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                               getattr(module, "N_CONTACTS", 0))
+                               getattr(module, "N_CONTACTS", 0),
+                               getattr(module, "N_NONHOLONOMIC", 0))
     saved = {name: out["extra"][:, :, a:a + w] for name, a, w in layout}
     energy = out["stats"][:, :, STAT_ENERGY].copy()
     if "element_state" in saved:

@@ -18,6 +18,8 @@ import math
 import tempfile
 from pathlib import Path
 
+from ..errors import SimulationError
+
 #: Target seconds of work per task (Dask's overhead per task is about a millisecond) and the
 #: step cost used to size chunks before anything is measured (rk4 on the cart pendulum: ~2e-7 s).
 CHUNK_SECONDS = 0.5
@@ -76,6 +78,18 @@ def run_chunk(path, source, key, method, q, v, p, t0, h, n_steps, save_every, se
     finally:
         set_num_threads(before)
     return {k: out[k] for k in ("q", "v", "stats", "extra", "last", "status")}
+
+
+def check_client(client):
+    """Refuse, before anything is allocated, a client that cannot take tasks: closed (or
+    closing), or not a dask.distributed Client at all; one SimulationError line."""
+    status = getattr(client, "status", None)
+    if status is None or not hasattr(client, "submit"):
+        raise SimulationError(f"client= must be a dask.distributed Client, got "
+                              f"{type(client).__name__}")
+    if status != "running":
+        raise SimulationError(f"the Dask client is {status} (closed clients take no tasks); "
+                              f"open a new one, e.g. distributed.Client(cluster)")
 
 
 def run_on_client(client, module, method, q, v, p, t0, h, n_steps, save_every, settings, out,

@@ -8,11 +8,12 @@ agree. Inputs given once, q0 or v0 (n,) and scalar parameters, are shared by eve
 
 from __future__ import annotations
 
-import itertools
+import math
 
 import numpy as np
 
 from ..errors import SimulationError
+from .memory import available_memory
 from .params import resolve_params
 
 
@@ -28,9 +29,16 @@ def grid(**axes):
         if not arr.size:
             raise SimulationError(f"grid axis {name!r} is empty")
         values[name] = arr
-    points = list(itertools.product(*values.values()))
-    table = np.array(points, dtype=np.float64).reshape(len(points), len(values))
-    return {name: np.ascontiguousarray(table[:, j]) for j, name in enumerate(values)}
+    points = math.prod(arr.size for arr in values.values())
+    need = 2 * points * len(values) * 8          # the columns and meshgrid's copies
+    free = available_memory()
+    if free is not None and need > free:
+        sizes = " x ".join(str(arr.size) for arr in values.values())
+        raise SimulationError(f"grid of {sizes} = {points} points needs {need / 1e9:.3g} GB of "
+                              f"memory and {free / 1e9:.3g} GB is available; use fewer values "
+                              f"per axis")
+    columns = np.meshgrid(*values.values(), indexing="ij")      # first axis varies slowest
+    return {name: np.ascontiguousarray(col.reshape(-1)) for name, col in zip(values, columns)}
 
 
 def member_count(module, q0, v0, params):

@@ -12,6 +12,7 @@ from pathlib import Path
 from ..codegen.keys import check_current, read_key
 from ..errors import GenerationError, StaleModuleError
 from . import model_cache
+from ..jit.cache import GENERATED_MODULE_PREFIX
 
 
 def import_generated(path):
@@ -21,7 +22,7 @@ def import_generated(path):
     if not path.is_file():
         raise GenerationError(f"{path}: no generated module here (run lagrange-gen on its model)")
     # The name must be the same in every process: numba's cache refers to globals by module name.
-    name = f"lagrange_gen_generated_{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
+    name = f"{GENERATED_MODULE_PREFIX}{hashlib.sha1(str(path).encode()).hexdigest()[:12]}_{path.stem}"
     cached = sys.modules.get(name)
     # The file may have been regenerated since this process imported it: then import it again;
     # otherwise the module's own import-time check runs again (its model may have changed).
@@ -141,6 +142,7 @@ def kernel_call_args(module):
     import numpy as np
     n, m, ne = module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS
     nc = getattr(module, "N_CONTACTS", 0)
+    nr = getattr(module, "N_NONHOLONOMIC", 0)
     q, w, lam, we = np.zeros(n), np.zeros(n), np.zeros(m), np.zeros(ne)
     p = np.ones(module.N_PARAMS)
     A, B, v = np.empty((n, n)), np.empty((n, n)), np.empty(n)
@@ -157,6 +159,7 @@ def kernel_call_args(module):
         "elements_hessian": (q, we, p, A),
         "contacts": (q, 0.0, p, np.empty(nc), np.empty((nc, n)), np.empty((nc, n)),
                      np.empty((nc, 2))),
+        "nonholonomic": (q, q, 0.0, p, np.empty((nr, n)), np.empty(nr), np.empty(nr)),
         "forward_dynamics": (q, q, 0.0, p, A, v),
         "events": (q, q, 0.0, p, np.empty(getattr(module, "N_EVENTS", 0))),
         "inverse_dynamics": (q, q, q, 0.0, p, v), "gravity_forces": (q, 0.0, p, v),

@@ -12,9 +12,10 @@ very text with this generator, its text and the package sources it compiles are 
 no entry, a record with fields this check does not know, a missing method - goes the ordinary
 way: run the file, re-derive if needed.
 
-Like the derivation record it reads, this never sees data files or helper modules the model
-file reads (``lagrange-gen --check`` re-derives to see them); a record that lists such files
-(issue 34) has fields this check does not know, so such models are run as before.
+The data files the model file read when it was generated are in the record too (their sha256,
+size and mtime): the module serves only while every one is unchanged (keys.changed_data_file,
+which reads a file only when its size or mtime moved). Helper modules the model file imports
+are not recorded: ``lagrange-gen --check`` re-derives to see them.
 """
 
 from __future__ import annotations
@@ -24,10 +25,12 @@ import json
 import os
 from pathlib import Path
 
-from ..codegen.keys import derivation_record_path, generator_hash, model_hash, read_header, why_stale
+from ..codegen.keys import (changed_data_file, derivation_record_path, generator_hash, model_hash,
+                           read_header, why_stale)
 
-#: The fields of a derivation record this check compares (codegen.generate._record).
-_RECORD_FIELDS = {"model", "generator", "options", "key"}
+#: The fields of a derivation record this check compares (codegen.generate._record and the
+#: data files' sizes and times that remember_current adds).
+_RECORD_FIELDS = {"model", "data", "generator", "options", "key", "data_files"}
 
 
 def entry_path(model_path, out_dir, options) -> Path:
@@ -71,7 +74,13 @@ def current_module(model_path, out_dir, methods=None, options=None, freeze=None)
         return None
     if Path(os.path.normpath(target.parent / header["MODEL_PATH"])).resolve() != Path(model_path).resolve():
         return None
-    if record != {"model": model_hash(text), "generator": generator_hash(), "options": disk, "key": header.get("KEY")}:
+    data_files = record.get("data_files")
+    if not isinstance(data_files, dict) or not isinstance(record.get("data"), dict):
+        return None
+    expected = {"model": model_hash(text), "data": {name: rec.get("sha256") for name, rec in data_files.items()
+                                                     if isinstance(rec, dict)},
+                "generator": generator_hash(), "options": disk, "key": header.get("KEY"), "data_files": data_files}
+    if record != expected or changed_data_file(data_files) is not None:
         return None
     if why_stale(target, header.get("KEY"), header["SOURCES"], header.get("TEXT_SHA")):
         return None

@@ -26,7 +26,7 @@ import numpy as np
 from . import checks as run_checks
 from .adaptive_driver import C_ACCEPTED, C_EVALS, C_REJECTED, integrate_adaptive
 from ..codegen.keys import regeneration_command_for
-from .control import attach_inputs_outputs, controlled_run, resolve_inputs
+from .control import attach_inputs_outputs, blame_inputs, controlled_run, resolve_inputs
 from .energy_check import energy_warning
 from ..errors import EnergyWarning, SimulationError
 from .failures import raise_for_status
@@ -169,9 +169,10 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         run = _with_data(controlled_run(module, method, hook), data)
         jit = "specialized"       # the control glue is compiled per model and controller
     run_checks.check_element_coefficients(module, p)
+    run_checks.check_contact_coefficients(module, p, q)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                           getattr(module, "N_CONTACTS", 0))
+                           getattr(module, "N_CONTACTS", 0), getattr(module, "N_NONHOLONOMIC", 0))
     initial = np.zeros(0)
     if keep and not spec.constraints:
         raise SimulationError(f"{module.NAME}: keep= ({', '.join(keep)}) chooses the velocities "
@@ -181,8 +182,13 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
                                            getattr(config, "newton_tol", 1e-12), keep)
     elif spec.contacts:          # (its prepare fills row 0; the contact work starts at 0)
         initial = np.zeros(n_saved)
+    elif spec.nonholonomic:      # v0 onto A v + b = 0; prepare fills row 0
+        from .consistent import nonholonomic_start
+        v = nonholonomic_start(module, q, v, p, t0, stacklevel=3)
+        initial = np.zeros(n_saved)
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
+    run_checks.check_events_at_start(module, q, v, t0, p)
     if spec.adaptive:
         task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit)
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
@@ -191,14 +197,31 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         return attach_inputs_outputs(_adaptive_trajectory(task, out, wanted, wall, compile_time),
                                      module, p, hook, data)
     n_steps = n_steps_to(t0, t_end, h)
+    overshoot = run_checks.step_past_end(module.NAME, method, t0, t_end, h, n_steps)
+    if overshoot:
+        warnings.warn(overshoot, stacklevel=2)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
                  jit=jit)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
-    compile_time, wall = integrate_fixed(task, q, v, out, progress)
-    return attach_inputs_outputs(_trajectory(task, out, wall, compile_time), module, p, hook, data)
+    try:
+        compile_time, wall = integrate_fixed(task, q, v, out, progress)
+    except SimulationError as exc:
+        if hook is None:
+            raise
+        raise blame_inputs(exc, module, task.p, control) from None
+    traj = _trajectory(task, out, wall, compile_time)
+    if overshoot:
+        traj.warnings.insert(0, overshoot)
+    if spec.constraints:
+        violated = run_checks.constraint_violation(module.NAME, method, traj.t, traj.q,
+                                                   traj.saved.get("constraint_error"))
+        if violated:
+            traj.warnings.append(violated)
+            warnings.warn(violated, stacklevel=2)
+    return attach_inputs_outputs(traj, module, p, hook, data)
 
 
 def _with_data(run, data):
@@ -313,7 +336,8 @@ def _has_work(module, spec):
 def _build(task, rows, out, steps, h, wall, compile_time):
     """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
     m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
-    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS, getattr(m, "N_CONTACTS", 0))
+    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS, getattr(m, "N_CONTACTS", 0),
+                               getattr(m, "N_NONHOLONOMIC", 0))
     saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
     energy = rows["stats"][:, STAT_ENERGY].copy()
     if "element_state" in saved:

@@ -17,13 +17,16 @@ Failures raise the exception simulate raises for that status (failures.raise_for
 from __future__ import annotations
 
 import importlib
+import math
 
 import numpy as np
+from .checks import state_vector
 from .control import input_slots
 from ..errors import SimulationError
 from ..jit import njit
 from ..jit.api import jitclass, typeof
 from .failures import raise_for_status
+from .params import is_number
 from ..linear.linearize import parameter_vector
 from ..steppers.core import status as st
 from ..steppers.core import registry
@@ -131,23 +134,31 @@ class Stepper:
     def __init__(self, module, method="midpoint", h=None, params=None, q0=None, v0=None, t0=0.0,
                  **settings):
         from .simulate import load_module
+        if method not in registry.METHODS:
+            raise SimulationError(f"Stepper: unknown method {method!r}; known: "
+                                  f"{', '.join(registry.METHODS)}")
         module = load_module(module, method=method)
         spec = registry.spec(method)
-        if (spec.adaptive or spec.constraints or spec.contacts or getattr(module, "N_ELEMENTS", 0)
-                or module.N_CONSTRAINTS or getattr(module, "N_CONTACTS", 0)):
+        if (spec.adaptive or spec.constraints or spec.contacts or spec.nonholonomic
+                or getattr(module, "N_ELEMENTS", 0) or module.N_CONSTRAINTS
+                or getattr(module, "N_CONTACTS", 0) or getattr(module, "N_NONHOLONOMIC", 0)):
             raise SimulationError(f"Stepper: {method} on {module.NAME}: the step API takes a "
                                   "fixed-step method on a model without constraints, elements "
                                   "or contacts")
-        if h is None or not float(h) > 0:
-            raise SimulationError(f"Stepper: give a step h > 0, got {h!r}")
+        if not (is_number(h) and math.isfinite(h) and h > 0):
+            raise SimulationError(f"Stepper: give a finite step h > 0, got {h!r}")
+        if not (is_number(t0) and math.isfinite(t0)):
+            raise SimulationError(f"Stepper: t0 must be a finite number, got {t0!r}")
         n, (first, k) = module.N_COORDS, input_slots(module)
         self.module, self.method, self.h, self.n_inputs = module, method, float(h), k
         self.settings = make_settings(spec, settings)
         p = parameter_vector(module, params)
-        self.q = np.ascontiguousarray(np.zeros(n) if q0 is None else q0, dtype=np.float64).copy()
-        self.v = np.ascontiguousarray(np.zeros(n) if v0 is None else v0, dtype=np.float64).copy()
+        # The compiled step indexes q and v up to n - 1 without bounds checks.
+        self.q = state_vector("q0", q0, n, module.COORDS).copy()
+        self.v = state_vector("v0", v0, n, module.COORDS).copy()
         self.p = p
         self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
+        self._failure = None        # the message of the failure that ended this stepper
         ws = _workspace(module, method)
         cls = _core_class(module, method, typeof(self.settings), typeof(ws))
         self._core = cls(self.q, self.v, np.zeros(n), p, np.zeros(0), self._clock, self._info,
@@ -167,7 +178,15 @@ class Stepper:
         return np.concatenate((self.q, self.v))
 
     def step(self, u=None, k=1):
-        """Advance k steps with the inputs held at u; returns nothing, raises on failure."""
+        """Advance k steps with the inputs held at u; returns nothing, raises on failure (and
+        on any later call: the state is the failed one)."""
+        if not (is_number(k) and int(k) == k and k >= 1):
+            raise SimulationError(f"Stepper.step: k must be a positive integer (the number of "
+                                  f"steps), got {k!r}")
+        if self._failure is not None:
+            raise SimulationError(f"Stepper: this run failed at t = {self.t:g} ({self._failure}); "
+                                  f"make a new Stepper to start again")
+        k = int(k)
         core = self._core
         if u is None:
             code = core.advance(k)
@@ -180,7 +199,11 @@ class Stepper:
                                       f"{self.n_inputs} input(s)")
             code = core.step_vector(u, k)
         if code:
-            self._check(code, k)
+            try:
+                self._check(code, k)
+            except SimulationError as exc:
+                self._failure = str(exc)
+                raise
 
     def _check(self, code, k):
         if code == st.OK:

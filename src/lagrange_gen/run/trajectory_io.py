@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -63,15 +65,37 @@ def _plain(value):
 
 def read_npz(cls, path):
     """The Trajectory (class ``cls``) written by write_npz; LagrangeGenError naming the file
-    when it is not one."""
+    when it is not one: unreadable, truncated or corrupted (zip, compression), metadata that is
+    not the writer's, or arrays whose lengths disagree."""
     try:
-        with np.load(path, allow_pickle=False) as data:
+        # Opened here so that it is closed whatever np.load makes of it (a file that is not a
+        # zip is left open by numpy, and a ResourceWarning line follows later).
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as data:
             data = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise LagrangeGenError(f"{path}: cannot read as a trajectory .npz ({exc})") from None
-    if "meta" not in data:
-        return _read_legacy(cls, path, data)
+    except (OSError, ValueError, EOFError, TypeError, AttributeError, zipfile.BadZipFile,
+            zlib.error) as exc:        # TypeError: a .npy (an array, not an archive)
+        raise LagrangeGenError(f"{path}: cannot read as a trajectory .npz "
+                               f"({type(exc).__name__}: {_first_line(exc)})") from None
+    try:
+        traj = _read_legacy(cls, path, data) if "meta" not in data else _read_meta(cls, data)
+    except LagrangeGenError:
+        raise
+    except (ValueError, KeyError, TypeError, IndexError, AttributeError) as exc:
+        raise LagrangeGenError(f"{path}: not a trajectory written by lagrange-gen (its metadata "
+                               f"or arrays are damaged: {type(exc).__name__}: "
+                               f"{_first_line(exc)})") from None
+    _check_lengths(path, traj)
+    return traj
+
+
+def _first_line(exc):
+    return (str(exc).splitlines() or [""])[0]
+
+
+def _read_meta(cls, data):
     meta = json.loads(str(data["meta"]))
+    if not isinstance(meta, dict):
+        raise TypeError(f"meta is a {type(meta).__name__}, not a dict")
     kwargs = {}
     for f in dataclasses.fields(cls):
         if f.name == "saved":
@@ -87,6 +111,27 @@ def read_npz(cls, path):
         elif f.name in data:
             kwargs[f.name] = data[f.name]
     return cls(**kwargs)
+
+
+def _check_lengths(path, traj):
+    """Refuse a trajectory whose per-row arrays do not have one row per time, or whose q, v
+    do not have one column per coordinate."""
+    t = np.asarray(traj.t)
+    if t.ndim != 1:
+        raise LagrangeGenError(f"{path}: t has shape {t.shape}, not (S,)")
+    rows, n = len(t), len(traj.coords)
+    for name in ("q", "v"):
+        arr = np.asarray(getattr(traj, name))
+        if arr.shape != (rows, n):
+            raise LagrangeGenError(f"{path}: {name} has shape {arr.shape}, not ({rows}, {n}) for "
+                                   f"{rows} times and the coordinates {', '.join(traj.coords)}")
+    for name in ("energy", "newton_iters", "newton_residual"):
+        arr = np.asarray(getattr(traj, name))
+        if arr.shape != (rows,):
+            raise LagrangeGenError(f"{path}: {name} has shape {arr.shape}, not ({rows},)")
+    for name, arr in traj.saved.items():
+        if len(arr) != rows:
+            raise LagrangeGenError(f"{path}: saved field {name} has {len(arr)} rows for {rows} times")
 
 
 def _read_legacy(cls, path, data):

@@ -10,7 +10,8 @@ method names. A spec says:
 * which models it applies to: ``constraints`` (True: only models with holonomic constraints,
   False: only models without), ``elements`` (treats nonsmooth elements), ``stands_in_for`` (the
   methods it runs in place of on a model with elements: nonsmooth_euler for implicit_euler),
-  ``contacts`` (True: only models with unilateral contacts, False: only models without);
+  ``contacts`` (True: only models with unilateral contacts, False: only models without),
+  ``nonholonomic`` (True: only models with velocity constraints, False: only models without);
 * ``settings``: a NamedTuple class, its fields typed and defaulted; simulate builds one from the
   user's keywords (``make_settings``, validated by the field types and ``limits``) and the jitted
   step reads it by name (``settings.newton_tol``), so numba sees ints as ints and bools as bools;
@@ -18,8 +19,8 @@ method names. A spec says:
   the code, codegen.needs);
 * ``saved``: the named fields the method saves per output row besides (t, q, v, energy, Newton
   iterations and residual), in the order of its ``extra`` buffer, each with a width given as a
-  count name (``"m"`` constraints, ``"ne"`` elements, ``"c"`` contacts, ``"n"`` coordinates)
-  or an int;
+  count name (``"m"`` constraints, ``"ne"`` elements, ``"c"`` contacts, ``"r"`` nonholonomic
+  constraints, ``"n"`` coordinates) or an int;
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
   adaptive signature (codegen/glue.py).
 
@@ -104,6 +105,7 @@ class Spec:
     elements: bool = False
     stands_in_for: tuple = ()
     contacts: bool = False
+    nonholonomic: bool = False
     saved: tuple = ()
     limits: dict = field(default_factory=dict)
     adaptive: bool = False
@@ -122,9 +124,10 @@ class Spec:
         if self.family not in FAMILIES:
             raise ValueError(f"{self.name}: family {self.family!r} is not one of {FAMILIES}")
 
-    def saved_layout(self, n: int, m: int, ne: int, nc: int = 0) -> tuple:
-        """((name, start, width), ...) of the saved fields in the extra buffer (nc contacts)."""
-        counts = {"n": n, "m": m, "ne": ne, "c": nc}
+    def saved_layout(self, n: int, m: int, ne: int, nc: int = 0, nr: int = 0) -> tuple:
+        """((name, start, width), ...) of the saved fields in the extra buffer (nc contacts,
+        nr nonholonomic constraints)."""
+        counts = {"n": n, "m": m, "ne": ne, "c": nc, "r": nr}
         layout, start = [], 0
         for name, width in self.saved:
             w = counts[width] if isinstance(width, str) else int(width)
@@ -132,9 +135,9 @@ class Spec:
             start += w
         return tuple(layout)
 
-    def n_saved(self, n: int, m: int, ne: int, nc: int = 0) -> int:
+    def n_saved(self, n: int, m: int, ne: int, nc: int = 0, nr: int = 0) -> int:
         """Width of the extra buffer (sum of the saved fields' widths)."""
-        return sum(w for _, _, w in self.saved_layout(n, m, ne, nc))
+        return sum(w for _, _, w in self.saved_layout(n, m, ne, nc, nr))
 
     def setting_names(self) -> tuple:
         return tuple(self.settings._fields)

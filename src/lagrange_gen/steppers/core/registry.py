@@ -14,13 +14,17 @@ import importlib
 #: method is declared by its module's SPEC (method_spec.py).
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
            "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
-           "constrained_midpoint", "constrained_implicit_euler", "spook", "index1", "moreau_jean")
+           "constrained_midpoint", "constrained_implicit_euler", "spook", "index1", "moreau_jean",
+           "nonholonomic_rk4")
 
 #: {method: its Spec}.
 INFO = {m: importlib.import_module(f"lagrange_gen.steppers.methods.{m}").SPEC for m in METHODS}
 
 #: Methods for models with holonomic constraints (they save multipliers and residuals).
 CONSTRAINED_METHODS = tuple(m for m in METHODS if INFO[m].constraints)
+
+#: Methods for models with nonholonomic (velocity) constraints.
+NONHOLONOMIC_METHODS = tuple(m for m in METHODS if INFO[m].nonholonomic)
 
 #: Methods that treat nonsmooth elements (SaintVenant, DryFriction).
 NONSMOOTH_METHODS = tuple(m for m in METHODS if INFO[m].elements)
@@ -50,9 +54,17 @@ def runs_as(method: str, n_elements: int) -> str:
     return ON_ELEMENTS.get(method, method) if n_elements else method
 
 
-def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: int = 0) -> str:
+def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: int = 0,
+                 n_nonholonomic: int = 0) -> str:
     """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
     flags = INFO[method]
+    if n_nonholonomic and (n_constraints or n_elements or n_contacts):
+        return ("nonholonomic constraints together with holonomic constraints, nonsmooth "
+                "elements or contacts are not supported by any method yet")
+    if bool(n_nonholonomic) != flags.nonholonomic:
+        return (f"it ignores the model's nonholonomic constraints (use "
+                f"{', '.join(NONHOLONOMIC_METHODS)})" if n_nonholonomic
+                else "it is for models with nonholonomic constraints and this model has none")
     if n_constraints and n_elements:
         return "constraints together with nonsmooth elements are not supported by any method"
     if n_contacts and (n_constraints or n_elements):
@@ -72,9 +84,11 @@ def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: i
     return ""
 
 
-def applicable_methods(n_constraints: int, n_elements: int, n_contacts: int = 0) -> tuple:
+def applicable_methods(n_constraints: int, n_elements: int, n_contacts: int = 0,
+                       n_nonholonomic: int = 0) -> tuple:
     """The methods that apply to a model with these counts, in METHODS order."""
-    return tuple(m for m in METHODS if not inapplicable(m, n_constraints, n_elements, n_contacts))
+    return tuple(m for m in METHODS
+                 if not inapplicable(m, n_constraints, n_elements, n_contacts, n_nonholonomic))
 
 
 #: The jitted loop each kind of method runs in: (module, function).
