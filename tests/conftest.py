@@ -1,7 +1,6 @@
 """Shared fixtures: every model in models/ is generated once per session into a temp dir."""
 
 import json
-from pathlib import Path
 
 import pytest
 
@@ -9,16 +8,7 @@ from lagrange_gen import load_model
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.derive import derive
 from lagrange_gen.run.loader import import_generated
-
-ROOT = Path(__file__).resolve().parent.parent
-MODELS_DIR = ROOT / "models"
-MODEL_FILES = sorted(MODELS_DIR.glob("*.py"))
-#: The 3D robots of models/ (trees of bodies, 6 to 30 coordinates). Their equations written out in
-#: sympy do not fit in memory, so the suites that check every model through sympy or compile every
-#: kernel skip them; tests/derive/test_structured.py and tests/interop/test_pinocchio_trees.py check
-#: the same identities on spatial trees of 2 to 6 bodies.
-ROBOT_MODELS = ("humanoid", "spatial_chain", "ur5")
-
+from lg_test_support import MODELS_DIR
 
 def pytest_addoption(parser):
     """Options of the differential harness (tests/harness/conftest.py says what they do); here,
@@ -28,17 +18,6 @@ def pytest_addoption(parser):
     group.addoption("--printer-bug", action="store_true",
                     help="put the old a/x**2 -> a/x*x printer bug back and count failing examples")
     group.addoption("--harness-summary", metavar="PATH", help="write the harness counts as JSON here")
-
-
-def glue(module, method):
-    """What the tests call instead of ``module.run_<method>`` (same arguments and returns): the
-    portable glue of ``method`` on ``module``'s kernels (lagrange_gen.jit.portable). It is compiled
-    once per method for every model, where each model's own glue compiles the whole stepper
-    again (several seconds per model and method, the bulk of this suite's time).
-    tests/test_portable.py checks, for every method, that the module's own glue gives the same
-    trajectory bit for bit; the step API, control and ensemble tests run the module's own glue."""
-    from lagrange_gen.jit import portable
-    return portable.runner(module, method)
 
 
 @pytest.fixture(scope="session")

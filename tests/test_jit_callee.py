@@ -14,7 +14,7 @@ import sys
 import numpy as np
 from numba.core.registry import CPUDispatcher
 
-from conftest import ROOT
+from lg_test_support import ROOT
 from lagrange_gen import steppers
 from lagrange_gen.jit.cache import njit
 from lagrange_gen.jit.callee import CalleeDispatcher

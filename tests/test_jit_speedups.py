@@ -17,7 +17,7 @@ from numba.core import inline_closurecall
 from numba.core.types.functions import BaseFunction
 
 import lagrange_gen
-from conftest import ROOT
+from lg_test_support import ROOT
 from lagrange_gen.jit import cache, callee, compile_gc, inline_copy, portable, speedups
 from lagrange_gen.jit import typing_memo
 from lagrange_gen.jit.cache import njit

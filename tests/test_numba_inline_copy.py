@@ -14,7 +14,7 @@ from numba.core.compiler import run_frontend
 
 import lagrange_gen.steppers  # noqa: F401
 from lagrange_gen.jit import inline_copy as numba_inline_copy
-from conftest import ROOT
+from lg_test_support import ROOT
 
 
 def _branchy(x, n):

@@ -9,7 +9,7 @@ import sys
 
 from numba import types
 
-from conftest import ROOT
+from lg_test_support import ROOT
 from lagrange_gen.jit import typing_memo as numba_typing_memo
 from lagrange_gen.jit.cache import njit
 

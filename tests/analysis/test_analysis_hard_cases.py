@@ -1,7 +1,7 @@
 """Verdicts of the hard cases (lagrange_gen.analysis.hard_cases) on a few methods: they must come
 out failing for a wrong stepper and passing for a right one. No timing asserts."""
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen.analysis import hard_cases
 
 FAST = ("explicit_euler", "midpoint", "implicit_euler", "rk4")

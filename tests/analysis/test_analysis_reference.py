@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen.analysis import reference
 from lagrange_gen.analysis.runs import params_of
 

@@ -9,7 +9,7 @@ import shutil
 import matplotlib.image as mpimg
 import numpy as np
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen.cli.main import main
 
 

@@ -4,7 +4,7 @@ is recorded as a timeout with the stage it was in, and the report marks goals fr
 
 import json
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen.bench import robots, robots_report
 
 

@@ -5,7 +5,7 @@ import textwrap
 
 import pytest
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen.cli.main import main
 
 HEADER = "import sympy as sp\nfrom lagrange_gen import Model, coordinates, parameters, t\n"

@@ -2,7 +2,7 @@
 
 import pytest
 
-from conftest import MODEL_FILES, ROOT
+from lg_test_support import MODEL_FILES, ROOT
 from lagrange_gen.codegen.generate import is_current
 
 

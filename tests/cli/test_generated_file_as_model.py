@@ -5,7 +5,7 @@ item 7)."""
 
 import pytest
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen import ModelError, load_model
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model

@@ -14,7 +14,7 @@ import textwrap
 
 import pytest
 
-from conftest import MODELS_DIR, ROOT
+from lg_test_support import MODELS_DIR, ROOT
 from lagrange_gen.cli.main import main
 
 CLI = str(ROOT / ".venv" / "bin" / "lagrange-gen")

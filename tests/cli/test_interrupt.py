@@ -17,8 +17,11 @@ LAGRANGE_GEN = Path(sys.executable).parent / "lagrange-gen"
 @pytest.mark.skipif(sys.platform == "win32", reason="SIGINT to a child process")
 def test_ctrl_c_in_a_slow_stage_says_interrupted(tmp_path, monkeypatch):
     monkeypatch.setenv("PYTHONUNBUFFERED", "1")
+    # A pytest-xdist worker ignores SIGINT, and a child inherits that (Python then installs no
+    # KeyboardInterrupt handler): the child gets the default disposition back, as from a shell.
     proc = subprocess.Popen([str(LAGRANGE_GEN), str(ROOT / "models" / "spatial_chain.py"), "-o", str(tmp_path)],
-                            stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     first = proc.stderr.readline()          # the first progress line: a stage still running
     if "running" not in first:              # every stage under 2 s on this machine: nothing to stop
         proc.communicate(timeout=120)

@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from conftest import MODELS_DIR, ROOT
+from lg_test_support import MODELS_DIR, ROOT
 from lagrange_gen import StaleModuleError
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.keys import read_key

@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen import StaleModuleError
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 import lagrange_gen
-from conftest import MODELS_DIR, ROOT
+from lg_test_support import MODELS_DIR, ROOT
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import keys, sources
 from lagrange_gen.codegen import generate_model

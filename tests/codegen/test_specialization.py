@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen import SimulationError, load_model, simulate
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import generate_model, generate_text

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from constraint_util import four_bar_state, generated_model, params, pendulum_state
-from conftest import glue
+from lg_test_support import glue
 from lagrange_gen.run.consistent import initial_multipliers
 from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings

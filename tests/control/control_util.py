@@ -1,5 +1,5 @@
 """The test model of this directory, generated once per session (a fixture the tests import:
-no conftest.py here, whose name would shadow tests/conftest.py for `from conftest import ...`)."""
+no conftest.py here, whose name would shadow tests/conftest.py for `from lg_test_support import ...`)."""
 
 from pathlib import Path
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import MODEL_FILES, ROBOT_MODELS
+from lg_test_support import MODEL_FILES, ROBOT_MODELS
 
 STEMS = [f.stem for f in MODEL_FILES if f.stem not in ROBOT_MODELS]
 

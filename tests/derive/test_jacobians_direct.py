@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen import load_model
 from lagrange_gen.codegen import generate_text
 from lagrange_gen.derive import derive

@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 from sympy.physics import mechanics as me
 
-from conftest import MODELS_DIR
+from lg_test_support import MODELS_DIR
 from lagrange_gen.codegen import generate_text
 from lagrange_gen.run.loader import import_generated
 

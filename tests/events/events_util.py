@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from conftest import glue
+from lg_test_support import glue
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core import registry

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import glue
+from lg_test_support import glue
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.run.loader import import_generated
 

@@ -18,7 +18,7 @@ from lagrange_gen.steppers.core import registry
 from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings
 from lagrange_gen.steppers.core.status import OK
-from conftest import glue
+from lg_test_support import glue
 from stepper_util import HERE, model, params, run  # model is a fixture
 
 # (model, q0, v0, h, steps, bound on the energy error over the first fifth): the double

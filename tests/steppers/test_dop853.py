@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import quad, solve_ivp
 from scipy.special import ellipk
 
-from conftest import glue
+from lg_test_support import glue
 from stepper_util import generated_model, params
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.needs import method_needs

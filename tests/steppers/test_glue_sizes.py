@@ -8,7 +8,7 @@ naming the sizes."""
 import numpy as np
 import pytest
 
-from conftest import glue
+from lg_test_support import glue
 from lagrange_gen.steppers.core import registry
 from lagrange_gen.steppers.core.layout import N_STATS
 from lagrange_gen.steppers.core.method_spec import make_settings
