@@ -3,7 +3,7 @@
 import pytest
 
 from lg_test_support import MODEL_FILES, ROOT
-from lagrange_gen.codegen.generate import is_current
+from lagrange_gen.codegen.generated_files import is_current
 
 
 @pytest.mark.parametrize("model_file", MODEL_FILES, ids=lambda p: p.stem)

@@ -18,7 +18,7 @@ from lg_test_support import MODELS_DIR, ROOT
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen import keys, sources
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.codegen.generate import check_generated
+from lagrange_gen.codegen.generated_files import check_generated
 from lagrange_gen.errors import SimulationError, StaleModuleError
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.steppers.core.registry import CONSTRAINED_METHODS, METHODS, applicable_methods

@@ -164,7 +164,7 @@ def test_frozen_parameters_and_build_options_come_from_the_source(run):
 
 def test_simulate_records_where_the_module_came_from(tmp_path):
     from types import SimpleNamespace
-    from lagrange_gen.run.simulate import _source
+    from lagrange_gen.run.run_result import _source
     module = SimpleNamespace(__file__=str(tmp_path / "gen" / "m.py"), MODEL_PATH="../models/m.py",
                              OPTIONS={"build": {"n": 4}, "methods": ["rk4"]}, FROZEN={"g": 9.81})
     assert _source(module) == {"model_file": str(tmp_path / "models" / "m.py"),

@@ -95,7 +95,7 @@ def warm_stepper_library(models_dir, work, env, limit):
     the cart pendulum generated into ``work`` and one rk4 step); None when it failed."""
     code = ("import sys, time\n"
             "from pathlib import Path\n"
-            "from lagrange_gen.codegen.generate import generate_model\n"
+            "from lagrange_gen.codegen.generated_files import generate_model\n"
             "from lagrange_gen.run.loader import import_generated\n"
             "from lagrange_gen.run.simulate import simulate\n"
             "mod = import_generated(generate_model(Path(sys.argv[1]), Path(sys.argv[2]), methods=['rk4']).path)\n"

@@ -85,7 +85,7 @@ def run_generate(args) -> int:
 
 
 def _generate_one(path, args, methods, options, freeze):
-    from ..codegen.generate import generate_model
+    from ..codegen.generated_files import generate_model
     start = time.perf_counter()
     result = generate_model(path, args.out_dir, methods, options, freeze, force=args.force)
     what = "written" if result.written else "unchanged"
@@ -94,7 +94,7 @@ def _generate_one(path, args, methods, options, freeze):
 
 
 def _check_one(path, args, methods, options, freeze):
-    from ..codegen.generate import check_generated
+    from ..codegen.generated_files import check_generated
     from ..codegen.keys import regeneration_command
     target, problem = check_generated(path, args.out_dir, methods, options, freeze)
     if problem is None:

@@ -1,6 +1,6 @@
 """Code generation stage: Dynamics -> KernelSpecs -> text -> generated/<name>.py, and freshness.
 
-The pipeline (generate), kernel specs (spec), CSE, the printer, rendering, the glue templates
+The pipeline (generate; the file on disk: generated_files), kernel specs (spec), CSE, the printer, rendering, the glue templates
 (glue) and the atomic write live here, and so does what decides whether a generated module is
 current: KEY and the stale check (keys), the package files compiled code is built from
 (sources). keys and sources are imported by generated modules and by the jit layer at run
@@ -11,7 +11,7 @@ sources it reads) steppers.core.registry, never run/, cli/ or viz/.
 
 from importlib import import_module
 
-_LAZY = {"generate_model": "generate", "generate_text": "generate", "output_path": "generate",
+_LAZY = {"generate_model": "generated_files", "generate_text": "generate", "output_path": "generate",
          "read_key": "keys", "KernelSpec": "spec", "make_kernels": "compose"}
 
 __all__ = sorted(_LAZY)

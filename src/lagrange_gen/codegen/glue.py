@@ -105,8 +105,9 @@ ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
 # because numba parallelizes a prange loop only when its body has one exit, and run_loop, once
 # inlined, has several (early returns, a raise). S = saved_rows: the final state gets a row when
 # n_steps is not a multiple of save_every or a terminal event stopped the member, written as
-# simulate's _trajectory writes it, so a member equals simulate's Trajectory. Time rows and
-# events are per-member scratch (the times are the same for every member; events are counted).
+# run_result.fixed_step_trajectory writes it, so a member equals simulate's Trajectory. Time
+# rows and events are per-member scratch (the times are the same for every member; events are
+# counted).
 _ENSEMBLE_GLUE = '''import math as _math
 
 from lagrange_gen.jit.api import prange as _prange

@@ -16,7 +16,7 @@ from .sources import source_hashes
 _PACKAGE = Path(__file__).resolve().parents[1]     # src/lagrange_gen
 # Sources that shape the text generated from a model (equations, kernels, module layout, glue
 # template): a change is seen by re-deriving (--check, load), not by the KEY. Hashed into the
-# record load() keeps next to a module to skip re-deriving (codegen.generate.module_current).
+# record load() keeps next to a module to skip re-deriving (codegen.generated_files.module_current).
 _GENERATOR_PARTS = ("model", "run/params.py", "derive", "codegen", "steppers/core/registry.py")
 # The header lines that record hashes of the rest of the file (a hash cannot hash itself).
 KEY_PREFIX = "KEY = "

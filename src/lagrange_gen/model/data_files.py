@@ -1,7 +1,7 @@
 """The data files a model file reads while it runs (its parameters from a JSON file, a table of
 coefficients): recorded at generation, so that a changed data file makes the generated module
 stale for load, simulate and a direct import, as it is for ``lagrange-gen --check``
-(codegen.generate records them; codegen.keys.changed_data_file checks them on import).
+(codegen.generated_files records them; codegen.keys.changed_data_file checks them on import).
 
 Files are seen through Python's audit hook "open" (sys.addaudithook, installed once on first
 use, recording only inside ``files_read``). Recorded: regular files opened for reading, but not

@@ -41,7 +41,7 @@ def load_model(path, **options) -> Model:
     with files_read(exclude=[path]) as data_files:
         model = _run_model_file(path, options)
     model.source_path = str(path)
-    # What the model read besides its own text: generation records it (codegen.generate).
+    # What the model read besides its own text: generation records it (codegen.generated_files).
     model.data_files = {name: file_record(name) for name in sorted(data_files)}
     model.source_text = source
     model.build_options = dict(options)

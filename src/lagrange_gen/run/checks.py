@@ -11,6 +11,9 @@
   t0 + k h, and the driver saves those times; they must resolve h (TIME_RESOLUTION).
 * Memory for the saved rows (``check_memory``), against the memory this process can still take
   now: MemAvailable, its cgroup's memory limit and RLIMIT_AS (run/memory.py).
+
+Over 300 lines: twenty short checks, each with its one-line messages, kept in one module so
+that simulate, ensemble and Stepper refuse the same inputs the same way.
 """
 
 from __future__ import annotations

@@ -29,6 +29,9 @@ multiplier: their multipliers are not unique, and the methods' Newton matrices a
 The error names the constraints that are dependent (a left null vector of J).
 
 All arrays are numpy: q, v (n,), Phi, lam (m,), J (m, n), H (n, n); p the parameter vector.
+
+Over 300 lines: the projections of positions and velocities, the multipliers, the rank and
+singularity diagnoses and the nonholonomic start share the constraint evaluations above.
 """
 
 from __future__ import annotations

@@ -34,7 +34,7 @@ from ..jit.portable import choose_ensemble, jit_mode
 from ..steppers.core import status as st
 from ..steppers.core import registry
 from ..steppers.core.layout import (N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, T,
-                                    last_size, state_slice)
+                                    state_slice)
 from ..steppers.core.method_spec import make_settings
 
 __all__ = ["ensemble", "grid", "EnsembleResult"]
@@ -278,7 +278,7 @@ def _result(module, spec, out, p, t0, h, n_steps, save_every, wall, compile_time
     saved = {name: out["extra"][:, :, a:a + w] for name, a, w in layout}
     energy = out["stats"][:, :, STAT_ENERGY].copy()
     if "element_state" in saved:
-        from .simulate import element_energy
+        from .run_result import element_energy
         for i in range(p.shape[0]):
             energy[i] += element_energy(module, p[i], saved["element_state"][i])
     messages = {int(i): _message(module, spec, int(status[i]), int(steps[i]), n_steps, last[i],

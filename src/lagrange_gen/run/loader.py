@@ -63,7 +63,7 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True,
     known = None if force else model_cache.current_module(path, out_dir, methods, options, freeze)
     if known is not None:
         return import_generated(known)
-    from ..codegen.generate import generate_model
+    from ..codegen.generated_files import generate_model
     target, plan = _plan(path, out_dir, methods, options, freeze, force)
     if plan is not None:
         why, build, methods, freeze, command = plan
@@ -79,10 +79,10 @@ def _plan(path, out_dir, methods, options, freeze, force):
     """(target, None) when the module on disk serves the request of load(), else (target,
     (why, build, methods, freeze, command)) to generate with. Requested methods that do not
     apply to the model are not added (simulate refuses them, naming why); whether the module
-    on disk is current is codegen.generate.module_current (re-derives only when the model file
+    on disk is current is codegen.generated_files.module_current (re-derives only when the model file
     or the generator changed since that was last decided)."""
-    from ..codegen.generate import (other_source, refuse_overwrite, describe_options, generation_options,
-                                   module_current, output_path, resolve_methods)
+    from ..codegen.generate import generation_options, output_path, resolve_methods
+    from ..codegen.generated_files import describe_options, module_current, other_source, refuse_overwrite
     from ..codegen.keys import read_header, regeneration_command
     from ..model.model_file import load_model
     model = load_model(path, **(options or {}))

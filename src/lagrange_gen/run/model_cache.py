@@ -28,7 +28,7 @@ from pathlib import Path
 from ..codegen.keys import (changed_data_file, derivation_record_path, generator_hash, model_hash,
                            read_header, why_stale)
 
-#: The fields of a derivation record this check compares (codegen.generate._record and the
+#: The fields of a derivation record this check compares (codegen.generated_files._record and the
 #: data files' sizes and times that remember_current adds).
 _RECORD_FIELDS = {"model", "data", "generator", "options", "key", "data_files"}
 

@@ -7,15 +7,14 @@
 The integration itself runs inside the generated module's jitted ``run_<method>`` (see
 codegen/glue.py), driven in chunks by run/fixed_driver.py or, for an adaptive method, by
 run/adaptive_driver.py; this module only checks inputs (run_checks: element coefficients, step count,
-time resolution, memory; the method's settings by its spec), builds the Trajectory from the
-method's declared saved fields, and warns when a conservative run lost its energy
-(run/energy_check.py). What a method is and which models it applies to is read from its spec
+time resolution, memory; the method's settings by its spec) and hands the finished run to
+run/run_result.py, which builds the Trajectory from the method's declared saved fields and warns
+when a conservative run lost its energy (run/energy_check.py). What a method is and which models it applies to is read from its spec
 (steppers/core/method_spec.py), never from its name.
 """
 
 from __future__ import annotations
 
-import math
 import types
 import warnings
 from dataclasses import dataclass
@@ -24,18 +23,15 @@ from pathlib import Path
 import numpy as np
 
 from . import checks as run_checks
-from .adaptive_driver import C_ACCEPTED, C_EVALS, C_REJECTED, integrate_adaptive
+from .adaptive_driver import integrate_adaptive
 from ..codegen.keys import regeneration_command_for
 from .control import attach_inputs_outputs, blame_inputs, controlled_run, resolve_inputs
-from .energy_check import energy_warning
-from ..errors import EnergyWarning, SimulationError
-from .failures import raise_for_status
+from ..errors import SimulationError
 from .fixed_driver import allocate, integrate_fixed, n_steps_to
 from ..jit.portable import choose, jit_mode
-from ..steppers.core import status as st
 from ..steppers.core import registry
-from ..steppers.core.layout import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK, read_last
 from ..steppers.core.method_spec import make_settings
+from .run_result import adaptive_trajectory, fixed_step_trajectory
 from .trajectory import Trajectory
 
 __all__ = ["simulate", "Trajectory", "load_module"]
@@ -88,13 +84,6 @@ def element_method(module, method):
     raise SimulationError(
         f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) "
         f"{', '.join(names)} (no silent regularization); use {use}")
-
-
-def element_energy(module, p, state):
-    """Elastic energy sum_e k_e u_e^2 / 2 stored in the Saint-Venant elements, (S,)."""
-    coef = run_checks.element_coefficients(module, p)
-    k = np.where(coef[:, 2] == 0.0, coef[:, 0], 0.0)
-    return 0.5 * (state**2 * k).sum(axis=1)
 
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
@@ -194,7 +183,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
         out, compile_time, wall = integrate_adaptive(
             task, q, v, initial, t_end, None if wanted is None else wanted[wanted > t0], progress)
-        return attach_inputs_outputs(_adaptive_trajectory(task, out, wanted, wall, compile_time),
+        return attach_inputs_outputs(adaptive_trajectory(task, out, wanted, wall, compile_time),
                                      module, p, hook, data)
     n_steps = n_steps_to(t0, t_end, h)
     overshoot = run_checks.step_past_end(module.NAME, method, t0, t_end, h, n_steps)
@@ -212,7 +201,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         if hook is None:
             raise
         raise blame_inputs(exc, module, task.p, control) from None
-    traj = _trajectory(task, out, wall, compile_time)
+    traj = fixed_step_trajectory(task, out, wall, compile_time)
     if overshoot:
         traj.warnings.insert(0, overshoot)
     if spec.constraints:
@@ -281,107 +270,6 @@ class _Task:
     @property
     def max_iter(self):
         return getattr(self.settings, "max_iter", 0)
-
-
-def _trajectory(task, out, wall, compile_time):
-    """The Trajectory of a finished fixed-step run: times t0 + k h (not accumulated,
-    independent of the chunking), the final state when it is not on a save (or a terminal
-    event stopped the run), energies, and the energy warning."""
-    m, n, h, p = task.module, task.module.N_COORDS, task.h, task.p
-    last, row = out["last"], out["rows"] - 1
-    out["t"][:row + 1] = task.t0 + h * task.save_every * np.arange(row + 1)
-    steps = out["steps"]
-    if steps % task.save_every or steps < task.n_steps:
-        row += 1
-        final = read_last(last, n, with_work=True)
-        q, v = final.q, final.v
-        energy = m.energy(np.ascontiguousarray(q), np.ascontiguousarray(v), float(final.t), p)
-        if not math.isfinite(energy):
-            raise_for_status(st.NON_FINITE, m, task.method, steps, task.n_steps, last,
-                             task.max_iter, h, p)
-        out["t"][row], out["q"][row], out["v"][row] = final.t, q, v
-        out["stats"][row] = (energy, final.iters, final.resid, final.work)
-        out["extra"][row] = final.extra
-    rows = slice(0, row + 1)
-    traj = _build(task, {k: out[k][rows] for k in ("t", "q", "v", "stats", "extra")},
-                  out, steps, h, wall, compile_time)
-    return _warn_energy(task, traj, h, "reduce h")
-
-
-def _adaptive_trajectory(task, out, t_eval, wall, compile_time):
-    """The Trajectory of an adaptive run; with t_eval, only the requested times (row 0, the
-    initial state, only when t_eval starts at t0). h = the mean accepted step."""
-    rows = {k: out[k] for k in ("t", "q", "v", "stats", "extra")}
-    if t_eval is not None and not (len(t_eval) and t_eval[0] == task.t0):
-        rows = {k: a[1:] for k, a in rows.items()}
-    counters = out["counters"]
-    accepted = int(counters[C_ACCEPTED])
-    h = (out["last"][0] - task.t0) / max(accepted, 1)
-    traj = _build(task, rows, out, accepted, h, wall, compile_time)
-    traj.newton_iters[:] = 0.0          # the stats columns hold step counts and error norms
-    traj.newton_residual[:] = 0.0
-    traj.saved["accepted_steps"] = rows["stats"][:, STAT_ITERS:STAT_ITERS + 1].copy()
-    traj.saved["error_norm"] = rows["stats"][:, STAT_RESIDUAL:STAT_RESIDUAL + 1].copy()
-    traj.step_counts = dict(accepted=accepted, rejected=int(counters[C_REJECTED]),
-                            evaluations=int(counters[C_EVALS]))
-    return _warn_energy(task, traj, h, "tighten rtol and atol")
-
-
-def _has_work(module, spec):
-    """Whether the run integrated W (steppers/core/work.py): fixed-step methods on a model whose
-    energy E = T2 - T0 + V is not conserved (WORK; modules generated before it have none)."""
-    return bool(getattr(module, "WORK", False)) and not spec.adaptive
-
-
-def _build(task, rows, out, steps, h, wall, compile_time):
-    """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
-    m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
-    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS, getattr(m, "N_CONTACTS", 0),
-                               getattr(m, "N_NONHOLONOMIC", 0))
-    saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
-    energy = rows["stats"][:, STAT_ENERGY].copy()
-    if "element_state" in saved:
-        energy = energy + element_energy(m, p, saved["element_state"])
-    return Trajectory(t=rows["t"], q=rows["q"], v=rows["v"], energy=energy,
-                      newton_iters=rows["stats"][:, STAT_ITERS].copy(),
-                      newton_residual=rows["stats"][:, STAT_RESIDUAL].copy(), method=spec.name,
-                      h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
-                      coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
-                      compile_time=compile_time, jit=task.ran, saved=saved,
-                      work=rows["stats"][:, STAT_WORK].copy() if _has_work(m, spec) else None,
-                      element_names=tuple(m.ELEMENTS) if spec.elements else (),
-                      constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
-                      events=_events(m, out), source=_source(m))
-
-
-def _source(module):
-    """{model_file (absolute), build options, frozen parameters} of a generated module; {} for a
-    module without MODEL_PATH (hand-made modules in tests)."""
-    if getattr(module, "MODEL_PATH", None) is None:
-        return {}
-    model_file = (Path(module.__file__).parent / module.MODEL_PATH).resolve()
-    return dict(model_file=str(model_file), build=dict(module.OPTIONS.get("build", {})),
-                frozen=dict(getattr(module, "FROZEN", {})))
-
-
-def _events(module, out):
-    """The located events of a run (steppers/core/events.py), () for a model without events."""
-    if not out["n_events"]:
-        return ()
-    from ..steppers.core.events import events_table
-    return events_table(module, out["events"], out["n_events"])
-
-
-def _warn_energy(task, traj, h, advice):
-    if task.controlled:         # driven by its inputs: the premise of a conservative model fails
-        return traj
-    message = energy_warning(task.module, task.method, traj.q, traj.v, traj.t, traj.energy,
-                             task.p, h, advice)
-    if message:
-        traj.warnings.append(message)
-        # stacklevel 4: _warn_energy <- _trajectory <- simulate <- the user's call
-        warnings.warn(message, EnergyWarning, stacklevel=4)
-    return traj
 
 
 def _constrained_start(module, q, v, p, t0, tol, keep=None):

@@ -1,0 +1,197 @@
+"""The generated file on disk: write it from a model file (generate_model), refuse to overwrite
+what another model file or a person wrote, record what it was generated from (the derivation
+record beside numba's cache: model text, data files, generator sources, options, KEY), and
+decide whether it is current: cheaply from that record for ``lagrange_gen.load``
+(module_current, is_current), or by generating the text again for ``--check``
+(check_generated), with a phrase saying why it is stale.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+from pathlib import Path
+
+from ..errors import GenerationError
+from .generate import (GenerationResult, Progress, generate_parts, generate_text, generation_options,
+                       output_path, resolve_methods)
+from .keys import (derivation_record_path, generator_hash, key_of_text, model_hash, read_header,
+                   regeneration_command, text_hash, why_stale)
+from ..model.model_file import load_model
+from .write import write_if_changed
+
+__all__ = ["generate_model", "check_generated", "is_current", "module_current", "remember_current",
+           "refuse_overwrite", "other_source", "describe_options"]
+
+
+def _label(model_path, options):
+    return " ".join([str(model_path)] + [f"--set {k}={v}" for k, v in sorted((options or {}).items())])
+
+
+def generate_model(model_path, out_dir="generated", methods=None, options=None,
+                   freeze=None, force=False) -> GenerationResult:
+    """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched).
+
+    A file there generated from another model file (or not by lagrange-gen) is not overwritten
+    unless ``force`` (GenerationError naming both files)."""
+    progress = Progress(_label(model_path, options))
+    with progress.stage("load model"):
+        model = load_model(model_path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    if not force:
+        refuse_overwrite(model_path, target, model.name)
+    parts = generate_parts(model, out_dir, methods, freeze, progress)
+    with progress.stage("write"):
+        written = write_if_changed(target, parts.text)
+    remember_current(target, model, parts.key, read_header(target)["OPTIONS"])
+    return GenerationResult(target, written, parts.key)
+
+
+def other_source(model_path, target, header):
+    """The model file ``target`` was generated from when it is not ``model_path`` and exists."""
+    recorded = header.get("MODEL_PATH")
+    if not isinstance(recorded, str):
+        return None
+    source = Path(os.path.normpath(target.parent / recorded))
+    if not source.is_file() or source.resolve() == Path(model_path).resolve():
+        return None
+    return source
+
+
+def refuse_overwrite(model_path, target, name):
+    """GenerationError when ``target`` holds something generating ``model_path`` (model ``name``)
+    would destroy: a module generated from another existing model file, or a file that
+    lagrange-gen did not write."""
+    if not target.is_file() or target.stat().st_size == 0:
+        return
+    header = read_header(target)
+    if header is None:
+        raise GenerationError(f"{target} exists and was not written by lagrange-gen: not overwritten "
+                              f"(move it, use another -o DIR, or pass --force)")
+    other = other_source(model_path, target, header)
+    if other is not None:
+        raise GenerationError(f"{target} was generated from {other}, not {model_path} (both define model "
+                              f"{name!r}): not overwritten (rename one model, use another -o DIR, or pass --force)")
+
+
+def _record(model, key, options) -> dict:
+    """What makes re-deriving needless: the same model text, data files it read (their sha256),
+    generator sources, options and KEY."""
+    data = {name: rec.get("sha256") for name, rec in getattr(model, "data_files", {}).items()}
+    return {"model": model_hash(model.source_text), "data": data, "generator": generator_hash(),
+            "options": options, "key": key}
+
+
+def _recorded(path) -> dict:
+    """The record of remember_current at ``path`` without the data files' sizes and mtimes
+    (which only make the import-time check cheap, keys.check_current); {} when unreadable."""
+    record = json.loads(path.read_text())
+    if not isinstance(record, dict):
+        return {}
+    record.pop("data_files", None)
+    return record
+
+
+def remember_current(target, model, key, options):
+    """Record that ``target`` (KEY ``key``) is what ``model`` generates with ``options`` now; the
+    model text's hash goes here, never into the generated file (a comment edit must not change it).
+    Best effort: an unwritable directory only means load() re-derives next time."""
+    path = derivation_record_path(target)
+    try:
+        path.parent.mkdir(exist_ok=True)
+        tmp = path.with_suffix(f".{os.getpid()}.tmp")
+        record = _record(model, key, options)
+        record["data_files"] = getattr(model, "data_files", {})
+        tmp.write_text(json.dumps(record, sort_keys=True))
+        os.replace(tmp, path)
+    except OSError:
+        pass
+
+
+def module_current(model, target, header) -> bool:
+    """True when ``target`` (its ``header``: keys.read_header) is what generating ``model`` with
+    the header's OPTIONS writes now. Cheap when the record of remember_current matches (model
+    text, generator sources, options, KEY); otherwise re-derives and compares the text (about
+    50 ms for the models in models/), recording the answer when current."""
+    options = header.get("OPTIONS")
+    if "SOURCES" not in header or not isinstance(options, dict):
+        return False                      # not a module of this lagrange-gen
+    if why_stale(target, header.get("KEY"), header["SOURCES"], header.get("TEXT_SHA")):
+        return False
+    try:
+        if _recorded(derivation_record_path(target)) == _record(model, header["KEY"], options):
+            return True
+    except (OSError, ValueError):
+        pass
+    try:
+        text, key, _ = generate_text(model, target.parent, options.get("methods"), options.get("freeze"))
+    except GenerationError:
+        return False                      # e.g. methods that no longer apply
+    if text != target.read_text(encoding="utf-8"):
+        return False
+    remember_current(target, model, key, options)
+    return True
+
+
+def is_current(model_path, out_dir="generated", methods=None, options=None, freeze=None):
+    """(target, True when target is what generating the model with these arguments writes now):
+    the decision of load(), re-deriving only when the model file or the generator changed since
+    the last time it was made (module_current); check_generated always re-derives."""
+    model = load_model(model_path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    header = read_header(target)
+    freeze = dict(sorted((freeze or {}).items()))
+    wanted = generation_options(model.build_options, resolve_methods(methods, model), freeze)
+    return target, header is not None and header.get("OPTIONS") == wanted and module_current(model, target, header)
+
+
+def check_generated(model_path, out_dir="generated", methods=None, options=None, freeze=None):
+    """(target, None) when the file on disk is exactly what generating with these arguments would
+    write now, else (target, "missing" or "stale (why)"). Re-derives: a changed data file or
+    helper module the model reads is seen when it changes the equations, and only then."""
+    model = load_model(model_path, **(options or {}))
+    target = output_path(model.name, out_dir)
+    header = read_header(target)
+    if header is None:
+        return target, "stale (not a lagrange-gen module)" if target.exists() else "missing"
+    other = other_source(model_path, target, header)
+    if other is not None:
+        return target, f"stale (generated from {other}, not {model_path})"
+    parts = generate_parts(model, out_dir, methods, freeze)
+    try:
+        on_disk = target.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        return target, f"stale (unreadable: {exc})"
+    if on_disk == parts.text:
+        remember_current(target, model, parts.key, header.get("OPTIONS"))
+        return target, None
+    return target, f"stale ({_difference(header, on_disk, parts.text)})"
+
+
+def _difference(header, on_disk, text):
+    """Why the generated text ``on_disk`` (its ``header``) differs from ``text``, the text
+    generating writes now: a phrase."""
+    if "SOURCES" not in header:
+        return "generated by an older lagrange-gen"
+    if text_hash(on_disk) != header.get("TEXT_SHA") or key_of_text(on_disk) != header.get("KEY"):
+        return "edited by hand since it was generated"
+    new = {}
+    for line in text.split("\n"):
+        name, sep, value = line.partition(" = ")
+        if sep and name in ("OPTIONS", "SOURCES") and name not in new:
+            new[name] = ast.literal_eval(value)
+    if header.get("OPTIONS") != new.get("OPTIONS"):
+        return f"generated with other options: {describe_options(header.get('OPTIONS') or {})}"
+    if header.get("SOURCES") != new.get("SOURCES"):
+        changed = sorted(set((header.get("SOURCES") or {}).items()) ^ set(new["SOURCES"].items()))
+        return f"stepper sources changed: {', '.join(sorted({name for name, _ in changed}))}"
+    return "its equations changed: the model, a file it reads or imports, or the generator changed"
+
+
+def describe_options(options) -> str:
+    """Recorded generation options as command-line options ('--set n=8 --freeze g=1.62'), or
+    'default options'."""
+    command = regeneration_command("M", "generated", options.get("build"), options.get("methods"),
+                                   options.get("freeze"))
+    return command.split(" ", 2)[2] if command.count(" ") >= 2 else "default options"
