@@ -106,13 +106,16 @@ def test_a_moved_project_says_so_not_unreadable(tmp_path):
            "print(m.energy(np.ones(1), np.zeros(1), 0.0, m.DEFAULT_PARAMS.copy()))")
     make = ("import sys; from lagrange_gen.codegen import generate_model;"
             "generate_model(sys.argv[1], sys.argv[2], methods=['rk4'])")
+    # numba's cache beside the module (its __pycache__ moves with the folder): with
+    # NUMBA_CACHE_DIR the entries stay under the old path and the moved module simply misses.
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     subprocess.run([sys.executable, "-c", make, str(models / "damped_oscillator.py"),
-                    str(tmp_path / "old")], check=True, timeout=300)
+                    str(tmp_path / "old")], check=True, timeout=300, env=env)
     subprocess.run([sys.executable, "-c", run, str(tmp_path / "old" / "damped_oscillator.py")],
-                   check=True, timeout=300, capture_output=True)
+                   check=True, timeout=300, capture_output=True, env=env)
     (tmp_path / "old").rename(tmp_path / "new")
     out = subprocess.run([sys.executable, "-c", run, str(tmp_path / "new" / "damped_oscillator.py")],
-                         check=True, timeout=300, capture_output=True, text=True)
+                         check=True, timeout=300, capture_output=True, text=True, env=env)
     assert out.stdout.strip() == "0.5"
     assert "unreadable" not in out.stderr and "moved" in out.stderr, out.stderr
     assert len(out.stderr.strip().splitlines()) == 1, out.stderr
