@@ -77,3 +77,19 @@ def test_frac_and_its_derivative_are_printed_as_sympy_means_them(tmp_path):
     H, rhs = np.empty((1, 1)), np.empty(1)
     mod.dynamics(q, v, 0.0, p, H, rhs)
     assert rhs[0] == pytest.approx(-2.0 * 2.3 - 0.5)
+
+
+def test_a_point_force_at_a_point_with_floor_builds_and_its_jump_does_no_work():
+    """A point force's virtual work differentiates the point: d floor(x)/dx stays unevaluated in
+    the Model's generalized force, and derive sets it to 0 (the model was refused as 'an
+    undefined function or derivative' by the harness's thorough draws)."""
+    import sympy as sp
+
+    from lagrange_gen import Model, PointForce, coordinates
+    from lagrange_gen.derive import derive
+    from lagrange_gen.derive.kinks import settle_derivatives
+    x = coordinates("x")
+    model = Model("floor_point", coords=[x], T=x.d**2 / 2,
+                  forces=[PointForce(point=(x / 2 + sp.floor(x),), force=(sp.Integer(3),))])
+    Q = settle_derivatives(derive(model).Q[0])
+    assert sp.simplify(Q - sp.Rational(3, 2)) == 0

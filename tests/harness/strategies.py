@@ -260,7 +260,8 @@ def _contacts(g):
     for _ in range(g.draw(st.integers(1, 2))):
         gap = g.term() - g.pick(COEFFS)
         if g.draw(st.booleans()):
-            restitution = g.pick(g.params) / (g.pick(g.params) + g.pick(g.params))
+            a, b = g.pick(g.params), g.pick(g.params)
+            restitution = a / (a + b)          # in (0, 1) for positive a, b (the same a twice)
         else:
             restitution = g.pick([sp.Integer(0), sp.Rational(1, 2), sp.Integer(1)])
         friction, slip = sp.S.Zero, None

@@ -17,16 +17,10 @@ import numpy as np
 import sympy as sp
 
 from ..errors import GenerationError
+from ..model.expressions import PIECEWISE_CONSTANT, zero_derivative
 
 __all__ = ["PIECEWISE_CONSTANT", "settle_derivatives", "zero_derivative", "NUMERIC_FUNCTIONS"]
 
-#: Functions constant between their jumps, whose derivative is 0 where it exists.
-PIECEWISE_CONSTANT = (sp.floor, sp.ceiling, sp.sign, sp.Heaviside)
-
-
-def zero_derivative(expr) -> bool:
-    """Whether the unevaluated ``Derivative`` ``expr`` is one of a piecewise-constant function."""
-    return isinstance(expr, sp.Derivative) and isinstance(expr.expr, PIECEWISE_CONSTANT)
 
 
 def _through_floor(derivative):

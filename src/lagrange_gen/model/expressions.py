@@ -242,3 +242,19 @@ def prescriptions(model_name, prescribed, coords, replace):
                              f"or derivative: {expr}")
         out[c] = expr
     return out
+
+
+#: Functions constant between their jumps, whose derivative is 0 where it exists
+#: (derive/kinks.py sets it so; a model may contain it, e.g. from a point force's virtual work).
+PIECEWISE_CONSTANT = (sp.floor, sp.ceiling, sp.sign, sp.Heaviside)
+
+
+def zero_derivative(expr) -> bool:
+    """Whether the unevaluated ``Derivative`` ``expr`` is one of a piecewise-constant function."""
+    return isinstance(expr, sp.Derivative) and isinstance(expr.expr, PIECEWISE_CONSTANT)
+
+
+def settled_later(derivative) -> bool:
+    """Whether derive/kinks.py closes the unevaluated ``derivative``: a piecewise-constant
+    function's (0), or frac's and Mod's (through floor)."""
+    return zero_derivative(derivative) or isinstance(derivative.expr, (sp.frac, sp.Mod))

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
-from .expressions import check_rayleigh, unknown_symbols_hint
+from .expressions import check_rayleigh, settled_later, unknown_symbols_hint
 from .intermediates import expand_intermediates
 from .symbols import Parameter, check_name, t
 
@@ -37,7 +37,8 @@ def check_model(model):
             raise ModelError(f"model {model.name}: {where} uses symbol(s) {', '.join(unknown)} "
                              "that are neither coordinates, velocities, parameters nor t"
                              + unknown_symbols_hint(expr.free_symbols - allowed))
-        if expr.has(sp.Derivative) or expr.atoms(sp.core.function.AppliedUndef):
+        open_derivatives = [d for d in expr.atoms(sp.Derivative) if not settled_later(d)]
+        if open_derivatives or expr.atoms(sp.core.function.AppliedUndef):
             raise ModelError(f"model {model.name}: {where} contains an undefined function or derivative: {expr}")
     moving = [f"{v} ({c}.d)" for c, v in zip(model.coords, model.velocities) if v in model.symbols_of(model.V)]
     if moving:
