@@ -1,10 +1,11 @@
-# Two set-up commands (see README.md): `make demo` runs the main job, `make test` the test suite.
+# Two set-up commands (see README.md): `make demo` runs the main job, `make test` the test suite;
+# `make docs` builds the documentation site into site/.
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test test-lowest-numba generate check bench clean
+.PHONY: demo test test-lowest-numba docs generate check bench clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +26,18 @@ demo: generate
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
+# The documentation site (mkdocs.yml): the docs extra in the same venv, then a strict build (a
+# warning, a broken link or a failing example in examples/ fails it) into site/.
+DOCS_STAMP := $(VENV)/.installed-docs
+
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/pip install --quiet -e '.[docs]'
+	touch $(DOCS_STAMP)
+
+# The two variables quiet the notices mkdocs-material and a plugin print about a future mkdocs 2.
+docs: $(DOCS_STAMP)
+	DISABLE_MKDOCS_2_WARNING=true NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --site-dir site
+
 # The smoke job on the lowest numba pyproject.toml allows (and the numpy it supports), in a venv
 # and caches of its own: generate, every method once (against the portable glue), the jit
 # layer's tests, the import rules.
@@ -44,4 +57,4 @@ test-lowest-numba: $(LOWEST_VENV)/.installed
 		$(LOWEST_VENV)/bin/python -m pytest -q -n 2 --dist loadfile -p no:cacheprovider $(SMOKE_TESTS)
 
 clean:
-	rm -rf $(VENV) $(LOWEST_VENV) out .pytest_cache
+	rm -rf $(VENV) $(LOWEST_VENV) out site .pytest_cache

@@ -8,10 +8,11 @@ Public API (explicit re-exports)::
     from lagrange_gen import ensemble, grid, EnsembleResult
 
 The modelling names load sympy on first use only, so that importing a generated module (which
-imports lagrange_gen for its runtime helpers) stays fast.
+imports lagrange_gen for its runtime helpers) stays fast; ``dir(lagrange_gen)`` lists them all
+the same. ``lagrange_gen.__version__`` is the installed distribution's version.
 """
 
-from importlib import import_module
+from importlib import import_module as _import_module
 
 from .errors import (BlowUp, EnergyWarning, GenerationError, LagrangeGenError, ModelError,
                      NewtonDivergence, SimulationError, SingularMass, SingularNewtonMatrix,
@@ -36,9 +37,31 @@ __all__ = sorted(_LAZY) + [
 ]
 
 
+#: __version__ when the package runs from a source tree that was never installed (no metadata).
+_UNKNOWN_VERSION = "0+unknown"
+
+
+def _installed_version():
+    """The version pip recorded for the lagrange-gen distribution, else _UNKNOWN_VERSION;
+    read on first use of __version__ (importlib.metadata costs an import at startup)."""
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("lagrange-gen")
+    except PackageNotFoundError:
+        return _UNKNOWN_VERSION
+
+
 def __getattr__(name):
     if name in _LAZY:
-        value = getattr(import_module(f".{_LAZY[name]}", __name__), name)
+        value = getattr(_import_module(f".{_LAZY[name]}", __name__), name)
         globals()[name] = value
         return value
+    if name == "__version__":
+        globals()[name] = value = _installed_version()
+        return value
     raise AttributeError(f"module 'lagrange_gen' has no attribute {name!r}")
+
+
+def __dir__():
+    """The module's attributes and every lazy public name (tab completion, ``dir()``)."""
+    return sorted(set(globals()) | set(_LAZY) | {"__version__"})
