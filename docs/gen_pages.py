@@ -41,11 +41,22 @@ def run_example(script, out_dir):
     return done.stdout
 
 
+def title_and_summary(script):
+    """An example's title and one-line summary from its docstring, whose first paragraph reads
+    "Title: what it shows. ..." (the title falls back to the file name)."""
+    doc = ast.get_docstring(ast.parse(script.read_text())) or ""
+    first = " ".join(doc.split("\n\n")[0].split())
+    title, colon, rest = first.partition(": ")
+    if not colon or len(title) > 40:
+        title, rest = script.stem.replace("_", " "), first
+    return title, rest.split(". ")[0].rstrip(".") + "."
+
+
 def example_page(script, stdout, figures):
     source = script.read_text()
     doc = ast.get_docstring(ast.parse(source)) or ""
-    summary, _, rest = doc.partition("\n")
-    lines = [f"# {script.stem.replace('_', ' ').capitalize()}", "", summary, rest, "",
+    title, _ = title_and_summary(script)
+    lines = [f"# {title}", "", doc, "",
              f"Source: `examples/{script.name}` (run from the repository root; this page ran it "
              "when the docs were built).", ""]
     for figure in figures:
@@ -74,8 +85,8 @@ def write_examples():
                     f.write(figure.read_bytes())
             with mkdocs_gen_files.open(f"examples/{script.stem}.md", "w") as f:
                 f.write(example_page(script, stdout, figures))
-            summary = (ast.get_docstring(ast.parse(script.read_text())) or "").split("\n")[0]
-            index.append(f"- [{script.stem}]({script.stem}.md): {summary}")
+            title, summary = title_and_summary(script)
+            index.append(f"- [{title}]({script.stem}.md) (`examples/{script.name}`): {summary}")
     with mkdocs_gen_files.open("examples/index.md", "w") as f:
         f.write("\n".join(index) + "\n")
 

@@ -1,4 +1,4 @@
-"""Contact and impacts: the bouncing ball of models/bouncing_ball.py (gap y >= 0, Newton
+"""Bouncing ball, contact and impacts: the ball of models/bouncing_ball.py (gap y >= 0, Newton
 restitution e = 0.8) stepped by moreau_jean, dropped from 1 m. The apex heights fall as
 e^(2k) h0 and the ball comes to rest at the Zeno time sqrt(2 h0 / g) (1 + e) / (1 - e).
 

@@ -1,8 +1,8 @@
-"""Constraints: the pendulum written in Cartesian coordinates (x, y) with the rod as a
+"""Constrained pendulum: the pendulum written in Cartesian coordinates (x, y) with the rod as a
 holonomic constraint Phi = (x^2 + y^2 - l^2) / 2 = 0 (models/cartesian_pendulum.py). rattle
 holds Phi and J v at the Newton tolerance; index1 (rk4 on the acceleration-level form) lets
-the constraint drift. traj.constraint_error and traj.velocity_constraint_error give max_i |Phi_i| and
-max_i |(J v)_i| per saved state. The multiplier lam is the rod's force: J^T lam = (x, y) lam.
+the constraint drift. traj.constraint_error and traj.velocity_constraint_error give
+max_i |Phi_i| and max_i |(J v)_i| per saved state. The multiplier lam is the rod's force: J^T lam = (x, y) lam.
 
     python examples/constrained_pendulum.py [OUT_DIR]   # writes OUT_DIR/constrained_pendulum.png
 """
@@ -25,7 +25,8 @@ for method in ("rattle", "index1"):
     x, y = traj.q[:, 0], traj.q[:, 1]
     phi = np.abs(x**2 + y**2 - 1.0) / 2                   # l = 1, the model's default
     print(f"{method:7s} max |Phi| = {phi.max():.2e}   max |J v| = "
-          f"{traj.velocity_constraint_error.max():.2e}   lam at t = 0: {traj.multipliers[0, 0]:.3f}")
+          f"{traj.velocity_constraint_error.max():.2e}   "
+          f"lam at t = 0: {traj.multipliers[0, 0]:.3f}")
     ax.semilogy(traj.t, np.maximum(phi, 1e-17), lw=1, label=method)
 ax.set_xlabel("t [s]")
 ax.set_ylabel("|Phi(q)|")

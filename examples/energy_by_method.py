@@ -1,4 +1,4 @@
-"""Choosing a method: the energy error of the double pendulum (a chaotic, conservative model)
+"""Energy by method: the energy error of the double pendulum (a chaotic, conservative model)
 over 20 s with the same step h = 0.01 for four methods. Explicit Euler gains energy without
 bound; rk4 is accurate per step but drifts; midpoint and composition6 are symplectic, so their
 energy error stays bounded however long the run.

@@ -1,4 +1,4 @@
-"""Ensembles: 400 cart pendulums over a grid of spring stiffness k and bob mass m, run in one
+"""Ensemble sweep: 400 cart pendulums over a grid of spring stiffness k and bob mass m, run in one
 parallel numba loop (member i equals simulate with its inputs, bit for bit); the figure shows
 the largest cart excursion over 5 s for each member.
 
