@@ -2,7 +2,8 @@
 holonomic constraint Phi = (x^2 + y^2 - l^2) / 2 = 0 (models/cartesian_pendulum.py). rattle
 holds Phi and J v at the Newton tolerance; index1 (rk4 on the acceleration-level form) lets
 the constraint drift. traj.constraint_error and traj.velocity_constraint_error give
-max_i |Phi_i| and max_i |(J v)_i| per saved state. The multiplier lam is the rod's force: J^T lam = (x, y) lam.
+max_i |Phi_i| and max_i |(J v)_i| per saved state. The multiplier lam is the rod's force:
+J^T lam = (x, y) lam.
 
     python examples/constrained_pendulum.py [OUT_DIR]   # writes OUT_DIR/constrained_pendulum.png
 """
