@@ -1,5 +1,6 @@
 """Every script in examples/ has a page in the docs site's nav and is linked from a hand-written
-page, so none is left out of the site (docs/gen_pages.py runs each one when the site builds)."""
+page (as ../../examples/NAME.py, which docs/repository_links.py points at the example's page), so
+none is left out of the site (docs/gen_pages.py runs each one when the site builds)."""
 import pytest
 
 from lg_test_support import ROOT
@@ -16,5 +17,5 @@ def test_there_are_examples_and_pages():
 def test_example_is_in_the_nav_and_linked_from_a_page(script):
     page = f"examples/{script.stem}.md"
     assert page in (ROOT / "mkdocs.yml").read_text(), f"{page} is not in mkdocs.yml's nav"
-    linked = [p for p in HAND_WRITTEN if f"{script.stem}.md" in p.read_text()]
-    assert linked, f"no page under docs/ links to {page}"
+    linked = [p for p in HAND_WRITTEN if f"examples/{script.name})" in p.read_text()]
+    assert linked, f"no page under docs/ links to examples/{script.name}"
