@@ -19,3 +19,17 @@ def test_example_is_in_the_nav_and_linked_from_a_page(script):
     assert page in (ROOT / "mkdocs.yml").read_text(), f"{page} is not in mkdocs.yml's nav"
     linked = [p for p in HAND_WRITTEN if f"examples/{script.name})" in p.read_text()]
     assert linked, f"no page under docs/ links to examples/{script.name}"
+
+
+def test_every_public_name_is_in_the_api_reference():
+    import lagrange_gen
+    from lagrange_gen import errors
+    page = (ROOT / "docs" / "reference" / "api.md").read_text()
+    targets = [line.split()[1] for line in page.splitlines() if line.startswith("::: ")]
+    documented = {target.rsplit(".", 1)[-1] for target in targets}
+    if "lagrange_gen.errors" in targets:
+        documented |= {name for name in vars(errors) if not name.startswith("_")}
+    if "`lagrange_gen.t`" in page:
+        documented.add("t")
+    missing = sorted(set(lagrange_gen.__all__) - documented)
+    assert not missing, f"docs/reference/api.md does not document {missing}"
