@@ -23,7 +23,6 @@ import mkdocs_gen_files
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 EXAMPLE_TIMEOUT_S = 600
-CLI_COMMANDS = ("", "simulate", "sweep", "equations", "animate", "identify", "bench")
 log = logging.getLogger("mkdocs.gen_pages")
 
 
@@ -95,8 +94,9 @@ def write_cli_help():
     lines = ["# Command-line reference", "",
              "The `--help` of `lagrange-gen` and of each subcommand, as printed by this version "
              "(the [CLI guide](../guides/cli.md) explains them with examples).", ""]
+    from lagrange_gen.cli.main import SUBCOMMANDS
     env = dict(os.environ, COLUMNS="100")
-    for command in CLI_COMMANDS:
+    for command in ("", *SUBCOMMANDS):
         argv = [sys.executable, "-m", "lagrange_gen.cli", *([command] if command else []), "--help"]
         done = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
         if done.returncode != 0:
