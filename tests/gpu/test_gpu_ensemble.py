@@ -43,7 +43,11 @@ def _assert_same(gpu, cpu, rtol=RTOL, atol=ATOL):
                                    atol=atol, equal_nan=True, err_msg=name)
 
 
-@pytest.mark.parametrize("method", registry.GPU_METHODS)
+#: The GPU methods for models without constraints, elements or contacts.
+PLAIN_METHODS = tuple(m for m in registry.GPU_METHODS if not registry.inapplicable(m, 0, 0))
+
+
+@pytest.mark.parametrize("method", PLAIN_METHODS)
 def test_members_equal_the_cpu_ensemble(method):
     """Each GPU method on the cart pendulum: 3 members (their own q0, v0 and k), 11 steps saved
     every 4th (so the last row is the final state, written after the loop)."""
@@ -54,6 +58,54 @@ def test_members_equal_the_cpu_ensemble(method):
     assert gpu.q.shape == cpu.q.shape == (3, 4, 2)
     assert gpu.ok.all()
     _assert_same(gpu, cpu)
+
+
+CARTESIAN = str(ROOT / "generated" / "cartesian_pendulum.py")
+
+#: The other GPU methods, each on a model it applies to: (generated module, members' q0, v0).
+#: The default profile runs one method of each kind; --thorough runs every one.
+KINDS = {
+    # holonomic constraints: a consistent start (|r| = 1, r . v = 0) for each member
+    "rattle": (CARTESIAN, [[0.6, -0.8], [0.8, -0.6]], [[0.8, 0.6], [0.3, 0.4]]),
+    "constrained_midpoint": (CARTESIAN, [[0.6, -0.8], [0.8, -0.6]], [[0.8, 0.6], [0.3, 0.4]]),
+    "constrained_implicit_euler": (CARTESIAN, [[0.6, -0.8]], [[0.8, 0.6]]),
+    "spook": (CARTESIAN, [[0.6, -0.8]], [[0.8, 0.6]]),
+    "index1": (CARTESIAN, [[0.6, -0.8]], [[0.8, 0.6]]),
+    # a dry-friction element: members that stick and that slip
+    "nonsmooth_euler": (str(ROOT / "generated" / "coulomb_oscillator.py"), [[0.05], [1.0]],
+                        [[0.0], [0.0]]),
+    # a unilateral contact: members that hit the floor within the run and one that does not
+    "moreau_jean": (str(ROOT / "generated" / "bouncing_ball.py"), [[1e-3], [2e-3], [1.0]],
+                    [[-1.0], [-0.5], [0.0]]),
+    # velocity constraints
+    "nonholonomic_rk4": (str(ROOT / "generated" / "chaplygin_sleigh.py"), None, None),
+}
+FIRST_OF_KIND = ("rattle", "nonsmooth_euler", "moreau_jean", "nonholonomic_rk4")
+
+
+def test_every_gpu_method_is_tested():
+    assert set(PLAIN_METHODS) | set(KINDS) == set(registry.GPU_METHODS)
+
+
+@pytest.mark.parametrize("method", sorted(KINDS))
+def test_constrained_nonsmooth_and_contact_members_equal_the_cpu(method, request):
+    """The methods with constraints, elements, contacts or velocity constraints: what they save
+    besides q and v (multipliers, residuals, contact impulses, element states) travels through
+    the member's out_extra, so EnsembleResult.saved is compared too."""
+    if method not in FIRST_OF_KIND and not request.config.getoption("thorough", default=False):
+        pytest.skip("one method of each kind by default; --thorough runs every one")
+    path, q0, v0 = KINDS[method]
+    run = dict(t_end=0.006, h=1e-3, save_every=2)
+    if q0 is not None:
+        run.update(q0=q0, v0=v0)
+    cpu = lg.ensemble(path, method, **run)
+    gpu = lg.ensemble(path, method, device="cuda", **run)
+    assert gpu.device != "cpu" and cpu.ok.all()
+    _assert_same(gpu, cpu)
+    assert sorted(gpu.saved) == sorted(cpu.saved) and cpu.saved
+    for name in cpu.saved:
+        np.testing.assert_allclose(gpu.saved[name], cpu.saved[name], rtol=RTOL, atol=ATOL,
+                                   equal_nan=True, err_msg=name)
 
 
 def test_a_model_with_work_and_transport():

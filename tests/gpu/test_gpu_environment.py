@@ -68,22 +68,52 @@ def test_sweep_without_a_gpu_says_so_in_one_line():
     assert len(lines) == 1 and "no usable CUDA GPU" in lines[0], out.stderr
 
 
-@pytest.mark.parametrize("method, dtype", [("rk4", "float64"), ("implicit_euler", "float64"),
-                                           ("rk4", "float32")])
-def test_members_lower_for_the_cuda_target(method, dtype):
-    """The member of rk4 (explicit_rk's core) and implicit Euler (newton.solve, the dense LU
-    solve) on the cart pendulum type and lower for the CUDA target, without an allocation
-    (numba's runtime, NRT, would be called for one)."""
+#: (method, generated model, dtype) lowered by default: an explicit core, the dense LU solve, a
+#: float32 member, and one method of each kind with saved extras; --thorough lowers every GPU
+#: method.
+LOWERED = [("rk4", "cart_pendulum", "float64"), ("implicit_euler", "cart_pendulum", "float64"),
+           ("rk4", "cart_pendulum", "float32"), ("rattle", "cartesian_pendulum", "float64"),
+           ("moreau_jean", "bouncing_ball", "float64")]
+EVERY_KIND = {"constrained_midpoint": "cartesian_pendulum",
+              "constrained_implicit_euler": "cartesian_pendulum", "spook": "cartesian_pendulum",
+              "index1": "cartesian_pendulum", "nonsmooth_euler": "coulomb_oscillator",
+              "nonholonomic_rk4": "chaplygin_sleigh", "explicit_euler": "cart_pendulum",
+              "symplectic_euler": "cart_pendulum", "verlet": "cart_pendulum",
+              "midpoint": "cart_pendulum"}
+THOROUGH = [(m, model, "float64") for m, model in EVERY_KIND.items()]
+
+
+@pytest.mark.parametrize("method, model, dtype", LOWERED + THOROUGH)
+def test_members_lower_for_the_cuda_target(method, model, dtype, request):
+    """The member of the method on the model types and lowers for the CUDA target, without an
+    allocation (numba's runtime, NRT, would be called for one): rk4 (explicit_rk's core),
+    implicit Euler (newton.solve, the dense LU solve), the constrained, nonsmooth, contact and
+    nonholonomic cores with the multipliers and impulses they save."""
+    if (method, model, dtype) not in LOWERED and not request.config.getoption("thorough",
+                                                                             default=False):
+        pytest.skip("--thorough lowers every GPU method")
+    path = str(ROOT / "generated" / f"{model}.py")
     out = _python(
         "import lagrange_gen as lg\n"
         "from lagrange_gen.gpu.lowering import lower_member, missing_hook\n"
+        "from lagrange_gen.steppers.core import registry\n"
         "reason = missing_hook()\n"
         "if reason:\n"
         "    print('SKIP', reason)\n"
         "else:\n"
-        f"    ir = lower_member(lg.import_generated({CART!r}), {method!r}, dtype={dtype!r})\n"
+        f"    module = lg.import_generated({path!r})\n"
+        f"    spec = registry.spec({method!r})\n"
+        "    n_saved = spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,\n"
+        "                           getattr(module, 'N_CONTACTS', 0),\n"
+        "                           getattr(module, 'N_NONHOLONOMIC', 0))\n"
+        f"    ir = lower_member(module, {method!r}, n_saved, dtype={dtype!r})\n"
         "    print('NRT' if 'NRT_' in ir else 'LOWERED', len(ir))\n")
     assert out.returncode == 0, out.stderr[-3000:]
     if out.stdout.startswith("SKIP"):
         pytest.skip(out.stdout.strip())
     assert out.stdout.startswith("LOWERED"), out.stdout
+
+
+def test_every_gpu_method_is_lowered_by_some_profile():
+    from lagrange_gen.steppers.core import registry
+    assert {m for m, _, _ in LOWERED + THOROUGH} == set(registry.GPU_METHODS)

@@ -151,10 +151,10 @@ def ensemble_{method}({table}{wrapped}):
     q0, v0 (M, n); p (M, n_params); out_q, out_v (M, S, n); out_stats (M, S, N_STATS);
     out_extra (M, S, n_saved) (row 0: the initial saved fields); out_last (M, 2 n + 3 +
     n_saved); out_status (M, 3) int64 receives (status, steps_done, n_events) per member.
-    See lagrange_gen.codegen.glue; lagrange_gen.ensemble wraps this."""
-    for i in _prange(q0.shape[0]):
+    See lagrange_gen.codegen.glue; lagrange_gen.ensemble wraps this."""{unpack}
+    for i in _prange(q0.shape[0]):{rebuild}
         status, steps, n_events = _member_{method}(
-            {table}q0[i], v0[i], t0, h, n_steps, save_every, p[i], settings, out_q[i], out_v[i],
+            {table}q0[i], v0[i], t0, h, n_steps, save_every, p[i], {settings}, out_q[i], out_v[i],
             out_stats[i], out_extra[i], out_last[i])
         out_status[i, 0] = status
         out_status[i, 1] = steps
@@ -232,9 +232,36 @@ def _ensemble_source(method, n_saved, n_events, kern, table):
     wrapped = _wrap(ENSEMBLE_GLUE_ARGS, f"def ensemble_{method}(")
     member_args = table + _wrap(_MEMBER_ARGS, f"def _member_{method}(") if table else _MEMBER_ARGS
     loop = "None, " if table else f"_loop_{method}, "      # (portable: run_loop runs the steps)
+    unpack, rebuild, settings = _settings_in_prange(method)
     return _ENSEMBLE_GLUE.format(method=method, wrapped=wrapped, n_saved=n_saved,
                                  n_events=n_events, kern=kern, table=table,
-                                 member_args=member_args, loop=loop)
+                                 member_args=member_args, loop=loop, unpack=unpack,
+                                 rebuild=rebuild, settings=settings)
+
+
+def _settings_in_prange(method):
+    """(lines before the prange loop, a line opening its body, the settings name the body
+    passes): ``settings`` itself, or, for a settings record with a tuple field (index1's
+    baumgarte), the record rebuilt in the body from scalars read before the loop: numba's
+    parallel loop cannot take a homogeneous tuple as an argument of the function it makes of
+    the body."""
+    record = spec(method).settings
+    defaults = record()
+    if not any(isinstance(value, tuple) for value in defaults):
+        return "", "", "settings"
+    lines, fields = [], []
+    for name, value in zip(record._fields, defaults):
+        if isinstance(value, tuple):
+            parts = [f"_s_{name}_{k}" for k in range(len(value))]
+            lines += [f"{part} = settings.{name}[{k}]" for k, part in enumerate(parts)]
+            fields.append(f"({', '.join(parts)},)")
+        else:
+            lines.append(f"_s_{name} = settings.{name}")
+            fields.append(f"_s_{name}")
+    unpack = "".join(f"\n    {line}" for line in lines)
+    rebuild = (f"\n        member_settings = _stepper_{method}.{record.__name__}(\n"
+               f"            {', '.join(fields)})")
+    return unpack, rebuild, "member_settings"
 
 
 _MEMBER_ARGS = "q0, v0, t0, h, n_steps, save_every, p, settings, q, v, stats, extra, last"

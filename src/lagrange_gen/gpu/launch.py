@@ -13,7 +13,7 @@ from ..errors import SimulationError
 from ..steppers.core import layout
 from .cuda_runtime import device_name, is_simulator, load_cuda
 from .kernels import DTYPES, compiled_kernel
-from .member_source import THREADS_PER_BLOCK, refusal
+from .member_source import THREADS_PER_BLOCK, flat_settings, refusal
 
 #: Threads per block under the simulator (it runs one Python thread per CUDA thread of a block).
 SIMULATOR_THREADS_PER_BLOCK = 8
@@ -58,7 +58,7 @@ def run_on_gpu(module, method, q, v, p, t0, h, n_steps, save_every, config, out,
     kernel = compiled_kernel(cuda, module, method, n_saved, dtype)
     threads = SIMULATOR_THREADS_PER_BLOCK if is_simulator(cuda) else THREADS_PER_BLOCK
     M = q.shape[0]
-    settings = tuple(config)
+    settings = flat_settings(method, config)
 
     start = time.perf_counter()
     _launch(cuda, kernel, threads, _first_member(cuda, host), t0, h, 0, save_every, settings)

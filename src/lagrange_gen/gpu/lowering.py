@@ -17,7 +17,7 @@ import contextlib
 
 from .cuda_runtime import import_cuda, is_simulator
 from .kernels import kernel_function
-from .member_source import method_module
+from .member_source import flat_settings, method_module
 
 #: The compute capability lowered for (an A100; H100 is (9, 0)).
 DEFAULT_CC = (8, 0)
@@ -63,7 +63,7 @@ def lower_member(module, method, n_saved=0, dtype="float64", cc=DEFAULT_CC) -> s
     kernel = kernel_function(cuda, module, method, n_saved, dtype)
     real = {"float64": float64, "float32": float32}[dtype]
     a1, a2, a3 = real[::1], real[:, ::1], real[:, :, ::1]
-    settings = method_module(method).SPEC.settings()
+    settings = flat_settings(method, method_module(method).SPEC.settings())
     args = ((a2, a2, types.float64, types.float64, int64, int64, a2)
             + tuple(typeof(value) for value in settings)
             + (a1, a3, a3, a3, a3, a2, int64[:, ::1], a2))

@@ -93,12 +93,33 @@ def member_source(module, method, n_saved) -> str:
         zero_ws=_zero_text("ws", ws), zero_ww=_zero_text("ww", ww))
 
 
+def _setting_widths(method):
+    """[(name, width)] of the method's settings record: width 0 for a scalar, k for a k-tuple
+    (index1's baumgarte = (alpha, beta))."""
+    defaults = method_module(method).SPEC.settings()
+    return [(name, len(value) if isinstance(value, tuple) else 0)
+            for name, value in zip(defaults._fields, defaults)]
+
+
+def flat_settings(method, config) -> tuple:
+    """The settings record ``config`` as the kernel's scalar arguments (tuples spread out): a
+    kernel argument must be a scalar or an array."""
+    flat = []
+    for (name, width), value in zip(_setting_widths(method), config):
+        flat.extend(value if width else (value,))
+    return tuple(flat)
+
+
 def kernel_source(method) -> str:
     """Source text of ``ensemble_kernel(...)``, which runs ``member`` for member i = the
-    thread's index (the settings record passed as its fields: plain scalars)."""
-    settings = method_module(method).SPEC.settings._fields
-    return _KERNEL.format(setting_args="".join(f"s_{name}, " for name in settings),
-                          settings=", ".join(f"s_{name}" for name in settings))
+    thread's index (the settings record passed as scalars, flat_settings, and rebuilt)."""
+    args, fields = [], []
+    for name, width in _setting_widths(method):
+        parts = [f"s_{name}_{k}" for k in range(width)] if width else [f"s_{name}"]
+        args.extend(parts)
+        fields.append(f"({', '.join(parts)},)" if width else parts[0])
+    return _KERNEL.format(setting_args="".join(f"{a}, " for a in args),
+                          settings=", ".join(fields))
 
 
 _TEMPLATE = '''

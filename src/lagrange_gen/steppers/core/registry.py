@@ -34,9 +34,12 @@ ADAPTIVE_METHODS = tuple(m for m in METHODS if INFO[m].adaptive)
 
 #: Methods lagrange_gen.ensemble(..., device="cuda") runs (lagrange_gen.gpu): numba-cuda compiles
 #: their prepare and step, the run loop's steps and the generated kernels for the GPU as they are
-#: (tests/gpu lowers each for the CUDA target). Not yet: the compositions (their workspaces are
-#: built by jitted helpers), dop853 (adaptive), the nonsmooth and constrained methods.
-GPU_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4")
+#: (tests/gpu lowers each for the CUDA target). Not yet: the compositions (their workspace is a
+#: record of records, built by a jitted helper, which the member's local arrays do not express)
+#: and dop853 (adaptive: no fixed-step ensemble runs it).
+GPU_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
+               "rattle", "constrained_midpoint", "constrained_implicit_euler", "spook", "index1",
+               "nonsmooth_euler", "moreau_jean", "nonholonomic_rk4")
 
 #: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
 ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}
