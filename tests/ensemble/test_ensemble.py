@@ -107,6 +107,24 @@ def test_a_tuple_setting_reaches_every_member(cartesian):
     assert stabilized < 0.5 * np.abs(free.saved["constraint_error"][:, -1]).max()
 
 
+def test_members_with_a_nonsmooth_element_equal_simulate(tmp_path_factory):
+    """The Coulomb oscillator (a DryFriction element: nonsmooth_euler runs for implicit_euler):
+    the element's state starts at 0 in every member as in simulate (an ensemble's outputs are
+    NaN until written, and row 0 of the saved fields is the method's initial state), members
+    that slide and one that sticks from the start."""
+    out = tmp_path_factory.mktemp("ensemble_gen_friction")
+    mod = import_generated(generate_model(MODELS / "coulomb_oscillator.py", out,
+                                          methods=["nonsmooth_euler"]).path)
+    q0 = np.array([[1.05], [0.5], [0.05]])
+    ens = lg.ensemble(mod, "implicit_euler", q0=q0, t_end=0.5, h=1e-3, save_every=50)
+    assert ens.ok.all() and ens.method == "nonsmooth_euler"
+    for i in range(3):
+        traj = lg.simulate(mod, "implicit_euler", q0[i], t_end=0.5, h=1e-3, save_every=50)
+        _assert_member_equals(ens, i, traj)
+    # |k x0| = 0.05 <= F_d = 0.1: the third member never moves
+    assert (ens.q[2] == 0.05).all()
+
+
 @pytest.mark.filterwarnings("ignore::lagrange_gen.EnergyWarning")
 def test_failing_member_reported_others_finish(cart):
     q0, v0, k, _ = _members(8, seed=1)

@@ -9,10 +9,13 @@ from ..steppers.core.layout import N_STATS, last_size
 
 
 def allocate_outputs(M, rows, n, n_saved):
-    """Outputs, NaN until written (rows after a member's failure stay NaN)."""
+    """Outputs, NaN until written (rows after a member's failure stay NaN); row 0 of the saved
+    fields is the state a member's method starts from (an element's plastic strain or friction
+    force), 0 as in simulate unless set (a constrained start's multipliers)."""
+    extra = np.full((M, rows, n_saved), np.nan)
+    extra[:, 0] = 0.0
     return dict(q=np.full((M, rows, n), np.nan), v=np.full((M, rows, n), np.nan),
-                stats=np.full((M, rows, N_STATS), np.nan),
-                extra=np.full((M, rows, n_saved), np.nan),
+                stats=np.full((M, rows, N_STATS), np.nan), extra=extra,
                 last=np.zeros((M, last_size(n, n_saved))), status=np.zeros((M, 3), np.int64))
 
 
