@@ -113,8 +113,8 @@ def _model_changed(here, model_relpath, key):
     data_files = record.get("data_files")
     changed = changed_data_file(data_files) if isinstance(data_files, dict) else None
     if changed is not None:
-        return (f"{_shown(changed)} changed since {here} was generated (a data file that "
-                f"{_shown(here.parent / model_relpath)} reads)")
+        return (f"{_shown(changed)} changed since {here} was generated (a data file or helper "
+                f"module that {_shown(here.parent / model_relpath)} reads or imports)")
     return None
 
 
