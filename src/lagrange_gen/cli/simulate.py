@@ -171,7 +171,9 @@ def run(args) -> int:
 def _summary(traj):
     per_step = traj.wall_time / max(traj.n_steps, 1)
     kind = "mean h" if traj.step_counts else "h"
-    print(f"model {traj.model}, method {traj.method}, {kind} = {traj.h:g}, "
+    tolerances = "".join(f", {name} {traj.settings[name]:g}" for name in ("rtol", "atol")
+                         if traj.step_counts and name in traj.settings)
+    print(f"model {traj.model}, method {traj.method}{tolerances}, {kind} = {traj.h:g}, "
           f"{traj.n_steps} steps to t = {traj.t[-1]:.9g}")
     if traj.step_counts:
         print("adaptive: " + ", ".join(f"{k} {v}" for k, v in traj.step_counts.items()))
@@ -186,7 +188,9 @@ def _summary(traj):
         print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
               f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
     elif traj.work is None:
-        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
+        unknown = (", W not tracked: E also changes by the work of forces, damping and explicit "
+                   "time, which only fixed-step methods integrate") if traj.work_note else ""
+        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g}{unknown})")
     else:       # forced, damped or rheonomic: E changes by the work W done on the system
         print(f"max |E - E0 - W| = {traj.max_energy_balance_error:.3e} (E0 = {traj.energy[0]:.9g}, "
               f"final W = {traj.work[-1]:.6g})")
