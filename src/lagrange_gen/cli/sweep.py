@@ -16,6 +16,7 @@ mean the same; cli/main.py wires ``add_parser`` and ``run`` in.
 from __future__ import annotations
 
 import sys
+import time
 
 import numpy as np
 
@@ -54,7 +55,9 @@ def add_parser(subparsers):
                    help="parameters shared by every member, e.g. k=20,m=0.5; repeatable")
     p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
                    help="options passed to the model file's build() (e.g. n=8), repeatable")
-    p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
+    p.add_argument("--save-every", type=int, metavar="K",
+                   help="keep every K-th state (default: every state unless the ensemble would "
+                        "hold more than 256 MB; then the smallest K that fits, said on stderr)")
     p.add_argument("--scalar", default="final_energy", choices=sorted(SCALARS),
                    help="; ".join(f"{k}: {text}" for k, (text, _) in SCALARS.items()))
     p.add_argument("--coord", metavar="NAME", help="coordinate of max_amplitude / final_coord "
@@ -110,6 +113,7 @@ def run(args) -> int:
     if both:
         raise SimulationError(f"parameter {both[0]!r} is given both by --grid and --param")
     options = parse_assignments(args.options, "--set", BUILD, SimulationError)
+    start = time.perf_counter()
     with one_line_warnings():
         model = args.model
         if options:
@@ -120,6 +124,7 @@ def run(args) -> int:
                           save_every=args.save_every, progress=args.progress,
                           out_dir=args.gen_dir, device=args.device, dtype=args.dtype,
                           **given_settings(args))
+    elapsed = time.perf_counter() - start
     coord = _coord_index(result, args.coord)
     scalar = SCALARS[args.scalar][1](result, coord)
     scalar = np.where(result.ok, scalar, np.nan)
@@ -127,8 +132,10 @@ def run(args) -> int:
         print(f"lagrange-gen: failed: {line}", file=sys.stderr)
     print(f"{result.model}, {result.method}: {len(result.status)} members over "
           f"{' x '.join(f'{k} ({len(v)})' for k, v in axes.items())}, "
-          f"{int((~result.ok).sum())} failed, {result.wall_time:.3g} s"
-          + (f" on {result.device}" if result.device != "cpu" else ""))
+          f"{int((~result.ok).sum())} failed; {result.wall_time:.3g} s stepping"
+          + (f" on {result.device}" if result.device != "cpu" else "")
+          + f", {result.compile_time:.3g} s compiling/loading the loop, {elapsed:.3g} s in all "
+            f"(with generating and loading the model)")
     if args.out:
         _write_npz(args.out, result, axes, args.scalar, scalar)
         print(f"wrote {args.out}")
