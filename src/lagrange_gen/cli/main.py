@@ -12,7 +12,7 @@ import sys
 import time
 
 from ..errors import LagrangeGenError
-from .options import BUILD, NUMBER, one_line_warnings, parse_assignments
+from .options import BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments
 
 SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate")
 
@@ -44,12 +44,14 @@ def generate_parser():
     p = argparse.ArgumentParser(
         prog="lagrange-gen",
         description="Derive equations of motion from SymPy model files and write numba kernels "
-                    "into generated/. Subcommands: simulate, sweep, equations, bench, identify "
+                    "into generated/ (see -o). Subcommands: simulate, sweep, equations, bench, identify "
                     "(lagrange-gen SUBCOMMAND --help).",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
-    p.add_argument("-o", "--out-dir", "--gen-dir", default="generated", metavar="DIR", dest="out_dir",
-                   help="directory for generated modules (default: generated)")
+    p.add_argument("-o", "--out-dir", "--gen-dir", metavar="DIR", dest="out_dir",
+                   help="directory for generated modules (default, from any working directory: "
+                        "generated/ beside the folder of a model file in a folder named models/, "
+                        "else generated/ beside the model file)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 when a generated file is missing or stale")
     p.add_argument("--methods", metavar="M1,M2",
@@ -87,7 +89,8 @@ def run_generate(args) -> int:
 def _generate_one(path, args, methods, options, freeze):
     from ..codegen.generated_files import generate_model
     start = time.perf_counter()
-    result = generate_model(path, args.out_dir, methods, options, freeze, force=args.force)
+    result = generate_model(path, out_dir(path, args.out_dir), methods, options, freeze,
+                            force=args.force)
     what = "written" if result.written else "unchanged"
     print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
     return True
@@ -96,11 +99,12 @@ def _generate_one(path, args, methods, options, freeze):
 def _check_one(path, args, methods, options, freeze):
     from ..codegen.generated_files import check_generated
     from ..codegen.keys import regeneration_command
-    target, problem = check_generated(path, args.out_dir, methods, options, freeze)
+    where = out_dir(path, args.out_dir)
+    target, problem = check_generated(path, where, methods, options, freeze)
     if problem is None:
         print(f"{target}: current")
         return True
-    command = regeneration_command(path, args.out_dir, options, methods, freeze)
+    command = regeneration_command(path, where, options, methods, freeze)
     print(f"{target}: {problem}; run {command}")
     return False
 

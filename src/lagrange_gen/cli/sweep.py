@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from ..errors import SimulationError
-from .options import BUILD, one_line_warnings, parse_assignments
+from .options import BUILD, one_line_warnings, out_dir, parse_assignments
 from .simulate import (add_setting_options, given_settings, parse_params,
                            check_output_path)
 from ..steppers.core.registry import METHODS
@@ -64,8 +64,9 @@ def add_parser(subparsers):
                                                    "(default: the first)")
     p.add_argument("--out", metavar="FILE.npz", help="write the ensemble")
     p.add_argument("--plot", metavar="FILE.png", help="picture of the scalar over the grid")
-    p.add_argument("--gen-dir", default="generated", metavar="DIR",
-                   help="where model files are generated (default: generated)")
+    p.add_argument("--gen-dir", metavar="DIR",
+                   help="where model files are generated (default: as lagrange-gen's -o, "
+                        "generated/ beside the model file or its models/ folder)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
     p.add_argument("--device", default="cpu", choices=("cpu", "cuda"),
                    help="cpu: every core; cuda: one GPU thread per member (needs numba-cuda, "
@@ -113,16 +114,17 @@ def run(args) -> int:
     if both:
         raise SimulationError(f"parameter {both[0]!r} is given both by --grid and --param")
     options = parse_assignments(args.options, "--set", BUILD, SimulationError)
+    gen_dir = out_dir(args.model, args.gen_dir)
     start = time.perf_counter()
     with one_line_warnings():
         model = args.model
         if options:
             from ..run.simulate import load_module
-            model = load_module(model, args.gen_dir, args.method, options=options)
+            model = load_module(model, gen_dir, args.method, options=options)
         result = ensemble(model, args.method, q0=args.q0, v0=args.v0,
                           params={**shared, **grid(**axes)}, t_end=args.t_end, h=args.h,
                           save_every=args.save_every, progress=args.progress,
-                          out_dir=args.gen_dir, device=args.device, dtype=args.dtype,
+                          out_dir=gen_dir, device=args.device, dtype=args.dtype,
                           **given_settings(args))
     elapsed = time.perf_counter() - start
     coord = _coord_index(result, args.coord)

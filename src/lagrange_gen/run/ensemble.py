@@ -22,6 +22,7 @@ kept, its rows after the failure are NaN, the other members finish.
 from __future__ import annotations
 
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -29,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import checks as run_checks
-from ..codegen.keys import regeneration_command_for
+from ..codegen.keys import default_generated_dir, regeneration_command_for
 from .ensemble_inputs import grid, member_count, member_params, member_states
 from .ensemble_outputs import allocate_outputs, dataframe, member_args, run_members
 from ..errors import LagrangeGenError, SimulationError
@@ -106,7 +107,7 @@ class EnsembleResult:
 
 
 def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
-             save_every=None, t0=0.0, progress=False, out_dir="generated", client=None,
+             save_every=None, t0=0.0, progress=False, out_dir=None, client=None,
              worker_threads=1, jit=None, device="cpu", dtype="float64", **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
@@ -117,7 +118,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     OUTPUT_BUDGET_BYTES (or a quarter of the available memory), then the smallest save_every
     that fits, with a warning saying so (default_save_every).
     Constrained models: each member's (q0, v0) is made consistent first (lagrange_gen.run.consistent;
-    one warning counts the members moved). Raises SimulationError (one line) on bad input or
+    one warning counts the members moved). out_dir: where a model file is generated (default
+    codegen.keys.default_generated_dir: the same place from any working directory). Raises SimulationError (one line) on bad input or
     when the saved output would not fit in memory; failing members do not raise (failures()).
     client: a dask.distributed Client: the members run as Dask tasks in chunks on its workers,
     each on ``worker_threads`` numba threads (run/ensemble_dask.py); the result is the same.
@@ -134,6 +136,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     jit = jit_mode(jit)
+    if out_dir is None and isinstance(module_or_path, (str, os.PathLike)):
+        out_dir = default_generated_dir(module_or_path)
     module = load_module(module_or_path, out_dir, method)
     method = element_method(module, method)
     from .consistent import check_method
