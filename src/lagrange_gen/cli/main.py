@@ -14,10 +14,12 @@ import time
 from ..errors import LagrangeGenError
 from .options import BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments
 
-SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate")
+SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate", "examples")
 
 _EPILOG = """\
 examples:
+  lagrange-gen examples                           list the example model files
+  lagrange-gen examples cart_pendulum --to models copy one into models/
   lagrange-gen models/cart_pendulum.py            write generated/cart_pendulum.py
   lagrange-gen models/*.py                        every model
   lagrange-gen models/n_link_pendulum.py --set n=8
@@ -34,7 +36,7 @@ examples:
   lagrange-gen animate traj.npz --out traj.gif    the model's draw= along a saved run
 
 A model file builds a lagrange_gen.Model from SymPy expressions and assigns it to `model`
-(see models/cart_pendulum.py). The generated module holds numba kernels (dynamics, energy,
+(`lagrange-gen examples cart_pendulum` copies one to start from). The generated module holds numba kernels (dynamics, energy,
 Jacobians, constraints), forward dynamics and one run_<method> function per stepper; import it,
 or use `lagrange-gen simulate`.
 """
@@ -44,8 +46,8 @@ def generate_parser():
     p = argparse.ArgumentParser(
         prog="lagrange-gen",
         description="Derive equations of motion from SymPy model files and write numba kernels "
-                    "into generated/ (see -o). Subcommands: simulate, sweep, equations, bench, identify "
-                    "(lagrange-gen SUBCOMMAND --help).",
+                    "into generated/ (see -o). Subcommands: simulate, sweep, equations, "
+                    "examples, bench, identify, animate (lagrange-gen SUBCOMMAND --help).",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
     p.add_argument("-o", "--out-dir", "--gen-dir", metavar="DIR", dest="out_dir",
@@ -145,6 +147,8 @@ def _subcommand_parser(name):
         from .equations import add_parser
     elif name == "animate":
         from .animate import add_parser
+    elif name == "examples":
+        from .examples import add_parser
     else:
         from ..bench.cli import add_parser
     add_parser(sub)
@@ -162,6 +166,8 @@ def _run_subcommand(args) -> int:
         from .equations import run
     elif args.command == "animate":
         from .animate import run
+    elif args.command == "examples":
+        from .examples import run
     else:
         from ..bench.cli import run
     return run(args)
