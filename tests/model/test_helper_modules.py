@@ -70,3 +70,22 @@ def test_simulate_sees_the_changed_helper(project, tmp_path):
     _change_helper(project, 9.0)
     second = lg.simulate(project / "helped_osc.py", **run).q[-1, 0]
     assert second == pytest.approx(math.cos(3.0), abs=1e-6)
+
+
+def test_modules_below_the_folder_that_are_not_helpers_stay_imported(tmp_path):
+    """A package installed below the model's folder (a virtual environment inside the project)
+    is not a helper: it is neither recorded nor removed from sys.modules."""
+    site = tmp_path / "venv" / "lib" / "site-packages"
+    site.mkdir(parents=True)
+    (site / "vendored_thing.py").write_text("K = 2.0\n")
+    (tmp_path / "vendored_osc.py").write_text(MODEL.replace("helper_params", "vendored_thing")
+                                              .replace("helped_osc", "vendored_osc"))
+    sys.path.insert(0, str(site))
+    try:
+        model = load_model(tmp_path / "vendored_osc.py")
+        assert model.params[0].default == 2.0
+        assert "vendored_thing" in sys.modules
+        assert not any("vendored_thing" in path for path in model.data_files)
+    finally:
+        sys.path.remove(str(site))
+        sys.modules.pop("vendored_thing", None)

@@ -87,18 +87,25 @@ def _folder_importable(path):
     finally:
         sys.path[:] = saved_path
         for name in set(sys.modules) - known:
-            source = _module_source(sys.modules.get(name))
-            if source is not None and source.startswith(folder + os.sep):
+            source = _helper_source(name, sys.modules.get(name), folder)
+            if source is not None:
                 helpers.add(source)
                 sys.modules.pop(name, None)
 
 
-def _module_source(module):
-    """The real path of a module's .py file, or None (built-in, extension, namespace)."""
+def _helper_source(name, module, folder):
+    """The real path of the .py file of module ``name`` when it was imported from ``folder`` as
+    a helper: its top-level module or package sits directly in the folder (not, say, in a
+    virtual environment below it, nor lagrange_gen itself). Else None."""
     filename = getattr(module, "__file__", None)
-    if not isinstance(filename, str) or not filename.endswith(".py"):
+    top = name.partition(".")[0]
+    if not isinstance(filename, str) or not filename.endswith(".py") or top == "lagrange_gen":
         return None
-    return os.path.realpath(filename)
+    source = os.path.realpath(filename)
+    for root in (os.path.join(folder, top + ".py"), os.path.join(folder, top)):
+        if source == root or source.startswith(root + os.sep):
+            return source
+    return None
 
 
 def _run_model_file(path, options):
