@@ -39,12 +39,14 @@ def test_the_repository_layout_is_unchanged(monkeypatch):
 
 def test_the_default_does_not_depend_on_the_working_directory(project, monkeypatch):
     want = (project / "generated").resolve()
-    for cwd, path in ((project, "models/where_osc.py"), (project / "elsewhere", "../models/where_osc.py"),
+    for cwd, path in ((project, "models/where_osc.py"),
+                      (project / "elsewhere", "../models/where_osc.py"),
                       (project / "models", "where_osc.py")):
         monkeypatch.chdir(cwd)
         assert Path(default_generated_dir(path)).resolve() == want
     loose = project / "elsewhere" / "loose.py"
-    assert Path(default_generated_dir(loose)).resolve() == (project / "elsewhere" / "generated").resolve()
+    want_loose = (project / "elsewhere" / "generated").resolve()
+    assert Path(default_generated_dir(loose)).resolve() == want_loose
 
 
 def test_the_cli_from_another_folder_finds_the_same_module(project, monkeypatch, capsys):

@@ -62,8 +62,8 @@ def test_large_entries_are_printed_through_shared_subexpressions(monkeypatch):
     th1, th2 = coordinates("th1 th2")
     l = parameters("l", defaults=1.0)
     c = sp.cos(th1 - th2)
-    model = Model("shared", coords=[th1, th2], T=l**2 * (th1.d**2 + th2.d**2 + 2 * c * th1.d * th2.d) / 2,
-                  V=-l * sp.cos(th1) - l * sp.cos(th2))
+    T = l**2 * (th1.d**2 + th2.d**2 + 2 * c * th1.d * th2.d) / 2
+    model = Model("shared", coords=[th1, th2], T=T, V=-l * sp.cos(th1) - l * sp.cos(th2))
     text = lg.equations(model, simplify=False).latex()
     where = [s for s in text.splitlines() if s.startswith(r"\xi_{")]
     assert where and r"\xi_{0} = " in where[0]

@@ -51,7 +51,8 @@ def add_parser(subparsers):
         description="Without NAME, list the example model files with their summaries; with "
                     "NAME, copy NAME.py into --to DIR (default: the working directory), ready "
                     "for `lagrange-gen DIR/NAME.py` and `lagrange-gen simulate DIR/NAME.py`.")
-    p.add_argument("name", nargs="?", metavar="NAME", help="the example to copy (e.g. cart_pendulum)")
+    p.add_argument("name", nargs="?", metavar="NAME",
+                   help="the example to copy (e.g. cart_pendulum)")
     p.add_argument("--to", default=".", metavar="DIR",
                    help="folder to copy it into (created if missing; default: .)")
     p.add_argument("--force", action="store_true", help="overwrite a file of that name there")

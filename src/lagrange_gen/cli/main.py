@@ -36,9 +36,10 @@ examples:
   lagrange-gen animate traj.npz --out traj.gif    the model's draw= along a saved run
 
 A model file builds a lagrange_gen.Model from SymPy expressions and assigns it to `model`
-(`lagrange-gen examples cart_pendulum` copies one to start from). The generated module holds numba kernels (dynamics, energy,
-Jacobians, constraints), forward dynamics and one run_<method> function per stepper; import it,
-or use `lagrange-gen simulate`.
+(`lagrange-gen examples cart_pendulum` copies one to start from). The generated module holds
+numba kernels (dynamics, energy, Jacobians, constraints), forward dynamics and one run_<method>
+function per stepper; import it, or use `lagrange-gen simulate`. Generated modules go to
+generated/ beside a models/ folder, else beside the model file, from any working directory.
 """
 
 

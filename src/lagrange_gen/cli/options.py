@@ -1,5 +1,6 @@
 """What every subcommand parses alike: NAME=VALUE lists (--param, --freeze, --set), velocity
-names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one ``lagrange-gen: warning: ...`` line each."""
+names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one
+``lagrange-gen: warning: ...`` line each."""
 
 from __future__ import annotations
 

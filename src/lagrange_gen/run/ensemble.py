@@ -119,8 +119,9 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     that fits, with a warning saying so (default_save_every).
     Constrained models: each member's (q0, v0) is made consistent first (lagrange_gen.run.consistent;
     one warning counts the members moved). out_dir: where a model file is generated (default
-    codegen.keys.default_generated_dir: the same place from any working directory). Raises SimulationError (one line) on bad input or
-    when the saved output would not fit in memory; failing members do not raise (failures()).
+    codegen.keys.default_generated_dir: the same place from any working directory). Raises
+    SimulationError (one line) on bad input or when the saved output would not fit in memory;
+    failing members do not raise (failures()).
     client: a dask.distributed Client: the members run as Dask tasks in chunks on its workers,
     each on ``worker_threads`` numba threads (run/ensemble_dask.py); the result is the same.
     jit: as simulate's (lagrange_gen.jit.portable): "auto" runs the generated ensemble_<method> when
