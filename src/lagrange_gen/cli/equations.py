@@ -12,7 +12,10 @@ def add_parser(subparsers):
         description="Print H qddot + h + g = Q + J^T lambda, Phi(q) = 0 and J qddot = gamma of a "
                     "model file as derived (the matrices of lagrange_gen.equations).")
     p.add_argument("model", metavar="MODEL.py", help="model file")
-    p.add_argument("--latex", action="store_true", help="print LaTeX (one line per matrix)")
+    p.add_argument("--latex", action="store_true",
+                   help="print LaTeX: the assembled equation H qddot + h + g = Q (+ J^T lambda, "
+                        "Phi = 0, J qddot = gamma) in matrix form, one equation per line; large "
+                        "models with their shared subexpressions after it")
     p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
                    help="options passed to the model file's build() (e.g. n=3), repeatable")
     p.add_argument("--no-simplify", action="store_true",

@@ -12,12 +12,14 @@ import sys
 import time
 
 from ..errors import LagrangeGenError
-from .options import BUILD, NUMBER, one_line_warnings, parse_assignments
+from .options import BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments
 
-SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate")
+SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate", "examples")
 
 _EPILOG = """\
 examples:
+  lagrange-gen examples                           list the example model files
+  lagrange-gen examples cart_pendulum --to models copy one into models/
   lagrange-gen models/cart_pendulum.py            write generated/cart_pendulum.py
   lagrange-gen models/*.py                        every model
   lagrange-gen models/n_link_pendulum.py --set n=8
@@ -34,9 +36,10 @@ examples:
   lagrange-gen animate traj.npz --out traj.gif    the model's draw= along a saved run
 
 A model file builds a lagrange_gen.Model from SymPy expressions and assigns it to `model`
-(see models/cart_pendulum.py). The generated module holds numba kernels (dynamics, energy,
-Jacobians, constraints), forward dynamics and one run_<method> function per stepper; import it,
-or use `lagrange-gen simulate`.
+(`lagrange-gen examples cart_pendulum` copies one to start from). The generated module holds
+numba kernels (dynamics, energy, Jacobians, constraints), forward dynamics and one run_<method>
+function per stepper; import it, or use `lagrange-gen simulate`. Generated modules go to
+generated/ beside a models/ folder, else beside the model file, from any working directory.
 """
 
 
@@ -44,12 +47,14 @@ def generate_parser():
     p = argparse.ArgumentParser(
         prog="lagrange-gen",
         description="Derive equations of motion from SymPy model files and write numba kernels "
-                    "into generated/. Subcommands: simulate, sweep, equations, bench, identify "
-                    "(lagrange-gen SUBCOMMAND --help).",
+                    "into generated/ (see -o). Subcommands: simulate, sweep, equations, "
+                    "examples, bench, identify, animate (lagrange-gen SUBCOMMAND --help).",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
-    p.add_argument("-o", "--out-dir", "--gen-dir", default="generated", metavar="DIR", dest="out_dir",
-                   help="directory for generated modules (default: generated)")
+    p.add_argument("-o", "--out-dir", "--gen-dir", metavar="DIR", dest="out_dir",
+                   help="directory for generated modules (default, from any working directory: "
+                        "generated/ beside the folder of a model file in a folder named models/, "
+                        "else generated/ beside the model file)")
     p.add_argument("--check", action="store_true",
                    help="write nothing; exit 1 when a generated file is missing or stale")
     p.add_argument("--methods", metavar="M1,M2",
@@ -87,7 +92,8 @@ def run_generate(args) -> int:
 def _generate_one(path, args, methods, options, freeze):
     from ..codegen.generated_files import generate_model
     start = time.perf_counter()
-    result = generate_model(path, args.out_dir, methods, options, freeze, force=args.force)
+    result = generate_model(path, out_dir(path, args.out_dir), methods, options, freeze,
+                            force=args.force)
     what = "written" if result.written else "unchanged"
     print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
     return True
@@ -96,11 +102,12 @@ def _generate_one(path, args, methods, options, freeze):
 def _check_one(path, args, methods, options, freeze):
     from ..codegen.generated_files import check_generated
     from ..codegen.keys import regeneration_command
-    target, problem = check_generated(path, args.out_dir, methods, options, freeze)
+    where = out_dir(path, args.out_dir)
+    target, problem = check_generated(path, where, methods, options, freeze)
     if problem is None:
         print(f"{target}: current")
         return True
-    command = regeneration_command(path, args.out_dir, options, methods, freeze)
+    command = regeneration_command(path, where, options, methods, freeze)
     print(f"{target}: {problem}; run {command}")
     return False
 
@@ -141,6 +148,8 @@ def _subcommand_parser(name):
         from .equations import add_parser
     elif name == "animate":
         from .animate import add_parser
+    elif name == "examples":
+        from .examples import add_parser
     else:
         from ..bench.cli import add_parser
     add_parser(sub)
@@ -158,6 +167,8 @@ def _run_subcommand(args) -> int:
         from .equations import run
     elif args.command == "animate":
         from .animate import run
+    elif args.command == "examples":
+        from .examples import run
     else:
         from ..bench.cli import run
     return run(args)

@@ -1,5 +1,6 @@
 """What every subcommand parses alike: NAME=VALUE lists (--param, --freeze, --set), velocity
-names (--keep), and warnings turned into one ``lagrange-gen: warning: ...`` line each."""
+names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one
+``lagrange-gen: warning: ...`` line each."""
 
 from __future__ import annotations
 
@@ -52,6 +53,14 @@ def _convert(name, value, kind, option, item, error):
         # Worded as the run checks word a non-finite parameter given through the Python API.
         raise error(f"{option} {item}: parameter {name!r} = {value} is not finite")
     return number
+
+
+def out_dir(model_path, given):
+    """The folder for the modules of ``model_path``: ``given`` (-o / --gen-dir), else the model
+    file's default (codegen.keys.default_generated_dir), which does not depend on the working
+    directory."""
+    from ..codegen.keys import default_generated_dir
+    return default_generated_dir(model_path) if given is None else given
 
 
 def velocity_names(values):

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ..errors import SimulationError
 from ..jit.portable import JIT_MODES
-from .options import BUILD, NUMBER, one_line_warnings, parse_assignments, velocity_names
+from .options import BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments, velocity_names
 from ..steppers.core.method_spec import SETTING_HELP
 from ..steppers.core.registry import INFO, METHODS
 
@@ -62,8 +62,9 @@ def add_parser(subparsers):
     p.add_argument("--out", metavar="FILE", help="write the trajectory (.npz or .csv)")
     p.add_argument("--plot", metavar="FILE.png",
                    help="plot coordinates and energy error (.png, .pdf or .svg)")
-    p.add_argument("--gen-dir", default="generated", metavar="DIR",
-                   help="where model files are generated (default: generated)")
+    p.add_argument("--gen-dir", metavar="DIR",
+                   help="where model files are generated (default: as lagrange-gen's -o, "
+                        "generated/ beside the model file or its models/ folder)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
     p.add_argument("--jit", choices=JIT_MODES,
                    help="compiled loop: specialized (the model's kernels inlined: fastest steps, "
@@ -154,14 +155,15 @@ def run(args) -> int:
     params = parse_params(args.param)
     options = parse_assignments(args.options, "--set", BUILD, SimulationError)
     keep = velocity_names(args.keep)
+    gen_dir = out_dir(args.model, args.gen_dir)
     with one_line_warnings():       # one line each, also when the run then fails
         model = args.model
         if options:
-            model = load_module(model, args.gen_dir, args.method, args.force, options=options)
+            model = load_module(model, gen_dir, args.method, args.force, options=options)
         traj = simulate(model, args.method, args.q0, args.v0, t_end=args.t_end,
                         h=args.h, params=params, save_every=args.save_every,
                         t_eval=args.t_eval, t0=args.t0, progress=args.progress,
-                        out_dir=args.gen_dir, force=args.force, keep=keep, jit=args.jit,
+                        out_dir=gen_dir, force=args.force, keep=keep, jit=args.jit,
                         **given_settings(args))
     _summary(traj)
     _write_outputs(traj, args.out, args.plot)
@@ -171,7 +173,9 @@ def run(args) -> int:
 def _summary(traj):
     per_step = traj.wall_time / max(traj.n_steps, 1)
     kind = "mean h" if traj.step_counts else "h"
-    print(f"model {traj.model}, method {traj.method}, {kind} = {traj.h:g}, "
+    tolerances = "".join(f", {name} {traj.settings[name]:g}" for name in ("rtol", "atol")
+                         if traj.step_counts and name in traj.settings)
+    print(f"model {traj.model}, method {traj.method}{tolerances}, {kind} = {traj.h:g}, "
           f"{traj.n_steps} steps to t = {traj.t[-1]:.9g}")
     if traj.step_counts:
         print("adaptive: " + ", ".join(f"{k} {v}" for k, v in traj.step_counts.items()))
@@ -186,7 +190,9 @@ def _summary(traj):
         print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
               f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
     elif traj.work is None:
-        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
+        unknown = (", W not tracked: E also changes by the work of forces, damping and explicit "
+                   "time, which only fixed-step methods integrate") if traj.work_note else ""
+        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g}{unknown})")
     else:       # forced, damped or rheonomic: E changes by the work W done on the system
         print(f"max |E - E0 - W| = {traj.max_energy_balance_error:.3e} (E0 = {traj.energy[0]:.9g}, "
               f"final W = {traj.work[-1]:.6g})")

@@ -16,11 +16,12 @@ mean the same; cli/main.py wires ``add_parser`` and ``run`` in.
 from __future__ import annotations
 
 import sys
+import time
 
 import numpy as np
 
 from ..errors import SimulationError
-from .options import BUILD, one_line_warnings, parse_assignments
+from .options import BUILD, one_line_warnings, out_dir, parse_assignments
 from .simulate import (add_setting_options, given_settings, parse_params,
                            check_output_path)
 from ..steppers.core.registry import METHODS
@@ -54,15 +55,18 @@ def add_parser(subparsers):
                    help="parameters shared by every member, e.g. k=20,m=0.5; repeatable")
     p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
                    help="options passed to the model file's build() (e.g. n=8), repeatable")
-    p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
+    p.add_argument("--save-every", type=int, metavar="K",
+                   help="keep every K-th state (default: every state unless the ensemble would "
+                        "hold more than 256 MB; then the smallest K that fits, said on stderr)")
     p.add_argument("--scalar", default="final_energy", choices=sorted(SCALARS),
                    help="; ".join(f"{k}: {text}" for k, (text, _) in SCALARS.items()))
     p.add_argument("--coord", metavar="NAME", help="coordinate of max_amplitude / final_coord "
                                                    "(default: the first)")
     p.add_argument("--out", metavar="FILE.npz", help="write the ensemble")
     p.add_argument("--plot", metavar="FILE.png", help="picture of the scalar over the grid")
-    p.add_argument("--gen-dir", default="generated", metavar="DIR",
-                   help="where model files are generated (default: generated)")
+    p.add_argument("--gen-dir", metavar="DIR",
+                   help="where model files are generated (default: as lagrange-gen's -o, "
+                        "generated/ beside the model file or its models/ folder)")
     p.add_argument("--progress", action="store_true", help="show a progress bar on stderr")
     p.add_argument("--device", default="cpu", choices=("cpu", "cuda"),
                    help="cpu: every core; cuda: one GPU thread per member (needs numba-cuda, "
@@ -110,16 +114,19 @@ def run(args) -> int:
     if both:
         raise SimulationError(f"parameter {both[0]!r} is given both by --grid and --param")
     options = parse_assignments(args.options, "--set", BUILD, SimulationError)
+    gen_dir = out_dir(args.model, args.gen_dir)
+    start = time.perf_counter()
     with one_line_warnings():
         model = args.model
         if options:
             from ..run.simulate import load_module
-            model = load_module(model, args.gen_dir, args.method, options=options)
+            model = load_module(model, gen_dir, args.method, options=options)
         result = ensemble(model, args.method, q0=args.q0, v0=args.v0,
                           params={**shared, **grid(**axes)}, t_end=args.t_end, h=args.h,
                           save_every=args.save_every, progress=args.progress,
-                          out_dir=args.gen_dir, device=args.device, dtype=args.dtype,
+                          out_dir=gen_dir, device=args.device, dtype=args.dtype,
                           **given_settings(args))
+    elapsed = time.perf_counter() - start
     coord = _coord_index(result, args.coord)
     scalar = SCALARS[args.scalar][1](result, coord)
     scalar = np.where(result.ok, scalar, np.nan)
@@ -127,8 +134,10 @@ def run(args) -> int:
         print(f"lagrange-gen: failed: {line}", file=sys.stderr)
     print(f"{result.model}, {result.method}: {len(result.status)} members over "
           f"{' x '.join(f'{k} ({len(v)})' for k, v in axes.items())}, "
-          f"{int((~result.ok).sum())} failed, {result.wall_time:.3g} s"
-          + (f" on {result.device}" if result.device != "cpu" else ""))
+          f"{int((~result.ok).sum())} failed; {result.wall_time:.3g} s stepping"
+          + (f" on {result.device}" if result.device != "cpu" else "")
+          + f", {result.compile_time:.3g} s compiling/loading the loop, {elapsed:.3g} s in all "
+            f"(with generating and loading the model)")
     if args.out:
         _write_npz(args.out, result, axes, args.scalar, scalar)
         print(f"wrote {args.out}")

@@ -16,8 +16,8 @@ from pathlib import Path
 from ..errors import GenerationError
 from .generate import (GenerationResult, Progress, generate_parts, generate_text, generation_options,
                        output_path, resolve_methods)
-from .keys import (derivation_record_path, generator_hash, key_of_text, model_hash, read_header,
-                   regeneration_command, text_hash, why_stale)
+from .keys import (default_generated_dir, derivation_record_path, generator_hash, key_of_text,
+                   model_hash, read_header, regeneration_command, text_hash, why_stale)
 from ..model.model_file import load_model
 from .write import write_if_changed
 
@@ -29,12 +29,14 @@ def _label(model_path, options):
     return " ".join([str(model_path)] + [f"--set {k}={v}" for k, v in sorted((options or {}).items())])
 
 
-def generate_model(model_path, out_dir="generated", methods=None, options=None,
+def generate_model(model_path, out_dir=None, methods=None, options=None,
                    freeze=None, force=False) -> GenerationResult:
     """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched).
+    out_dir None: keys.default_generated_dir of the model file.
 
     A file there generated from another model file (or not by lagrange-gen) is not overwritten
     unless ``force`` (GenerationError naming both files)."""
+    out_dir = default_generated_dir(model_path) if out_dir is None else out_dir
     progress = Progress(_label(model_path, options))
     with progress.stage("load model"):
         model = load_model(model_path, **(options or {}))
@@ -134,10 +136,11 @@ def module_current(model, target, header) -> bool:
     return True
 
 
-def is_current(model_path, out_dir="generated", methods=None, options=None, freeze=None):
+def is_current(model_path, out_dir=None, methods=None, options=None, freeze=None):
     """(target, True when target is what generating the model with these arguments writes now):
     the decision of load(), re-deriving only when the model file or the generator changed since
     the last time it was made (module_current); check_generated always re-derives."""
+    out_dir = default_generated_dir(model_path) if out_dir is None else out_dir
     model = load_model(model_path, **(options or {}))
     target = output_path(model.name, out_dir)
     header = read_header(target)
@@ -146,10 +149,11 @@ def is_current(model_path, out_dir="generated", methods=None, options=None, free
     return target, header is not None and header.get("OPTIONS") == wanted and module_current(model, target, header)
 
 
-def check_generated(model_path, out_dir="generated", methods=None, options=None, freeze=None):
+def check_generated(model_path, out_dir=None, methods=None, options=None, freeze=None):
     """(target, None) when the file on disk is exactly what generating with these arguments would
     write now, else (target, "missing" or "stale (why)"). Re-derives: a changed data file or
     helper module the model reads is seen when it changes the equations, and only then."""
+    out_dir = default_generated_dir(model_path) if out_dir is None else out_dir
     model = load_model(model_path, **(options or {}))
     target = output_path(model.name, out_dir)
     header = read_header(target)
@@ -192,6 +196,6 @@ def _difference(header, on_disk, text):
 def describe_options(options) -> str:
     """Recorded generation options as command-line options ('--set n=8 --freeze g=1.62'), or
     'default options'."""
-    command = regeneration_command("M", "generated", options.get("build"), options.get("methods"),
+    command = regeneration_command("M", None, options.get("build"), options.get("methods"),
                                    options.get("freeze"))
     return command.split(" ", 2)[2] if command.count(" ") >= 2 else "default options"

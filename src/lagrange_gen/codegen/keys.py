@@ -113,8 +113,8 @@ def _model_changed(here, model_relpath, key):
     data_files = record.get("data_files")
     changed = changed_data_file(data_files) if isinstance(data_files, dict) else None
     if changed is not None:
-        return (f"{_shown(changed)} changed since {here} was generated (a data file that "
-                f"{_shown(here.parent / model_relpath)} reads)")
+        return (f"{_shown(changed)} changed since {here} was generated (a data file or helper "
+                f"module that {_shown(here.parent / model_relpath)} reads or imports)")
     return None
 
 
@@ -196,15 +196,27 @@ def read_header(path) -> dict | None:
     return header
 
 
-def regeneration_command(model_path, out_dir="generated", build=None, methods=None, freeze=None) -> str:
+def default_generated_dir(model_path) -> Path:
+    """Where the modules generated from ``model_path`` go unless -o / out_dir= says otherwise,
+    the same from any working directory: ``<project>/generated`` for a model file in a folder
+    named ``models`` (this repository's layout: models/x.py -> generated/x.py), else
+    ``generated`` beside the model file. Relative to the working directory when below it."""
+    folder = Path(os.path.abspath(model_path)).parent
+    base = folder.parent if folder.name == "models" else folder
+    return Path(_shown(base / "generated"))
+
+
+def regeneration_command(model_path, out_dir=None, build=None, methods=None, freeze=None) -> str:
     """The shell command that generates ``model_path`` into ``out_dir`` with these options
-    (paths quoted; -o omitted for generated/, --methods for the methods that apply to the
-    model, the default): the one source of every "run lagrange-gen ..." hint."""
+    (paths quoted; -o omitted for the model's default_generated_dir, and for out_dir None;
+    --methods omitted for the methods that apply to the model, the default): the one source of
+    every "run lagrange-gen ..." hint."""
     from ..steppers.core.registry import METHODS, applicable_methods
     defaults = [set(applicable_methods(*counts))
                 for counts in ((0, 0, 0, 0), (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))]
     args = ["lagrange-gen", str(model_path)]
-    if os.path.normpath(str(out_dir)) != "generated":
+    if out_dir is not None and (os.path.abspath(out_dir)
+                                != os.path.abspath(default_generated_dir(model_path))):
         args += ["-o", str(out_dir)]
     for name, value in sorted((build or {}).items()):
         args += ["--set", f"{name}={value}"]

@@ -39,7 +39,10 @@ def write_if_changed(path, text: str) -> bool:
             _remove_dead_writers_temp_files(path)
             tmp, fd = _create_temp(path)
         except OSError as exc:
-            raise GenerationError(f"{directory}: cannot write generated files here ({exc.strerror})") from None
+            raise GenerationError(f"{directory}: cannot write generated files here "
+                                  f"({exc.strerror}); choose another folder with -o DIR "
+                                  f"(lagrange-gen) or out_dir= (lagrange_gen.load, simulate, "
+                                  f"ensemble)") from None
         try:
             with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
                 fh.write(text)

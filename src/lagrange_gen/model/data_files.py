@@ -6,7 +6,8 @@ stale for load, simulate and a direct import, as it is for ``lagrange-gen --chec
 Files are seen through Python's audit hook "open" (sys.addaudithook, installed once on first
 use, recording only inside ``files_read``). Recorded: regular files opened for reading, but not
 the model file itself, Python source or bytecode (imports), nor files of the Python
-installation or of installed packages, which are not the model's data.
+installation or of installed packages, which are not the model's data. (The helper modules a
+model file imports from its own folder are recorded beside these by model/model_file.py.)
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ from .expressions import (Event, convert_dynamicsymbols, equation_as_expr, is_me
 from .loads import DryFriction, PointForce, SaintVenant
 from .contacts import Contact, check_contacts, named_contacts
 from .nonholonomic import check_nonholonomic
-from .symbols import Coordinate, Parameter, Velocity, check_name, coordinates, parameters, t
+from .symbols import Coordinate, Parameter, Velocity, check_name, coordinates, inputs, parameters, t
 
 __all__ = [
     "Coordinate", "Velocity", "Parameter", "PointForce", "SaintVenant", "DryFriction", "Contact", "Event",
@@ -28,14 +28,6 @@ __all__ = [
     "Drawing",
     "coordinates", "parameters", "t", "inputs",
 ]
-
-
-def inputs(names, defaults=None):
-    """Declare control inputs, e.g. ``u = inputs("u")``: parameters that a Model lists in
-    ``inputs=`` (the trailing slots of its parameter vector, written by the run loop from a
-    controller or a signal before each step; see lagrange_gen.run.control). Without a default
-    (``defaults`` as for parameters()) a run must supply the input."""
-    return parameters(names, defaults)
 
 
 class Model:

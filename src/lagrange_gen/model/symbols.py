@@ -12,7 +12,7 @@ import sympy as sp
 
 from ..errors import ModelError
 
-__all__ = ["Coordinate", "Velocity", "Parameter", "coordinates", "parameters", "t"]
+__all__ = ["Coordinate", "Velocity", "Parameter", "coordinates", "parameters", "inputs", "t"]
 
 #: The time symbol. Forces and potentials may depend on it; T and constraints may not.
 t = sp.Symbol("t", real=True)
@@ -66,60 +66,89 @@ class Parameter(sp.Symbol):
 
 
 def _split_names(names):
+    """(names, as_tuple): the names of a string (spaces or commas between them) or a sequence;
+    as_tuple when a string ends in a comma, which asks for a tuple even of one name, as
+    sympy.symbols does (``s, = coordinates("s,")``)."""
     if isinstance(names, str):
-        names = names.replace(",", " ").split()
-    return list(names)
+        return names.replace(",", " ").split(), names.rstrip().endswith(",")
+    return list(names), False
+
+
+def _shaped(symbols, as_tuple):
+    """What a declaration returns: a tuple when asked (a trailing comma), else the symbol of a
+    single name or the list of several."""
+    if as_tuple:
+        return tuple(symbols)
+    return symbols[0] if len(symbols) == 1 else symbols
 
 
 def coordinates(names):
-    """Create generalized coordinates from a space-separated string, e.g. ``coordinates("x theta")``.
+    """Create generalized coordinates from a string of names, e.g. ``coordinates("x theta")``.
 
-    Returns a list of :class:`Coordinate` (a single one when one name is given).
+    Returns a list of :class:`Coordinate`, a single one when one name is given, or a tuple
+    when the string ends in a comma (``s, = coordinates("s,")``, as sympy.symbols).
     """
-    coords = [Coordinate(n) for n in _split_names(names)]
-    return coords[0] if len(coords) == 1 else coords
+    listed, as_tuple = _split_names(names)
+    for n in listed:
+        check_name("coordinate", n, where=f"coordinates({' '.join(listed)!r})")
+    return _shaped([Coordinate(n) for n in listed], as_tuple)
 
 
 def parameters(names, defaults=None):
     """Declare parameters, e.g. ``parameters("m l g", defaults=(1.0, 1.0, 9.81))``.
 
-    ``defaults`` may be a sequence (same length), a dict by name, a number (one name), or None
-    (values required at simulation time); each default is a finite number or None. Every call
-    declares new parameters (see :class:`Parameter`). Returns a list of :class:`Parameter` (a
-    single one when one name is given).
+    ``defaults`` may be a sequence (same length), a dict by name, one number (the default of
+    every name), or None (values required at simulation time); each default is a finite number
+    or None. Every call declares new parameters (see :class:`Parameter`). Returns a list of
+    :class:`Parameter`, a single one when one name is given, or a tuple when the string ends in
+    a comma.
     """
-    names = _split_names(names)
-    for n in names:
-        check_name("parameter", n)
-    params = [Parameter(n, next(_declarations), _finite_default(n, v))
-              for n, v in zip(names, _default_values(names, defaults))]
-    return params[0] if len(params) == 1 else params
+    return declare(names, defaults, "parameters")
 
 
-def _default_values(names, defaults):
+def inputs(names, defaults=None):
+    """Declare control inputs, e.g. ``u = inputs("u")``: parameters that a Model lists in
+    ``inputs=`` (the trailing slots of its parameter vector, written by the run loop from a
+    controller or a signal before each step; see lagrange_gen.run.control). ``defaults`` as
+    for parameters() (``inputs("tau1 tau2", defaults=0.0)``); without a default a run must
+    supply the input."""
+    return declare(names, defaults, "inputs")
+
+
+def declare(names, defaults, function):
+    """The parameters that ``function`` ("parameters" or "inputs", named in its messages)
+    declares."""
+    listed, as_tuple = _split_names(names)
+    where = f"{function}({' '.join(listed)!r})"
+    kind = "input" if function == "inputs" else "parameter"
+    for n in listed:
+        check_name(kind, n, where=where)
+    params = [Parameter(n, next(_declarations), _finite_default(n, v, kind))
+              for n, v in zip(listed, _default_values(listed, defaults, where))]
+    return _shaped(params, as_tuple)
+
+
+def _default_values(names, defaults, where):
     """One default (unchecked) per name from the forms parameters() accepts."""
-    listed = " ".join(names)
     if defaults is None:
         return [None] * len(names)
     if isinstance(defaults, dict):
         unknown = sorted(set(map(str, defaults)) - set(names))
         if unknown:
-            raise ModelError(f"parameters({listed!r}): defaults given for {', '.join(unknown)}, "
+            raise ModelError(f"{where}: defaults given for {', '.join(unknown)}, "
                              "which is not declared here")
         return [defaults.get(n) for n in names]
     if isinstance(defaults, (str, bytes)) or not hasattr(defaults, "__iter__"):
-        if len(names) == 1:
-            return [defaults]
-        raise ModelError(f"parameters({listed!r}): defaults must be a sequence of {len(names)} "
-                         f"numbers, a dict by name or None, got {defaults!r}")
+        return [defaults] * len(names)      # one default for every name
     values = list(defaults)
     if len(values) != len(names):
-        raise ModelError(f"parameters({listed!r}): {len(names)} names but {len(values)} defaults")
+        raise ModelError(f"{where}: {len(names)} names but {len(values)} defaults")
     return values
 
 
-def _finite_default(name, value):
-    """``value`` as a float, or None; ModelError naming the parameter unless finite."""
+def _finite_default(name, value, kind="parameter"):
+    """``value`` as a float, or None; ModelError naming the parameter (or input) unless
+    finite."""
     if value is None:
         return None
     try:
@@ -127,11 +156,13 @@ def _finite_default(name, value):
     except (TypeError, ValueError):
         number = math.nan
     if not math.isfinite(number):
-        raise ModelError(f"parameter {name}: default {value!r} is not a finite number "
+        raise ModelError(f"{kind} {name}: default {value!r} is not a finite number "
                          "(give a finite number, or None for a value required at run time)")
     return number
 
 
-def check_name(kind, name):
+def check_name(kind, name, where=None):
+    """ModelError unless ``name`` is a Python identifier (``where``: the call that gave it)."""
     if not name.isidentifier() or keyword.iskeyword(name):
-        raise ModelError(f"{kind} name {name!r} is not a valid Python identifier")
+        prefix = f"{where}: " if where else ""
+        raise ModelError(f"{prefix}{kind} name {name!r} is not a valid Python identifier")

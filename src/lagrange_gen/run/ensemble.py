@@ -5,6 +5,11 @@
                       t_end=10, h=1e-3, save_every=100)
     ens.q            # (M, S, n)
     ens.failures()   # ["member 17: cart_pendulum, explicit_euler: step 312 of 1000 ..."]
+    ens.to_dataframe()   # pandas: one row per member and saved state
+
+Without save_every, every step is saved unless that would hold more than OUTPUT_BUDGET_BYTES
+(or a quarter of the memory available): then the smallest save_every that fits is chosen and
+one warning line says which.
 
 The members run in the generated module's ``ensemble_<method>`` (codegen/glue.py): one
 numba parallel loop over members, each member run_loop.run_loop exactly as ``run_<method>`` runs it
@@ -17,6 +22,7 @@ kept, its rows after the failure are NaN, the other members finish.
 from __future__ import annotations
 
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -24,13 +30,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import checks as run_checks
-from ..codegen.keys import regeneration_command_for
+from ..codegen.keys import default_generated_dir, regeneration_command_for
 from .ensemble_inputs import grid, member_count, member_params, member_states
-from .ensemble_outputs import allocate_outputs, member_args, run_members
+from .ensemble_outputs import allocate_outputs, dataframe, member_args, run_members
 from ..errors import LagrangeGenError, SimulationError
 from .failures import raise_for_status
 from .fixed_driver import ProgressBar, n_steps_to
+from ..jit.compile_notice import first_use_notice
 from ..jit.portable import choose_ensemble, jit_mode
+from .memory import available_memory
 from ..steppers.core import status as st
 from ..steppers.core import registry
 from ..steppers.core.layout import (N_STATS, STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, T,
@@ -42,6 +50,10 @@ __all__ = ["ensemble", "grid", "EnsembleResult"]
 #: With a progress bar, members run in batches of at least this many per thread (a batch ends
 #: when its slowest member does, so batches of one member per thread would idle threads).
 MEMBERS_PER_THREAD = 32
+
+#: Without save_every, the saved output (ensemble_bytes) is kept under this many bytes, and under
+#: a quarter of the memory available.
+OUTPUT_BUDGET_BYTES = 256 * 2**20
 
 
 @dataclass
@@ -87,18 +99,29 @@ class EnsembleResult:
         """["member i: <the message simulate would raise>", ...] for the failed members."""
         return [f"member {i}: {self.messages[i]}" for i in sorted(self.messages)]
 
+    def to_dataframe(self):
+        """A long (tidy) pandas.DataFrame, one row per member and saved state (M S rows):
+        member, the parameters (param_names), t, the coordinates, their velocities (name_dot)
+        and energy. pandas is the optional extra ``lagrange-gen[dataframe]``."""
+        return dataframe(self)
+
 
 def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
-             save_every=1, t0=0.0, progress=False, out_dir="generated", client=None,
+             save_every=None, t0=0.0, progress=False, out_dir=None, client=None,
              worker_threads=1, jit=None, device="cpu", dtype="float64", **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
     q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
     array} (see grid), or an (M, n_params) table in PARAMS order; settings: the method's settings
     by name (as simulate), shared. M comes from the per-member inputs, which must agree.
+    save_every: keep every save_every-th step; None: every step unless the output would exceed
+    OUTPUT_BUDGET_BYTES (or a quarter of the available memory), then the smallest save_every
+    that fits, with a warning saying so (default_save_every).
     Constrained models: each member's (q0, v0) is made consistent first (lagrange_gen.run.consistent;
-    one warning counts the members moved). Raises SimulationError (one line) on bad input or
-    when the saved output would not fit in memory; failing members do not raise (failures()).
+    one warning counts the members moved). out_dir: where a model file is generated (default
+    codegen.keys.default_generated_dir: the same place from any working directory). Raises
+    SimulationError (one line) on bad input or when the saved output would not fit in memory;
+    failing members do not raise (failures()).
     client: a dask.distributed Client: the members run as Dask tasks in chunks on its workers,
     each on ``worker_threads`` numba threads (run/ensemble_dask.py); the result is the same.
     jit: as simulate's (lagrange_gen.jit.portable): "auto" runs the generated ensemble_<method> when
@@ -114,6 +137,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     jit = jit_mode(jit)
+    if out_dir is None and isinstance(module_or_path, (str, os.PathLike)):
+        out_dir = default_generated_dir(module_or_path)
     module = load_module(module_or_path, out_dir, method)
     method = element_method(module, method)
     from .consistent import check_method
@@ -127,7 +152,7 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if client is not None:
         from .ensemble_dask import check_client
         check_client(client)
-    h = check_times(spec, h, t0, t_end, save_every, None)
+    h = check_times(spec, h, t0, t_end, 1 if save_every is None else save_every, None)
     config = make_settings(spec, settings)
     if on_gpu:
         from ..gpu.launch import check_gpu_request
@@ -136,12 +161,15 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if M < 1:
         raise SimulationError(f"{module.NAME}: an ensemble of 0 members: the per-member inputs "
                               f"(q0, v0 (M, n), params arrays (M,)) are empty")
-    t0, t_end, save_every = float(t0), float(t_end), int(save_every)
+    t0, t_end = float(t0), float(t_end)
     n_steps = n_steps_to(t0, t_end, h)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     n, n_saved = module.N_COORDS, spec.n_saved(module.N_COORDS, module.N_CONSTRAINTS,
                                                module.N_ELEMENTS, getattr(module, "N_CONTACTS", 0),
                                                getattr(module, "N_NONHOLONOMIC", 0))
+    if save_every is None:
+        save_every = default_save_every(module.NAME, M, n_steps, n, n_saved, module.N_PARAMS)
+    save_every = int(save_every)
     rows = run_checks.saved_rows(n_steps, save_every)
     # Before the member tables: for 1e9 members q0 alone is 16 GB.
     check_ensemble_memory(module.NAME, M, n_steps, save_every, n, n_saved, module.N_PARAMS)
@@ -165,7 +193,7 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if client is None:
         run, ran, compile_time = _warm_up(
             lambda args: choose_ensemble(jit, run, module, method, args),
-            q, v, p, t0, h, save_every, config, out)
+            f"ensemble_{method} for {module.NAME}", q, v, p, t0, h, save_every, config, out)
     else:
         ran, compile_time = "specialized", 0.0   # done by each worker, inside its first task
     start = time.perf_counter()
@@ -210,6 +238,40 @@ def ensemble_bytes(M, rows, n, n_saved, n_params=0):
     return M * rows * 8 * (2 * n + N_STATS + n_saved + 3) + M * 8 * (2 * n + n_params)
 
 
+def default_save_every(model, M, n_steps, n, n_saved, n_params=0):
+    """The smallest save_every whose output (ensemble_bytes) fits the budget: OUTPUT_BUDGET_BYTES
+    or a quarter of the available memory, the smaller. 1 when every step fits; otherwise a
+    UserWarning line says what was chosen and how to choose."""
+    free = available_memory()
+    budget = OUTPUT_BUDGET_BYTES if free is None else min(OUTPUT_BUDGET_BYTES, free // 4)
+
+    def size(k):
+        return ensemble_bytes(M, run_checks.saved_rows(n_steps, k), n, n_saved, n_params)
+    if size(1) <= budget:
+        return 1
+    per_row = size(1) - size(n_steps) if n_steps > 1 else size(1)
+    per_row = max(per_row // max(n_steps - 1, 1), 1)
+    k = max(1, math.ceil(n_steps / max((budget - size(n_steps)) // per_row, 1)))
+    while k > 1 and size(k - 1) <= budget:
+        k -= 1
+    while k < n_steps and size(k) > budget:
+        k += 1
+    rows = run_checks.saved_rows(n_steps, k)
+    warnings.warn(f"{model}: an ensemble of {M} members saving every step would hold "
+                  f"{_size(size(1))}; saving one step in {k} instead: save_every={k} ({rows} "
+                  f"states of {n_steps + 1}, {_size(size(k))}); pass save_every= (--save-every) "
+                  f"to choose", UserWarning, stacklevel=3)
+    return k
+
+
+def _size(nbytes):
+    """'2.69 GB', '250 MB', '19.5 kB' (binary units)."""
+    for unit, scale in (("GB", 2**30), ("MB", 2**20)):
+        if nbytes >= scale:
+            return f"{nbytes / scale:.3g} {unit}"
+    return f"{nbytes / 2**10:.3g} kB"
+
+
 def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved, n_params=0):
     """Refuse, before allocating, an ensemble whose saved rows do not fit in the memory available
     now (run_checks.check_memory with the ensemble's bytes), saying how much it needs and which
@@ -239,13 +301,15 @@ def _consistent_starts(module, q, v, p, t0, config, extra):
     return q, v
 
 
-def _warm_up(choose, q, v, p, t0, h, save_every, config, out):
+def _warm_up(choose, label, q, v, p, t0, h, save_every, config, out):
     """Choose the glue (``choose(args)`` -> (glue, what ran), portable.choose_ensemble) and
-    compile or load it from numba's cache with zero members; (glue, what ran, seconds)."""
+    compile or load it from numba's cache with zero members, with the compile notice naming
+    ``label`` when that takes long; (glue, what ran, seconds)."""
     start = time.perf_counter()
     args = member_args(q, v, p, t0, h, 0, save_every, config, out, slice(0, 0))
-    run, ran = choose(args)
-    run(*args)
+    with first_use_notice(label):
+        run, ran = choose(args)
+        run(*args)
     return run, ran, time.perf_counter() - start
 
 

@@ -1,10 +1,12 @@
 """The output arrays of an ensemble and the call of the glue ``ensemble_<method>`` on a slice of
-its members: what a local run (ensemble) and a Dask worker (ensemble_dask) share."""
+its members: what a local run (ensemble) and a Dask worker (ensemble_dask) share; the finished
+result as a pandas frame."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..errors import LagrangeGenError
 from ..steppers.core.layout import N_STATS, last_size
 
 
@@ -28,3 +30,24 @@ def member_args(q, v, p, t0, h, n_steps, save_every, config, out, members):
 
 def run_members(run, q, v, p, t0, h, n_steps, save_every, config, out, members):
     run(*member_args(q, v, p, t0, h, n_steps, save_every, config, out, members))
+
+
+def dataframe(result):
+    """The long frame of an EnsembleResult (M members, S saved rows): M S rows, member-major;
+    columns member, the parameters, t, the coordinates, their velocities (name_dot), energy."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise LagrangeGenError("EnsembleResult.to_dataframe needs pandas: pip install "
+                               "'lagrange-gen[dataframe]'") from None
+    M, S = result.q.shape[:2]
+    columns = {"member": np.repeat(np.arange(M), S)}
+    for j, name in enumerate(result.param_names):
+        columns[name] = np.repeat(result.params[:, j], S)
+    columns["t"] = np.tile(result.t, M)
+    for i, name in enumerate(result.coords):
+        columns[name] = result.q[:, :, i].ravel()
+    for i, name in enumerate(result.coords):
+        columns[f"{name}_dot"] = result.v[:, :, i].ravel()
+    columns["energy"] = result.energy.ravel()
+    return pd.DataFrame(columns)

@@ -14,8 +14,8 @@ way: run the file, re-derive if needed.
 
 The data files the model file read when it was generated are in the record too (their sha256,
 size and mtime): the module serves only while every one is unchanged (keys.changed_data_file,
-which reads a file only when its size or mtime moved). Helper modules the model file imports
-are not recorded: ``lagrange-gen --check`` re-derives to see them.
+which reads a file only when its size or mtime moved); so are the helper modules it imported
+from its own folder (model/model_file.py).
 """
 
 from __future__ import annotations

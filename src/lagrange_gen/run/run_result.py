@@ -21,7 +21,8 @@ from ..steppers.core import status as st
 from ..steppers.core.layout import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK, read_last
 from .trajectory import Trajectory
 
-__all__ = ["fixed_step_trajectory", "adaptive_trajectory", "element_energy", "warn_energy_lost"]
+__all__ = ["fixed_step_trajectory", "adaptive_trajectory", "element_energy", "warn_energy_lost",
+           "work_note"]
 
 
 def element_energy(module, p, state):
@@ -81,6 +82,16 @@ def _has_work(module, spec):
     return bool(getattr(module, "WORK", False)) and not spec.adaptive
 
 
+def work_note(module, spec) -> str:
+    """The sentence of a run on a model whose E is not conserved that did not integrate W (an
+    adaptive method's loop does not), else ""."""
+    if not getattr(module, "WORK", False) or _has_work(module, spec):
+        return ""
+    return (f"W not tracked: {spec.name} (adaptive) does not integrate the work W of forces, "
+            f"damping and explicit time, so energy_balance is E - E0, not E - E0 - W "
+            f"(fixed-step methods track W)")
+
+
 def _build(task, rows, out, steps, h, wall, compile_time):
     """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
     m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
@@ -97,9 +108,16 @@ def _build(task, rows, out, steps, h, wall, compile_time):
                       coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
                       compile_time=compile_time, jit=task.ran, saved=saved,
                       work=rows["stats"][:, STAT_WORK].copy() if _has_work(m, spec) else None,
+                      work_note=work_note(m, spec), settings=_settings(task.settings),
                       element_names=tuple(m.ELEMENTS) if spec.elements else (),
                       constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
                       events=_events(m, out), source=_source(m))
+
+
+def _settings(record):
+    """{name: value} of a method's settings record (a namedtuple), {} for anything else."""
+    as_dict = getattr(record, "_asdict", None)
+    return dict(as_dict()) if as_dict is not None else {}
 
 
 def _source(module):

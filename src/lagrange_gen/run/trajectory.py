@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,6 +54,10 @@ class Trajectory:
     # (what animate needs to rebuild the model's Drawing)
     source: dict = field(default_factory=dict)
     work: np.ndarray | None = None   # W (S,), see above; None when E is conserved or not tracked
+    # one sentence when E is not conserved but W was not tracked (adaptive methods), else ""
+    work_note: str = ""
+    # the method's settings as the run used them (rtol, atol, newton_tol, ...)
+    settings: dict = field(default_factory=dict)
 
     @property
     def multipliers(self) -> np.ndarray:
@@ -93,8 +98,12 @@ class Trajectory:
     @property
     def energy_balance(self) -> np.ndarray:
         """E - E0 - (W - W0) (S,): zero up to the method's error when the work is tracked
-        (``work``), else E - E0. (W0 = 0 unless the trajectory was cut from a longer one.)"""
+        (``work``), else E - E0, with a UserWarning (``work_note``) when E is not conserved
+        but W was not tracked (adaptive methods). (W0 = 0 unless the trajectory was cut from a
+        longer one.)"""
         if self.work is None:
+            if self.work_note:
+                warnings.warn(self.work_note, UserWarning, stacklevel=2)
             return self.energy_error
         return self.energy_error - (np.asarray(self.work) - self.work[0])
 

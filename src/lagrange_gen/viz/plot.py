@@ -49,7 +49,7 @@ def plot_trajectory(traj, path=None):
         ax.tick_params(labelsize="small")
     for ax in bottom:
         ax.set_xlabel("t")
-    fig.suptitle(f"{traj.model}: {traj.method}, h = {traj.h:g}")
+    fig.suptitle(f"{traj.model}: {traj.method}, {_steps(traj)}")
     if path is None:
         return fig
     from pathlib import Path
@@ -74,10 +74,24 @@ def _panels(traj):
     return panels
 
 
+def _steps(traj):
+    """How the run chose its steps: "h = 0.001", or for an adaptive run its tolerances (the
+    mean step says little about an adaptive run)."""
+    if not traj.step_counts:
+        return f"h = {traj.h:g}"
+    tolerances = [f"{name}={traj.settings[name]:g}" for name in ("rtol", "atol")
+                  if isinstance(traj.settings.get(name), (int, float))]
+    return ", ".join(["adaptive"] + tolerances)
+
+
 def _energy_panel(traj):
-    """E - E0, or E - E0 - W with the work W (S,) when the trajectory has one."""
-    label = "E - E0" if traj.work is None else "E - E0 - W"
-    return label, lambda ax: ax.plot(traj.t, traj.energy_balance, lw=1, label=label)
+    """E - E0, or E - E0 - W with the work W (S,) when the trajectory has one; "E - E0 (W not
+    tracked)" when E is not conserved and the run did not integrate W (traj.work_note)."""
+    if traj.work is not None:
+        label = "E - E0 - W"
+        return label, lambda ax: ax.plot(traj.t, traj.energy_balance, lw=1, label=label)
+    label = "E - E0 (W not tracked)" if traj.work_note else "E - E0"
+    return label, lambda ax: ax.plot(traj.t, traj.energy_error, lw=1, label=label)
 
 
 def _constraint_errors(ax, traj):
