@@ -141,12 +141,21 @@ def constraint_basis(module, q, params=None, t=0.0):
     return np.linalg.svd(J)[2][m:].T.copy()
 
 
-def linearize(module, q, qd=None, u=None, t=0.0, params=None) -> Linearization:
+def linearize(module, q, qd=None, u=None, t=0.0, params=None, coordinates=None,
+              speeds=None) -> Linearization:
     """A, B, C, D of the model at (q, qd, u, t) (see the module docstring); ``module`` a
-    generated module or a model file. C, D have 0 rows for a model without outputs."""
+    generated module or a model file. C, D have 0 rows for a model without outputs.
+
+    A model with nonholonomic constraints is linearized in minimal coordinates and minimal
+    speeds (state (z, u), lagrange_gen.linear.nonholonomic; ``coordinates`` and ``speeds``
+    name the independent ones, default chosen by pivoting); linearize_nonholonomic gives the
+    second-order form M du' + C du + K dz as well."""
     from ..run.simulate import load_module
     module = load_module(module)
-    _refuse_nonholonomic(module, "linearize")
+    if getattr(module, "N_NONHOLONOMIC", 0):
+        from .nonholonomic import linearize_nonholonomic
+        lin = linearize_nonholonomic(module, q, qd, u, t, params, coordinates, speeds)
+        return Linearization(lin.A, lin.B, lin.C, lin.D)
     _need(module, "rhs_jacobian", "mass_matvec_dq",
           *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n = module.N_COORDS
