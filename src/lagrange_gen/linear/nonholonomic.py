@@ -77,7 +77,9 @@ def linearize_nonholonomic(module, q, qd=None, u=None, t=0.0, params=None, coord
     the constraints; coordinates: names (or indices) of the n - m independent coordinates,
     speeds: of the n - m - r independent speeds (default: chosen by pivoting on J and on
     [J; A], preferring the model's order). SimulationError (one line) for a wrong count or a
-    choice that leaves the dependent block singular."""
+    choice that leaves the dependent block singular. About a steady motion choose speeds that
+    stay constant along it (a wheel's rate, not a velocity component that turns with the
+    heading): the linearization is then time-invariant and its eigenvalues mean stability."""
     from ..run.simulate import load_module
     from .linearize import _need, as_vector, parameter_vector
     module = load_module(module)
@@ -174,8 +176,8 @@ def _acceleration_jacobians(module, q, qd, t, p, rows):
 
 def _independent(module, rows, chosen, count, what, names):
     """Indices (sorted) of the independent coordinates or speeds: the ``chosen`` names or
-    indices, else the columns left after picking, by column-pivoted elimination from the last
-    column back, the dependent ones where ``rows`` (s, n) is largest."""
+    indices, else the columns left after picking the dependent ones by complete pivoting on
+    ``rows`` (s, n)."""
     n = rows.shape[1]
     if chosen is not None:
         idx = []
@@ -195,8 +197,9 @@ def _independent(module, rows, chosen, count, what, names):
     for _ in range(rows.shape[0]):
         scores = np.max(np.abs(work), axis=0) if work.size else np.zeros(n)
         scores[dependent] = -1.0
-        # ties (within round-off) go to the later column: the model's first coordinates stay
-        best = max(range(n), key=lambda j: (scores[j] > 1e-9 * max(scores.max(), 1.0), j))
+        # the largest entry (a stable elimination); ties within round-off go to the earlier
+        # column (a contact point's coordinates, listed first, become the dependent ones)
+        best = min(j for j in range(n) if scores[j] >= (1.0 - 1e-9) * scores.max())
         row = int(np.argmax(np.abs(work[:, best])))
         pivot = work[row] / work[row, best]
         work = np.delete(work - np.outer(work[:, best], pivot), row, axis=0)
