@@ -41,6 +41,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..run.control import input_slots
+from .arguments import as_vector, need_kernels, parameter_vector
 
 __all__ = ["ReducedLinearization", "linearize_nonholonomic"]
 
@@ -81,13 +82,12 @@ def linearize_nonholonomic(module, q, qd=None, u=None, t=0.0, params=None, coord
     stay constant along it (a wheel's rate, not a velocity component that turns with the
     heading): the linearization is then time-invariant and its eigenvalues mean stability."""
     from ..run.simulate import load_module
-    from .linearize import _need, as_vector, parameter_vector
     module = load_module(module)
     n, m, r = module.N_COORDS, module.N_CONSTRAINTS, getattr(module, "N_NONHOLONOMIC", 0)
     if getattr(module, "CONSTRAINTS_RHEONOMIC", False):
         raise SimulationError(f"{module.NAME}: linearize with nonholonomic constraints needs "
                               "holonomic constraints that do not depend on t")
-    _need(module, "rhs_jacobian", "mass_matvec_dq", *(("nonholonomic", "nonholonomic_dq") if r else ()),
+    need_kernels(module, "rhs_jacobian", "mass_matvec_dq", *(("nonholonomic", "nonholonomic_dq") if r else ()),
           *(("constraints", "constraint_dq", "constraint_gamma_dq") if m else ()))
     q, qd = as_vector(q, n, "q", module), as_vector(qd, n, "qd", module)
     t = float(t)
@@ -103,7 +103,7 @@ def linearize_nonholonomic(module, q, qd=None, u=None, t=0.0, params=None, coord
     N = _basis(module, rows["J"], z_idx, "coordinates")
     S = _basis(module, C, u_idx, "speeds")
     W = _velocity_shift(C, rows["dC"] @ N, u_idx)
-    nz, k = N.shape[1], S.shape[1]
+    nz = N.shape[1]
     kin = np.hstack((W[z_idx], S[z_idx]))
     acc = np.hstack((da_dq @ N + da_dqd @ W, da_dqd @ S))[u_idx]
     A = np.vstack((kin, acc))
