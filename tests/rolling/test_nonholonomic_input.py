@@ -91,7 +91,8 @@ def test_only_the_nonholonomic_methods_apply():
 def test_another_method_on_a_rolling_model_is_one_line(generated):
     module = generated("chaplygin_sleigh")
     with pytest.raises(SimulationError, match="method 'rk4' ignores the model's nonholonomic "
-                                              "constraints \\(use nonholonomic_rk4\\)") as info:
+                                              "constraints \\(use nonholonomic_rk4, "
+                                              "nonholonomic_midpoint\\)") as info:
         simulate(module, "rk4", [0, 0, 0], [1.0, 0, 0], t_end=0.1, h=0.01)
     assert "\n" not in str(info.value)
 
