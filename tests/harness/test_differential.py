@@ -38,7 +38,7 @@ CASES = {
     "constrained": (dict(constrained=True), []),
     "elements": (dict(elements=True), []),
     "contacts": (dict(contacts=True), []),
-    "nonholonomic": (dict(nonholonomic=True), []),
+    # velocity constraints beside holonomic ones: every nonholonomic kernel kind in one class
     "constrained, nonholonomic": (dict(constrained=True, nonholonomic=True), []),
 }
 HARNESS_TESTS = ("test_kernels_as_python_match_reference", "test_compiled_kernels_match_reference",
