@@ -137,3 +137,26 @@ def test_off_the_constraints_is_refused_in_one_line(bicycle):
         lg.linearize_nonholonomic(bicycle, q, qd, speeds=SPEEDS)
     with pytest.raises(lg.SimulationError, match="3 independent speeds"):
         lg.linearize_nonholonomic(bicycle, *upright(4.0), speeds=("phi", "delta"))
+
+
+def test_nonlinear_bicycle_follows_its_linearization(bicycle):
+    """The nonlinear model stepped by nonholonomic_midpoint (the front wheel's contact as a
+    holonomic constraint beside the four rolling ones) at v = 5 m/s, self-stable, from a lean
+    rate of 0.05 rad/s: its lean and steer follow exp(A t) of the reduced linearization to
+    O(h^2) + O(amplitude^2) (measured 1.7e-5 of a 0.0105 rad swing at h = 0.01; asserted 1e-4),
+    the constraints hold to round-off and the energy to O(h^2) (measured 1.3e-6)."""
+    from scipy.linalg import expm
+    q, qd = upright(5.0)
+    lin = lg.linearize_nonholonomic(bicycle, q, qd, speeds=SPEEDS)
+    qd[3] = 0.05
+    traj = lg.simulate(bicycle, "nonholonomic_midpoint", q, qd, t_end=4.0, h=0.01)
+    x0 = np.zeros(lin.A.shape[0])
+    x0[len(lin.coordinates)] = 0.05                       # the lean rate, first speed
+    linear = np.array([expm(lin.A * t) @ x0 for t in traj.t])
+    for name, column in (("phi", 3), ("delta", 5)):
+        np.testing.assert_allclose(traj.q[:, column], linear[:, lin.coordinates.index(name)],
+                                   rtol=0, atol=1e-4, err_msg=name)
+    assert np.abs(traj.q[:, 3]).max() > 0.01 and abs(traj.q[-1, 3]) < 0.003   # it recovers
+    assert traj.saved["velocity_constraint_error"].max() < 1e-12
+    assert traj.saved["position_constraint_error"].max() < 1e-12
+    assert np.abs(traj.energy - traj.energy[0]).max() < 1e-5

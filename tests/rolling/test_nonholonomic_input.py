@@ -85,7 +85,9 @@ def test_only_the_nonholonomic_methods_apply():
     assert not set(registry.NONHOLONOMIC_METHODS) & set(registry.applicable_methods(0, 0, 0, 0))
     assert "ignores the model's nonholonomic constraints" in registry.inapplicable("rk4", 0, 0, 0, 2)
     assert "has none" in registry.inapplicable("nonholonomic_rk4", 0, 0, 0, 0)
-    assert "not supported by any method" in registry.inapplicable("nonholonomic_rk4", 1, 0, 0, 1)
+    assert "does not treat holonomic constraints" in registry.inapplicable("nonholonomic_rk4", 1, 0, 0, 1)
+    assert registry.applicable_methods(1, 0, 0, 1) == ("nonholonomic_midpoint",)
+    assert "not supported by any method" in registry.inapplicable("nonholonomic_midpoint", 0, 1, 0, 1)
 
 
 def test_another_method_on_a_rolling_model_is_one_line(generated):
