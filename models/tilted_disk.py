@@ -40,7 +40,8 @@ v_centre = centre.jacobian(q) * qd
 # the disk's angular velocity in L's axes (the inertia diag(I_diam, I_axle, I_diam) is the same
 # in every frame turned about the axle, so the spin angle phi itself never enters)
 w_L = rot_x(theta).T * (psi.d * e_z) + theta.d * e_x + phi.d * e_y
-T = m * (v_centre.T * v_centre)[0, 0] / 2 + (w_L.T * sp.diag(I_diam, I_axle, I_diam) * w_L)[0, 0] / 2
+inertia = sp.diag(I_diam, I_axle, I_diam)
+T = m * (v_centre.T * v_centre)[0, 0] / 2 + (w_L.T * inertia * w_L)[0, 0] / 2
 V = m * g * centre[2]
 
 slip = R_yaw.T * (v_centre + (R_L * w_L).cross(-R * R_L * e_z))

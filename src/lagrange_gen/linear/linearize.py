@@ -16,6 +16,10 @@ qd = N zd with N (n, n - m) an orthonormal basis of the null space of J(q*)
 (``constraint_basis``); the state is then (z, zd) (2 (n - m),). At rest (qd = 0, the usual
 case: an equilibrium) this is the linearization in any minimal coordinates with that tangent;
 off rest it is the projection of the full-coordinate linearization onto the tangent space.
+
+Models with nonholonomic constraints (velocity constraints, alone or beside holonomic ones) are
+linearized in minimal coordinates and minimal speeds by linear/nonholonomic.py, about an
+equilibrium or a steady motion; the shared argument handling is linear/arguments.py.
 """
 
 from __future__ import annotations
