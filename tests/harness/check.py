@@ -53,6 +53,14 @@ CONTRACT = {
     # only a model with unilateral contacts has it
     "contacts": (("q", "t", "p"), (("gap", "c"), ("WN", "cn"), ("WT", "cn"), ("coef", "c2")),
                  ("contact_gap", "contact_WN", "contact_WT", "contact_coef")),
+    # only a model with velocity constraints has them (constraint_gamma_dq: with holonomic ones too)
+    "nonholonomic": (_QQTP, (("A", "rn"), ("b", "r"), ("gamma", "r")), ("nh_A", "nh_b", "nh_gamma")),
+    "nonholonomic_dq": (("q", "qd", "w", "mu", "t", "p"),
+                        (("dAw", "rn"), ("dATmu", "nn"), ("dc", "rn"), ("dgamma_dq", "rn"),
+                         ("dgamma_dqd", "rn")),
+                        ("nh_dAw", "nh_dATmu", "nh_dc", "nh_dgamma_dq", "nh_dgamma_dqd")),
+    "constraint_gamma_dq": (_QQTP, (("dgamma_dq", "mn"), ("dgamma_dqd", "mn")),
+                            ("gamma_dq", "gamma_dqd")),
     # the kernels of a module generated from bodies (README, Robots); qdd is the State's w
     "inverse_dynamics": (("q", "qd", "qdd", "t", "p"), (("tau", "n"),), ("tau_id",)),
     "gravity_forces": (("q", "t", "p"), (("out", "n"),), ("gravity",)),
@@ -62,11 +70,14 @@ CONTRACT = {
 BODY_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
 #: the kernels only a module of a model with unilateral contacts has
 CONTACT_KERNELS = ("contacts",)
+#: the kernels only a module of a model with velocity constraints has
+NONHOLONOMIC_KERNELS = ("nonholonomic", "nonholonomic_dq", "constraint_gamma_dq")
 
 
 @dataclass
 class State:
-    """One evaluation point: q, qd, w (n,), t, params {name: value}, p (PARAMS order), lam (m,), we (ne,)."""
+    """One evaluation point: q, qd, w (n,), t, params {name: value}, p (PARAMS order), lam (m,),
+    we (ne,), mu (r,) (None: zeros)."""
 
     q: np.ndarray
     qd: np.ndarray
@@ -76,6 +87,7 @@ class State:
     w: np.ndarray
     lam: np.ndarray
     we: np.ndarray
+    mu: np.ndarray = None
 
     @property
     def qdd(self):
@@ -116,7 +128,8 @@ def states(drawn, mod, rng, count):
         scale = 1.0 if i == 0 else rng.uniform(0.7, 1.4, len(drawn.defaults))
         params = dict(zip(drawn.defaults, np.asarray(list(drawn.defaults.values())) * scale))
         p = np.array([params[name] for name in mod.PARAMS], dtype=float)
-        out.append(State(q, qd, t, params, p, rng.uniform(-1, 1, n), rng.uniform(-1, 1, m), rng.uniform(-1, 1, ne)))
+        out.append(State(q, qd, t, params, p, rng.uniform(-1, 1, n), rng.uniform(-1, 1, m),
+                         rng.uniform(-1, 1, ne), rng.uniform(-1, 1, len(drawn.nonholonomic))))
     return out
 
 
@@ -139,15 +152,16 @@ def compare(label, got, expected, rtol=RTOL, floor=FLOOR):
 ACCUMULATING = {"transport", "transport_dq"}
 
 
-def _shape(key, n, m, ne, ng=0, nc=0):
+def _shape(key, n, m, ne, ng=0, nc=0, nr=0):
     return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n),
             "e3": (ne, 3), "g": (ng,), "P": (2 * n + 2,), "c": (nc,), "cn": (nc, n),
-            "c2": (nc, 2)}[key]
+            "c2": (nc, 2), "r": (nr,), "rn": (nr, n)}[key]
 
 
 def call_kernel(kern, name, state, sizes):
     """Run kernel ``name`` of ``kern`` at a state on NaN-filled outputs: {reference name: value}.
-    sizes: (n, m, ne[, ng[, nc]]) coordinates, constraints, elements, events, contacts."""
+    sizes: (n, m, ne[, ng[, nc[, nr]]]) coordinates, constraints, elements, events, contacts,
+    velocity constraints."""
     inputs, outputs, quantities = CONTRACT[name]
     # The accumulating kernels (out += ...) start from zeros, the others from NaN (unwritten
     # entries show).
@@ -184,7 +198,8 @@ def _check_kernel(mod, kern, name, ref, state, mode):
     if actual != documented:
         return [f"{name}: arguments {actual}, documented {documented}"]
     values = call_kernel(kern, name, state,
-                         (ref.n, ref.m, ref.ne, len(ref.drawn.events), getattr(ref, "nc", 0)))
+                         (ref.n, ref.m, ref.ne, len(ref.drawn.events), getattr(ref, "nc", 0),
+                          getattr(ref, "nr", 0)))
     # counted for coverage only where it computes something: constraint and element kernels
     # of a model without constraints or elements fill empty or zero arrays
     if all(np.size(v) for v in values.values()) and (ref.m or "lam" not in inputs) and (ref.ne or "we" not in inputs):

@@ -10,7 +10,10 @@ lagrange_gen.derive or codegen, so a derivation or printing error cannot hide in
 Shapes for n coordinates, m constraints, ne elements: H (n, n), vectors (n,), Jacobians (n, n),
 Phi (m,), J (m, n), gamma (m,), dJw_dq (m, n), s (ne,), G (ne, n), coef (ne, 3); for c contacts
 contact_gap (c,), contact_WN = d gap/dq (c, n), contact_WT = d slip/d qd (c, n), contact_coef
-(c, 2) = (restitution, friction).
+(c, 2) = (restitution, friction); for r velocity constraints c = A qd + b: nh_A (r, n), nh_b,
+nh_gamma (r,) with A qdd = gamma = -(dc/dq qd + dc/dt), and their derivatives nh_dAw = d(A w)/dq,
+nh_dATmu = d(A^T mu)/dq, nh_dc = dc/dq, nh_dgamma_dq, nh_dgamma_dqd; gamma_dq, gamma_dqd (m, n)
+of the holonomic gamma.
 """
 
 from __future__ import annotations
@@ -36,7 +39,7 @@ def _jumps_settled(expr):
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
 VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
-           "power", "b", "tau_id", "gravity", "bias", "contact_gap"}
+           "power", "b", "tau_id", "gravity", "bias", "contact_gap", "nh_b", "nh_gamma"}
 
 
 def _vector(exprs):
@@ -55,11 +58,13 @@ class Reference:
         self.qd = sp.Matrix([c.d for c in drawn.coords])
         n, m, ne = len(drawn.coords), len(drawn.constraints), len(drawn.elements)
         self.n, self.m, self.ne, self.nc = n, m, ne, len(drawn.contacts)
+        self.nr = nr = len(drawn.nonholonomic)
         self.params = list(drawn.params)
         self.w = sp.Matrix(sp.symbols(f"ref_w0:{n}", real=True))
         self.lam = _vector(sp.symbols(f"ref_lam0:{m}", real=True)) if m else sp.zeros(0, 1)
         self.we = _vector(sp.symbols(f"ref_we0:{ne}", real=True)) if ne else sp.zeros(0, 1)
-        self.args = [*self.q, *self.qd, t, *self.params, *self.w, *self.lam, *self.we]
+        self.mu = _vector(sp.symbols(f"ref_mu0:{nr}", real=True)) if nr else sp.zeros(0, 1)
+        self.args = [*self.q, *self.qd, t, *self.params, *self.w, *self.lam, *self.we, *self.mu]
         self._exprs, self._functions = {}, {}
 
     # -- symbolic quantities ------------------------------------------------------------------
@@ -197,6 +202,40 @@ class Reference:
         rows = [[restitution, friction] for _, restitution, friction, _ in self.drawn.contacts]
         return sp.Matrix(rows) if rows else sp.zeros(0, 2)
 
+    def _nh_c(self):
+        return _vector(self.drawn.nonholonomic)
+
+    def _nh_A(self):
+        return self.expr("nh_c").jacobian(self.qd) if self.nr else sp.zeros(0, self.n)
+
+    def _nh_b(self):
+        return self.expr("nh_c").subs({v: 0 for v in self.qd})
+
+    def _nh_gamma(self):
+        c = self.expr("nh_c")
+        return -(c.jacobian(self.q) * self.qd + c.diff(t)) if self.nr else sp.zeros(0, 1)
+
+    def _nh_dAw(self):
+        return (self.expr("nh_A") * self.w).jacobian(self.q) if self.nr else sp.zeros(0, self.n)
+
+    def _nh_dATmu(self):
+        return (self.expr("nh_A").T * self.mu).jacobian(self.q) if self.nr else sp.zeros(self.n, self.n)
+
+    def _nh_dc(self):
+        return self.expr("nh_c").jacobian(self.q) if self.nr else sp.zeros(0, self.n)
+
+    def _nh_dgamma_dq(self):
+        return self.expr("nh_gamma").jacobian(self.q) if self.nr else sp.zeros(0, self.n)
+
+    def _nh_dgamma_dqd(self):
+        return self.expr("nh_gamma").jacobian(self.qd) if self.nr else sp.zeros(0, self.n)
+
+    def _gamma_dq(self):
+        return self.expr("gamma").jacobian(self.q) if self.m else sp.zeros(0, self.n)
+
+    def _gamma_dqd(self):
+        return self.expr("gamma").jacobian(self.qd) if self.m else sp.zeros(0, self.n)
+
     # -- numbers --------------------------------------------------------------------------------
     def value(self, name, state):
         """The quantity at a state: float, or array (column vectors flattened)."""
@@ -205,7 +244,8 @@ class Reference:
                                                 modules=_MODULES)
         expr = self.expr(name)
         p = [state.params[s.name] for s in self.params]
-        values = [*state.q, *state.qd, state.t, *p, *state.w, *state.lam, *state.we]
+        mu = state.mu if state.mu is not None else np.zeros(self.nr)
+        values = [*state.q, *state.qd, state.t, *p, *state.w, *state.lam, *state.we, *mu]
         out = np.asarray(self._functions[name](*values), dtype=float)
         if isinstance(expr, sp.MatrixBase):
             out = out.reshape(expr.shape)

@@ -79,7 +79,8 @@ class DrawnModel:
     radial[i]: coordinate i is sampled in RADIAL_BOX (else ANGLE_BOX); params: the declared
     Parameters (each carries its default); forces: n expressions or None; point_forces: [(point, force)] tuples;
     elements: [(kind, strain, coefficient, threshold or None, yield force or None)];
-    contacts: [(gap, restitution, friction, slip or None)].
+    contacts: [(gap, restitution, friction, slip or None)]; nonholonomic: velocity constraints
+    A(q) . qd + b(q, t) (expressions).
     """
 
     name: str
@@ -95,6 +96,7 @@ class DrawnModel:
     elements: list = field(default_factory=list)
     events: list = field(default_factory=list)
     contacts: list = field(default_factory=list)
+    nonholonomic: list = field(default_factory=list)
 
     @property
     def defaults(self):
@@ -114,7 +116,8 @@ class DrawnModel:
                      dissipation=self.dissipation, constraints=self.constraints, elements=elements,
                      events={f"g{i}": g for i, g in enumerate(self.events)},
                      contacts=[Contact(gap, restitution, friction, slip)
-                               for gap, restitution, friction, slip in self.contacts])
+                               for gap, restitution, friction, slip in self.contacts],
+                     nonholonomic=self.nonholonomic)
 
 
 def sample_state(drawn, rng):
@@ -273,11 +276,27 @@ def _contacts(g):
     return out
 
 
+def _nonholonomic(g):
+    """One or two velocity constraints sum_i f_i(q) qd_i + b(q, t): f_i and b from the grammar
+    (some f_i zero, one velocity at least), b zero, a term, or a term times a function of t."""
+    out = []
+    speeds = [c.d for c in g.coords]
+    for _ in range(g.draw(st.integers(1, 2))):
+        row = sp.Add(*[g.factor() * v for v in speeds if g.draw(st.booleans())])
+        row = row if row != 0 else g.pick(COEFFS) * g.pick(speeds)
+        kind = g.draw(st.integers(0, 2))
+        b = sp.S.Zero if kind == 0 else g.term() * (g.pick(TIME)(g.pick(g.params)) if kind == 2 else 1)
+        out.append(row + b)
+    return out
+
+
 @st.composite
-def models(draw, constant_mass=False, constrained=False, elements=False, contacts=False):
-    """A DrawnModel of 1-3 coordinates (2-3 when constrained): T, V (possibly time-dependent),
-    forces, Rayleigh dissipation, and constraints / elements / contacts when asked."""
-    tag, coords, radial, params, g = _setup(draw, 2 if constrained else 1, 3)
+def models(draw, constant_mass=False, constrained=False, elements=False, contacts=False,
+           nonholonomic=False):
+    """A DrawnModel of 1-3 coordinates (2-3 when constrained or nonholonomic): T, V (possibly
+    time-dependent), forces, Rayleigh dissipation, and constraints / elements / contacts /
+    velocity constraints when asked."""
+    tag, coords, radial, params, g = _setup(draw, 2 if constrained or nonholonomic else 1, 3)
     V = g.sum(1, 3)
     if draw(st.integers(0, 3)) == 0:
         V += g.term() * g.pick(TIME)(g.pick(g.params))
@@ -290,7 +309,8 @@ def models(draw, constant_mass=False, constrained=False, elements=False, contact
         name=f"harness_{tag}", coords=coords, radial=radial, params=params,
         T=_kinetic(g, constant_mass), V=V, forces=forces, point_forces=point_forces,
         dissipation=_rayleigh(g), constraints=constraints, elements=_elements(g) if elements else [],
-        events=events, contacts=_contacts(g) if contacts else [])
+        events=events, contacts=_contacts(g) if contacts else [],
+        nonholonomic=_nonholonomic(g) if nonholonomic else [])
 
 
 def kepler():

@@ -8,7 +8,9 @@ use the momentum rate, as verlet's and midpoint's do) get the composed dynamics 
 momentum_rate_jacobian,
 constant-H models the rhs kernel and the pre-factored forward dynamics,
 constrained models the constraint kernels, models with elements the element kernels, models
-with unilateral contacts the contacts kernel (gap, W_N, W_T, coefficients);
+with unilateral contacts the contacts kernel (gap, W_N, W_T, coefficients), models with
+velocity constraints the nonholonomic kernels (A, b, gamma and their derivatives; with holonomic
+constraints too, d gamma/dq of those);
 test_every_kernel_kind_was_checked asserts it. Profiles: profiles.py.
 """
 
@@ -22,7 +24,8 @@ from lagrange_gen.codegen.spec import kernel_table
 from lagrange_gen.derive import derive
 
 from . import profiles
-from .check import BODY_KERNELS, CHECKED, CONTACT_KERNELS, CONTRACT, STATS, check_model
+from .check import (BODY_KERNELS, CHECKED, CONTACT_KERNELS, CONTRACT, NONHOLONOMIC_KERNELS, STATS,
+                    check_model)
 from .printer_bug import put_back
 from .strategies import kepler, models
 
@@ -35,6 +38,8 @@ CASES = {
     "constrained": (dict(constrained=True), []),
     "elements": (dict(elements=True), []),
     "contacts": (dict(contacts=True), []),
+    # velocity constraints beside holonomic ones: every nonholonomic kernel kind in one class
+    "constrained, nonholonomic": (dict(constrained=True, nonholonomic=True), []),
 }
 HARNESS_TESTS = ("test_kernels_as_python_match_reference", "test_compiled_kernels_match_reference",
                  "test_kepler_kernels_match_reference")
@@ -90,9 +95,9 @@ def _expected_kinds():
     dyn = derive(drawn.build())
     table = kernel_table(dyn)
     # the kernels of body models are checked on spatial trees (test_spatial_trees.py)
-    assert set(table) | set(BODY_KERNELS) | set(CONTACT_KERNELS) == set(CONTRACT), \
-        "a kernel was added or removed: update check.CONTRACT"
-    kinds = set(table) | set(CONTACT_KERNELS) | {"accelerations", "forward_dynamics[general]", "forward_dynamics[factored]",
+    assert set(table) | set(BODY_KERNELS) | set(CONTACT_KERNELS) | set(NONHOLONOMIC_KERNELS) \
+        == set(CONTRACT), "a kernel was added or removed: update check.CONTRACT"
+    kinds = set(table) | set(CONTACT_KERNELS) | set(NONHOLONOMIC_KERNELS) | {"accelerations", "forward_dynamics[general]", "forward_dynamics[factored]",
                           "forward_dynamics[factored, other parameters]"}
     for name in table:
         try:

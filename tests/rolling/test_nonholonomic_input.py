@@ -55,11 +55,22 @@ def test_bad_constraint_is_one_line_naming_it(constraint, message):
     assert "\n" not in text and "model sleigh: nonholonomic constraint 0" in text
 
 
-def test_together_with_holonomic_constraints_is_refused_in_one_line():
+def test_together_with_holonomic_constraints_is_accepted_and_derived():
+    """A sleigh held on the line y = x: Phi = x - y next to the knife edge (the bicycle has both
+    kinds); J and A come out of derive unchanged by each other."""
     x, y, th = coordinates("x y theta")
-    with pytest.raises(ModelError, match="nonholonomic constraints together with holonomic "
-                                         "constraints are not supported by any method yet"):
-        _sleigh(constraints=[x - y])
+    dyn = derive(_sleigh(constraints=[x - y]))
+    assert dyn.J == sp.Matrix([[1, -1, 0]])
+    assert sp.simplify(dyn.nh_A[:, :2] - sp.Matrix([[-sp.sin(th), sp.cos(th)]])) == sp.zeros(1, 2)
+    assert [str(s) for s in dyn.nh_A[0, 2].free_symbols] == ["a"]
+
+
+def test_together_with_elements_is_refused_in_one_line():
+    from lagrange_gen import SaintVenant
+    x, y, th = coordinates("x y theta")
+    with pytest.raises(ModelError, match="nonholonomic constraints together with nonsmooth "
+                                         "elements are not supported by any method yet"):
+        _sleigh(elements=[SaintVenant(x, 1.0, threshold=0.1)])
 
 
 def test_a_velocity_in_constraints_points_to_nonholonomic():
@@ -74,13 +85,16 @@ def test_only_the_nonholonomic_methods_apply():
     assert not set(registry.NONHOLONOMIC_METHODS) & set(registry.applicable_methods(0, 0, 0, 0))
     assert "ignores the model's nonholonomic constraints" in registry.inapplicable("rk4", 0, 0, 0, 2)
     assert "has none" in registry.inapplicable("nonholonomic_rk4", 0, 0, 0, 0)
-    assert "not supported by any method" in registry.inapplicable("nonholonomic_rk4", 1, 0, 0, 1)
+    assert "does not treat holonomic constraints" in registry.inapplicable("nonholonomic_rk4", 1, 0, 0, 1)
+    assert registry.applicable_methods(1, 0, 0, 1) == ("nonholonomic_midpoint",)
+    assert "not supported by any method" in registry.inapplicable("nonholonomic_midpoint", 0, 1, 0, 1)
 
 
 def test_another_method_on_a_rolling_model_is_one_line(generated):
     module = generated("chaplygin_sleigh")
     with pytest.raises(SimulationError, match="method 'rk4' ignores the model's nonholonomic "
-                                              "constraints \\(use nonholonomic_rk4\\)") as info:
+                                              "constraints \\(use nonholonomic_rk4, "
+                                              "nonholonomic_midpoint\\)") as info:
         simulate(module, "rk4", [0, 0, 0], [1.0, 0, 0], t_end=0.1, h=0.01)
     assert "\n" not in str(info.value)
 
@@ -98,9 +112,8 @@ def test_inconsistent_v0_is_projected_with_a_warning(generated):
     assert traj.saved["velocity_constraint_error"][0, 0] < 1e-15
 
 
-def test_linearize_refuses_nonholonomic_models_in_one_line(generated):
+def test_equilibrium_refuses_nonholonomic_models_in_one_line(generated):
     import lagrange_gen as lg
     module = generated("chaplygin_sleigh")
-    for call in (lambda: lg.linearize(module, [0, 0, 0]), lambda: lg.equilibrium(module, [0, 0, 0])):
-        with pytest.raises(SimulationError, match="nonholonomic constraints is not implemented yet"):
-            call()
+    with pytest.raises(SimulationError, match="nonholonomic constraints is not implemented yet"):
+        lg.equilibrium(module, [0, 0, 0])

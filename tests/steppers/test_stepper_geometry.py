@@ -9,7 +9,8 @@ from lagrange_gen.steppers.core.registry import INFO, METHODS
 
 # The fixed-step methods for smooth unconstrained models whose SPEC claims the property.
 FIXED = [m for m in METHODS
-         if not (INFO[m].constraints or INFO[m].elements or INFO[m].adaptive)]
+         if not (INFO[m].constraints or INFO[m].elements or INFO[m].adaptive
+                 or INFO[m].contacts or INFO[m].nonholonomic)]
 SYMMETRIC = [m for m in FIXED if INFO[m].symmetric]
 SYMPLECTIC = [m for m in FIXED if INFO[m].symplectic]
 STATE = ([0.7, -0.4], [0.9, 1.3])          # generic state of the two-coordinate models

@@ -5,7 +5,8 @@ arguments by it."""
 #: Output arguments that are 2-D arrays even when they have one column (every other output with
 #: one column is a 1-D array).
 ALWAYS_2D = frozenset({"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef", "Ju", "Cq",
-                       "Cqd", "Du", "WN", "WT", "A"})
+                       "Cqd", "Du", "WN", "WT", "A", "dAw", "dATmu", "dc", "dgamma_dq",
+                       "dgamma_dqd"})
 
 #: The arguments of every generated kernel, in order: (name, shape), shape None for the scalar
 #: time t, else a tuple of dimension names (see kernel_dimensions). What a call from Python is
@@ -55,6 +56,11 @@ ARGUMENTS = {
                  ("WT", ("c", "n")), ("coef", ("c", "two"))),
     "nonholonomic": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                      ("A", ("r", "n")), ("b", ("r",)), ("gamma", ("r",))),
+    "nonholonomic_dq": (("q", ("n",)), ("qd", ("n",)), ("w", ("n",)), ("mu", ("r",)), ("t", None),
+                        ("p", ("n_params",)), ("dAw", ("r", "n")), ("dATmu", ("n", "n")),
+                        ("dc", ("r", "n")), ("dgamma_dq", ("r", "n")), ("dgamma_dqd", ("r", "n"))),
+    "constraint_gamma_dq": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
+                            ("dgamma_dq", ("m", "n")), ("dgamma_dqd", ("m", "n"))),
     "input_jacobian": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                        ("Ju", ("n", "n_inputs"))),
     "outputs": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),

@@ -145,7 +145,8 @@ def select_kernels(dyn, methods) -> dict:
     empty list, not None) asks for a kernel library without steppers: every kernel is emitted.
     """
     from ..errors import GenerationError
-    from .spec import CORE_KERNELS, ROBOT_KERNELS, default_kernels, kernel_table
+    from .spec import (CONSTRAINED_NONHOLONOMIC_LINEARIZE, CORE_KERNELS, NONHOLONOMIC_LINEARIZE,
+                       ROBOT_KERNELS, default_kernels, kernel_table)
     table = kernel_table(dyn)
     if not methods:
         return {name: ["no stepper requested: kernel library"] for name in default_kernels(dyn)}
@@ -155,6 +156,9 @@ def select_kernels(dyn, methods) -> dict:
     if dyn.m:
         why.setdefault("constraints", []).append("constrained model (consistent initial conditions)")
         why.setdefault("constraint_rate", []).append("constrained model (consistent initial velocities)")
+    if dyn.n_nonholonomic:
+        for name in NONHOLONOMIC_LINEARIZE + (CONSTRAINED_NONHOLONOMIC_LINEARIZE if dyn.m else ()):
+            why.setdefault(name, []).append("model with nonholonomic constraints (linearize)")
     if dyn.n_elements:
         why.setdefault("elements", []).append("model with nonsmooth elements (element energy)")
     if hasattr(dyn.jac, "inverse_dynamics"):

@@ -71,11 +71,11 @@ class Inputs:
     the kernels use, else None.
     """
 
-    _VECTORS = ("q", "qd", "qdd", "p", "w", "lam", "we")
+    _VECTORS = ("q", "qd", "qdd", "p", "w", "lam", "we", "mu")
 
     def __init__(self, dyn):
         symbols = {"q": dyn.q, "qd": dyn.qd, "qdd": dyn.aux.get("qdd", []), "p": dyn.params, "w": dyn.aux["w"],
-                   "lam": dyn.aux["lam"], "we": dyn.aux.get("we", [])}
+                   "lam": dyn.aux["lam"], "we": dyn.aux.get("we", []), "mu": dyn.aux.get("mu", [])}
         self.graph = getattr(dyn.ops, "graph", None)
         self.rename = {dyn.t: "t"}
         self._loads = {}

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from .kernel_abi import ALWAYS_2D
+from ..derive.nonholonomic import constraint_gamma_jacobians, nonholonomic_jacobians
 from ..derive.recursive import operation_count
 from ..model.symbols import Parameter
 
@@ -187,16 +188,46 @@ def contact_kernels(dyn) -> dict:
             "coef (c, 2) = (restitution, friction)")}
 
 
+#: The kernels a model with nonholonomic constraints gets for lagrange_gen.linearize (about a
+#: steady motion: the derivatives of both kinds of constraint rows along it).
+NONHOLONOMIC_LINEARIZE = ("rhs_jacobian", "mass_matvec_dq", "nonholonomic_dq")
+CONSTRAINED_NONHOLONOMIC_LINEARIZE = ("constraint_dq", "constraint_gamma_dq")
+
+
 def nonholonomic_kernels(dyn) -> dict:
-    """The ``nonholonomic`` kernel of a model with velocity constraints ({} without any)."""
+    """The ``nonholonomic`` kernel of a model with velocity constraints and the derivatives
+    linearize needs (``nonholonomic_dq``; ``constraint_gamma_dq`` with holonomic constraints
+    too); {} without velocity constraints."""
     if not dyn.n_nonholonomic:
         return {}
-    nat = dyn.native
-    return {"nonholonomic": lambda: KernelSpec(
+    nat, o = dyn.native, dyn.ops
+    q, qd = o.symbols(dyn.q), o.symbols(dyn.qd)
+
+    def derivatives():
+        d = nonholonomic_jacobians(o, nat, q, qd, o.symbols(dyn.aux["w"]), o.symbols(dyn.aux["mu"]))
+        return KernelSpec(
+            "nonholonomic_dq", ["q", "qd", "w", "mu", "t", "p"],
+            [Output("dAw", d["dAw"]), Output("dATmu", d["dATmu"]), Output("dc", d["dc"]),
+             Output("dgamma_dq", d["dgamma_dq"]), Output("dgamma_dqd", d["dgamma_dqd"])],
+            doc="d(A w)/dq (r, n), d(A^T mu)/dq (n, n), d(A qd + b)/dq (r, n), d gamma/dq and "
+                "d gamma/dqd (r, n) of the nonholonomic constraints")
+
+    def gamma_derivatives():
+        d = constraint_gamma_jacobians(o, nat, q, qd)
+        return KernelSpec(
+            "constraint_gamma_dq", ["q", "qd", "t", "p"],
+            [Output("dgamma_dq", d["dgamma_dq"]), Output("dgamma_dqd", d["dgamma_dqd"])],
+            doc="d gamma/dq and d gamma/dqd (m, n) of the holonomic constraints (J qdd = gamma)")
+
+    table = {"nonholonomic": lambda: KernelSpec(
         "nonholonomic", ["q", "qd", "t", "p"],
         [Output("A", nat["nh_A"]), Output("b", nat["nh_b"]), Output("gamma", nat["nh_gamma"])],
         doc="nonholonomic constraints A qd + b = 0: A(q, t) (r, n), b(q, t) (r,), gamma (r,) "
-            "with A qdd = gamma along a motion")}
+            "with A qdd = gamma along a motion"),
+             "nonholonomic_dq": derivatives}
+    if dyn.m:
+        table["constraint_gamma_dq"] = gamma_derivatives
+    return table
 
 
 def column_kernels(dyn) -> dict:

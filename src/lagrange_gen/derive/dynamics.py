@@ -154,6 +154,7 @@ def _finish(model, o, parts, frozen, jacobians):
     parts.update(derive_constraints(model, o, q))
     n, m = len(model.coords), len(model.constraints)
     aux = {"w": input_symbols("w", n), "qdd": input_symbols("qdd", n), "lam": input_symbols("lam", m),
+           "mu": input_symbols("mu", len(getattr(model, "nonholonomic", ()))),
            "we": input_symbols("we", len(model.elements))}
     for key, value in derive_elements(model, aux["we"]).items():
         parts[key] = o.matrix(*value.shape, list(value))

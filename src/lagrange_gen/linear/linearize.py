@@ -16,6 +16,10 @@ qd = N zd with N (n, n - m) an orthonormal basis of the null space of J(q*)
 (``constraint_basis``); the state is then (z, zd) (2 (n - m),). At rest (qd = 0, the usual
 case: an equilibrium) this is the linearization in any minimal coordinates with that tangent;
 off rest it is the projection of the full-coordinate linearization onto the tangent space.
+
+Models with nonholonomic constraints (velocity constraints, alone or beside holonomic ones) are
+linearized in minimal coordinates and minimal speeds by linear/nonholonomic.py, about an
+equilibrium or a steady motion; the shared argument handling is linear/arguments.py.
 """
 
 from __future__ import annotations
@@ -26,7 +30,8 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..run.control import input_slots
-from ..run.params import resolve_params
+from .arguments import as_vector, need_kernels, parameter_vector
+from .nonholonomic import linearize_nonholonomic
 
 __all__ = ["Linearization", "equilibrium", "linearize", "constraint_basis", "parameter_vector"]
 
@@ -41,42 +46,12 @@ class Linearization(NamedTuple):
     D: np.ndarray
 
 
-def parameter_vector(module, params=None, u=None):
-    """p (n_params,) with the inputs' slots set to u (n_inputs,), default 0."""
-    first, k = input_slots(module)
-    defaults = list(module.DEFAULTS[:first]) + [0.0] * k
-    p = resolve_params(module.PARAMS, defaults, params, model=module.NAME,
-                       frozen=getattr(module, "FROZEN", None))
-    if u is not None:
-        u = np.atleast_1d(np.asarray(u, dtype=np.float64))
-        if u.shape != (k,):
-            raise SimulationError(f"{module.NAME}: u has {u.size} entries for {k} input(s) "
-                                  f"({', '.join(module.PARAMS[first:]) or 'none'})")
-        p[first:] = u
-    return p
-
-
 def _refuse_nonholonomic(module, what):
-    """Velocity constraints change the linearization (minimal velocities in the null space of
-    A): not implemented, so refused rather than answered without them."""
+    """An equilibrium of a model with velocity constraints (its multipliers and the holonomic
+    ones together): not implemented, so refused rather than answered without them."""
     if getattr(module, "N_NONHOLONOMIC", 0):
         raise SimulationError(f"{module.NAME}: {what} of a model with nonholonomic constraints "
                               "is not implemented yet")
-
-
-def _need(module, *names):
-    missing = [n for n in names if not hasattr(module, n)]
-    if missing:
-        raise SimulationError(f"{module.NAME}: module {module.__file__} has no kernel "
-                              f"{', '.join(missing)} (linearize needs it); regenerate it for all "
-                              "methods: lagrange-gen <model file>")
-
-
-def as_vector(x, n, what, module):
-    x = np.ascontiguousarray(np.zeros(n) if x is None else x, dtype=np.float64).ravel()
-    if x.shape != (n,):
-        raise SimulationError(f"{module.NAME}: {what} has {x.size} entries for {n} coordinates")
-    return x
 
 
 def accel_jacobians(module, q, qd, t, p):
@@ -141,13 +116,21 @@ def constraint_basis(module, q, params=None, t=0.0):
     return np.linalg.svd(J)[2][m:].T.copy()
 
 
-def linearize(module, q, qd=None, u=None, t=0.0, params=None) -> Linearization:
+def linearize(module, q, qd=None, u=None, t=0.0, params=None, coordinates=None,
+              speeds=None) -> Linearization:
     """A, B, C, D of the model at (q, qd, u, t) (see the module docstring); ``module`` a
-    generated module or a model file. C, D have 0 rows for a model without outputs."""
+    generated module or a model file. C, D have 0 rows for a model without outputs.
+
+    A model with nonholonomic constraints is linearized in minimal coordinates and minimal
+    speeds (state (z, u), lagrange_gen.linear.nonholonomic; ``coordinates`` and ``speeds``
+    name the independent ones, default chosen by pivoting); linearize_nonholonomic gives the
+    second-order form M du' + C du + K dz as well."""
     from ..run.simulate import load_module
     module = load_module(module)
-    _refuse_nonholonomic(module, "linearize")
-    _need(module, "rhs_jacobian", "mass_matvec_dq",
+    if getattr(module, "N_NONHOLONOMIC", 0):
+        lin = linearize_nonholonomic(module, q, qd, u, t, params, coordinates, speeds)
+        return Linearization(lin.A, lin.B, lin.C, lin.D)
+    need_kernels(module, "rhs_jacobian", "mass_matvec_dq",
           *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n = module.N_COORDS
     q, qd = as_vector(q, n, "q", module), as_vector(qd, n, "qd", module)
@@ -173,7 +156,7 @@ def equilibrium(module, q, u=None, t=0.0, params=None, tol=1e-12, max_iter=50):
     from ..run.simulate import load_module
     module = load_module(module)
     _refuse_nonholonomic(module, "equilibrium")
-    _need(module, "rhs_jacobian", *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
+    need_kernels(module, "rhs_jacobian", *(("constraints", "constraint_dq") if module.N_CONSTRAINTS else ()))
     n, m = module.N_COORDS, module.N_CONSTRAINTS
     x = np.concatenate((as_vector(q, n, "q", module), np.zeros(m)))
     p, zero = parameter_vector(module, params, u), np.zeros(n)

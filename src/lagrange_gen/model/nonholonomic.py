@@ -22,8 +22,8 @@ __all__ = ["check_nonholonomic"]
 def check_nonholonomic(model):
     """ModelError (one line, naming the model and the constraint) when a nonholonomic constraint
     has no velocity in it, has a term that is not linear in the velocities (the term is named),
-    or the model also has holonomic constraints, nonsmooth elements or contacts (no method
-    treats those together yet)."""
+    or the model also has nonsmooth elements or contacts (no method treats those together yet).
+    Holonomic constraints may come with them (the rolling wheels of a bicycle)."""
     qd = set(model.velocities)
     for i, c in enumerate(model.nonholonomic):
         where = f"model {model.name}: nonholonomic constraint {i} ({c})"
@@ -36,8 +36,7 @@ def check_nonholonomic(model):
                              "as A(q, t) . qdot + b(q, t)")
     if not model.nonholonomic:
         return
-    others = [what for what, count in (("holonomic constraints", len(model.constraints)),
-                                       ("nonsmooth elements", len(model.elements)),
+    others = [what for what, count in (("nonsmooth elements", len(model.elements)),
                                        ("contacts", len(model.contacts))) if count]
     if others:
         raise ModelError(f"model {model.name}: nonholonomic constraints together with "
@@ -48,6 +47,11 @@ def nonlinear_term(expr, velocities):
     """The first term of ``expr`` (expanded) that is not of the form f(q, t) * qdot_j or
     f(q, t), or None when ``expr`` is linear in the velocities."""
     velocities = list(velocities)
+    # A derivative free of velocities proves linearity without expanding (a rolling wheel's
+    # constraint expands into thousands of terms); only an expression that fails it is expanded
+    # to name the offending term.
+    if not any(sp.diff(expr, v).has(*velocities) for v in velocities if expr.has(v)):
+        return None
     for term in sp.Add.make_args(sp.expand(expr)):
         if any(sp.diff(term, v).has(*velocities) for v in velocities if term.has(v)):
             return term

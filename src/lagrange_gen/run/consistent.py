@@ -21,8 +21,9 @@ scleronomic; dPhi/dt from the generated ``constraint_rate``). Every function tak
 * multipliers lam0 from the acceleration-level KKT system at (q, v), the constraint forces of
   the initial state (row 0 of Trajectory.multipliers).
 
-For nonholonomic constraints A(q, t) v + b = 0 (no position constraint) ``nonholonomic_start``
-projects v0 by the same velocity formula with A, b in place of J, dPhi/dt.
+For nonholonomic constraints A(q, t) v + b = 0 ``nonholonomic_start`` projects v0 by the same
+velocity formula with A, b in place of J, dPhi/dt (stacked under J, dPhi/dt when the model has
+holonomic constraints too, after q0 is projected onto Phi = 0).
 
 Redundant constraints (rank-deficient J at q0) are refused, not handled by a least-squares
 multiplier: their multipliers are not unique, and the methods' Newton matrices are singular.
@@ -295,19 +296,32 @@ def diagnose_singular(module, q, p):
 
 
 def nonholonomic_start(module, q, v0, p, t0=0.0, tol=1e-12, stacklevel=2):
-    """v0 projected onto the nonholonomic constraints A(q, t0) v + b(q, t0) = 0 (generated
-    ``nonholonomic`` kernel) in the kinetic-energy metric, v = v0 - H^-1 A^T (A H^-1 A^T)^-1
-    (A v0 + b): the velocity the constraints leave after an impulse that imposes them. Warns
-    with the violation and the change when v0 was off by more than tol (relative to
-    max(1, |v0|) and the rows' scale). q, v0 (n,); returns v (n,)."""
+    """(q, v): q0 on the holonomic constraints Phi(q, t0) = 0 if the model has any
+    (project_positions, with a warning when it moved), and v0 projected onto the velocity
+    constraints A(q, t0) v + b(q, t0) = 0 (generated ``nonholonomic`` kernel; with holonomic
+    constraints also J v + dPhi/dt = 0, the rows stacked) in the kinetic-energy metric,
+    v = v0 - H^-1 A^T (A H^-1 A^T)^-1 (A v0 + b): the velocity the constraints leave after an
+    impulse that imposes them. Warns with the violation and the change when v0 was off by more
+    than tol (relative to max(1, |v0|) and the rows' scale). q, v0 (n,)."""
     n, r = module.N_COORDS, module.N_NONHOLONOMIC
     q, v0 = np.asarray(q, dtype=float), np.asarray(v0, dtype=float)
     A, b, gamma = np.empty((r, n)), np.empty(r), np.empty(r)
+    if module.N_CONSTRAINTS:
+        moved = project_positions(module, q, p, tol, t=t0)
+        if np.abs(moved - q).max() > tol * max(1.0, float(np.abs(q).max())):
+            warnings.warn(f"{module.NAME}: q0 violates the holonomic constraints; replaced by "
+                          f"the nearest q on them (max|dq| = {np.abs(moved - q).max():.3g})",
+                          stacklevel=stacklevel)
+        q = moved
     module.nonholonomic(q, v0, float(t0), p, A, b, gamma)
+    if module.N_CONSTRAINTS:
+        _, J, _ = evaluate(module, q, v0, p, t0)
+        A, b = np.vstack((J, A)), np.concatenate((rate(module, q, p, t0), b))
+        r = A.shape[0]
     residual = A @ v0 + b
     scale = np.maximum(np.abs(A).max(axis=1), 1e-300) * max(1.0, float(np.abs(v0).max()))
     if float((np.abs(residual) / scale).max(initial=0.0)) <= tol:
-        return v0
+        return q, v0
     if np.linalg.matrix_rank(A) < r:
         raise ConstraintError(f"{module.NAME}: the nonholonomic constraints are dependent at "
                               f"q0 = {q.tolist()} (A has rank {np.linalg.matrix_rank(A)} < {r})")
@@ -316,4 +330,4 @@ def nonholonomic_start(module, q, v0, p, t0=0.0, tol=1e-12, stacklevel=2):
                   f"{np.abs(residual).max():.3g}); replaced by the closest velocity that meets "
                   f"them in the kinetic-energy metric, changing v0 by max|dv| = "
                   f"{np.abs(v - v0).max():.3g}", stacklevel=stacklevel)
-    return v
+    return q, v

@@ -171,9 +171,9 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
                                            getattr(config, "newton_tol", 1e-12), keep)
     elif spec.contacts:          # (its prepare fills row 0; the contact work starts at 0)
         initial = np.zeros(n_saved)
-    elif spec.nonholonomic:      # v0 onto A v + b = 0; prepare fills row 0
+    elif spec.nonholonomic:      # q0 onto Phi = 0, v0 onto A v + b = 0; prepare fills row 0
         from .consistent import nonholonomic_start
-        v = nonholonomic_start(module, q, v, p, t0, stacklevel=3)
+        q, v = nonholonomic_start(module, q, v, p, t0, stacklevel=3)
         initial = np.zeros(n_saved)
     elif n_saved:
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)

@@ -106,6 +106,8 @@ class Spec:
     stands_in_for: tuple = ()
     contacts: bool = False
     nonholonomic: bool = False
+    #: A nonholonomic method that also treats holonomic constraints beside the velocity ones.
+    holonomic_too: bool = False
     saved: tuple = ()
     limits: dict = field(default_factory=dict)
     adaptive: bool = False

@@ -15,7 +15,7 @@ import importlib
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
            "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
            "constrained_midpoint", "constrained_implicit_euler", "spook", "index1", "moreau_jean",
-           "nonholonomic_rk4")
+           "nonholonomic_rk4", "nonholonomic_midpoint")
 
 #: {method: its Spec}.
 INFO = {m: importlib.import_module(f"lagrange_gen.steppers.methods.{m}").SPEC for m in METHODS}
@@ -61,13 +61,18 @@ def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: i
                  n_nonholonomic: int = 0) -> str:
     """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
     flags = INFO[method]
-    if n_nonholonomic and (n_constraints or n_elements or n_contacts):
-        return ("nonholonomic constraints together with holonomic constraints, nonsmooth "
-                "elements or contacts are not supported by any method yet")
+    if n_nonholonomic and (n_elements or n_contacts):
+        return ("nonholonomic constraints together with nonsmooth elements or contacts are not "
+                "supported by any method yet")
     if bool(n_nonholonomic) != flags.nonholonomic:
         return (f"it ignores the model's nonholonomic constraints (use "
                 f"{', '.join(NONHOLONOMIC_METHODS)})" if n_nonholonomic
                 else "it is for models with nonholonomic constraints and this model has none")
+    if n_nonholonomic:
+        both = [m for m in NONHOLONOMIC_METHODS if INFO[m].holonomic_too]
+        return ("" if not n_constraints or flags.holonomic_too else
+                f"it does not treat holonomic constraints beside nonholonomic ones (use "
+                f"{', '.join(both)})")
     if n_constraints and n_elements:
         return "constraints together with nonsmooth elements are not supported by any method"
     if n_contacts and (n_constraints or n_elements):

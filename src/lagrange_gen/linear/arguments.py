@@ -1,0 +1,44 @@
+"""The arguments of a linearization: the parameter vector with the inputs' slots, state
+vectors checked against the model's size, and the kernels a module must have."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SimulationError
+from ..run.control import input_slots
+from ..run.params import resolve_params
+
+__all__ = ["parameter_vector", "as_vector", "need_kernels"]
+
+
+def parameter_vector(module, params=None, u=None):
+    """p (n_params,) with the inputs' slots set to u (n_inputs,), default 0."""
+    first, k = input_slots(module)
+    defaults = list(module.DEFAULTS[:first]) + [0.0] * k
+    p = resolve_params(module.PARAMS, defaults, params, model=module.NAME,
+                       frozen=getattr(module, "FROZEN", None))
+    if u is not None:
+        u = np.atleast_1d(np.asarray(u, dtype=np.float64))
+        if u.shape != (k,):
+            raise SimulationError(f"{module.NAME}: u has {u.size} entries for {k} input(s) "
+                                  f"({', '.join(module.PARAMS[first:]) or 'none'})")
+        p[first:] = u
+    return p
+
+
+def need_kernels(module, *names):
+    """SimulationError (one line) when the generated module lacks one of the kernels ``names``."""
+    missing = [n for n in names if not hasattr(module, n)]
+    if missing:
+        raise SimulationError(f"{module.NAME}: module {module.__file__} has no kernel "
+                              f"{', '.join(missing)} (linearize needs it); regenerate it for all "
+                              "methods: lagrange-gen <model file>")
+
+
+def as_vector(x, n, what, module):
+    """x (n,) as a contiguous float array (zeros for None); SimulationError for another size."""
+    x = np.ascontiguousarray(np.zeros(n) if x is None else x, dtype=np.float64).ravel()
+    if x.shape != (n,):
+        raise SimulationError(f"{module.NAME}: {what} has {x.size} entries for {n} coordinates")
+    return x
