@@ -2,8 +2,10 @@
 nonlinear model models/bicycle.py linearized about upright straight running by
 lagrange_gen.linearize_nonholonomic at each speed, the weave and capsize speeds by root finding.
 
-    python examples/bicycle_eigenvalues.py      # writes docs/figures/bicycle_eigenvalues.png
+    python examples/bicycle_eigenvalues.py [OUT_DIR]   # writes OUT_DIR/bicycle_eigenvalues.png
+                                                       # (default docs/figures, the guide's)
 """
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -58,7 +60,7 @@ ax.set(xlim=(0, 10), ylim=(-10, 10), xlabel="forward speed v (m/s)", ylabel="eig
        title=f"Whipple bicycle (benchmark parameters): v_w = {v_weave:.4f}, "
              f"v_c = {v_capsize:.4f} m/s")
 ax.legend(loc="lower left")
-out = ROOT / "docs" / "figures" / "bicycle_eigenvalues.png"
-out.parent.mkdir(parents=True, exist_ok=True)
-fig.savefig(out, dpi=120, bbox_inches="tight")
-print(f"wrote {out.relative_to(ROOT)}")
+out_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "docs" / "figures"
+out_dir.mkdir(parents=True, exist_ok=True)
+fig.savefig(out_dir / "bicycle_eigenvalues.png", dpi=120, bbox_inches="tight")
+print(f"weave speed {v_weave:.12f} m/s, capsize speed {v_capsize:.12f} m/s")
