@@ -192,7 +192,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
-                 jit=jit)
+                 jit=jit, hook=hook)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     try:
@@ -256,6 +256,14 @@ class _Task:
     controlled: bool = False    # inputs written by a controller or a signal (run/control.py)
     jit: str = "specialized"    # simulate(jit=): "auto", "specialized" or "portable"
     ran: str = ""               # what ran (Trajectory.jit), set by fixed_run / adaptive_run
+    hook: object = None         # the input hook compiled into ``run`` (control.make_apply)
+
+    def ready_key(self):
+        """What the glue's choice and compile depend on, besides argument types that simulate
+        makes the same for every run of a module and method (fresh writable float64 arrays, the
+        method's settings record): the drivers remember the choice per key (ready_glue)."""
+        m = self.module
+        return (m.__name__, m.KEY, self.spec.name, self.jit, type(self.settings), self.hook)
 
     def glue(self, args):
         """The glue to run (``run`` or the portable one, see portable.choose) for a first call
