@@ -30,6 +30,7 @@ import sys
 
 import numpy as np
 
+from ..jit.python_calls import unchecked
 from ..steppers.core.status import OK
 
 ENERGY_FRACTION = 0.1
@@ -78,7 +79,9 @@ def energy_scale(module, q, t, energy, p):
     rows = (np.arange(len(t)) if len(t) <= SCALE_ROWS else
             np.unique(np.linspace(0, len(t) - 1, SCALE_ROWS).astype(np.int64)))
     zero = np.zeros(module.N_COORDS)
-    V = np.array([module.energy(np.ascontiguousarray(q[k]), zero, float(t[k]), p) for k in rows])
+    energy_of = unchecked(module.energy)      # arrays made here, of the kernel's shapes
+    V = np.array([energy_of(np.ascontiguousarray(q[k], dtype=np.float64), zero, float(t[k]), p)
+                  for k in rows])
     T = energy[rows] - V
     return float(np.max(T) + np.max(V) - np.min(V))
 

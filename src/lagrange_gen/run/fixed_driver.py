@@ -66,13 +66,17 @@ def integrate_fixed(task, q, v, out, progress):
     integration seconds). Raises the exception of a failure status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     last = np.zeros(last_size(n, out["extra"].shape[1], with_work=True))
-    args = warm_up_args(q, v, t0, h, task.p, task.settings, out["extra"][:1].copy(),
-                        last.copy(), out["events"][:0])
+
+    def args():
+        return warm_up_args(q, v, t0, h, task.p, task.settings, out["extra"][:1].copy(),
+                            last.copy(), out["events"][:0])
+
     label = f"run_{task.method} for {m.NAME}"
     run = ready_glue(task)
     compile_time = 0.0
     if run is None:
-        run, compile_time = warm_up(lambda: task.glue(args), args, label)
+        first = args()
+        run, compile_time = warm_up(lambda: task.glue(first), first, label)
         remember_glue(task, run)
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = ProgressBar(task.n_steps) if progress else None
@@ -90,8 +94,8 @@ def integrate_fixed(task, q, v, out, progress):
 
 
 def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_time):
-    """The chunk loop of integrate_fixed; returns (steps done, last row, seconds spent switching
-    to the specialized glue, compile seconds)."""
+    """The chunk loop of integrate_fixed (args(): the arguments of a warm-up call); returns
+    (steps done, last row, seconds spent switching to the specialized glue, compile seconds)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     done, row, switch = 0, 0, 0.0
     while True:
@@ -125,7 +129,7 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
             break
         if task.ran == "portable" and task.jit == "auto" and _worth_specializing(
                 time.perf_counter() - start - switch, done, task.n_steps):
-            run, seconds = warm_up(lambda: task.run, args, label + ", specialized for this long run")
+            run, seconds = warm_up(lambda: task.run, args(), label + ", specialized for this long run")
             compile_time += seconds
             switch += seconds
             task.ran = f"portable, then specialized from step {done}"
