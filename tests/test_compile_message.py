@@ -121,3 +121,26 @@ def test_nested_notice_names_the_inner_call(monkeypatch, capsys):
             run()
     match = LINE.match(capsys.readouterr().err)
     assert match and match.group(2) == "inner"
+
+
+def test_layout_sizes_from_python_compile_nothing():
+    """The sizes simulate computes from Python in every new process (out_last, out_events)
+    come from the layout functions' Python bodies: a new process compiles nothing for them
+    (a jitted helper called from Python would compile a twin each time, a second or so)."""
+    import subprocess
+    import sys
+    code = ("from numba.core import event\n"
+            "seen = []\n"
+            "class L(event.Listener):\n"
+            "    def on_start(self, ev): seen.append(ev.data['dispatcher'])\n"
+            "    def on_end(self, ev): pass\n"
+            "event.register('numba:compile', L())\n"
+            "import numpy as np\n"
+            "from lagrange_gen.steppers.core.layout import events_size, last_size, read_last\n"
+            "last = np.zeros(last_size(3, 2, with_work=True))\n"
+            "read_last(last, 3, with_work=True)\n"
+            "assert last.shape == (1 + 6 + 2 + 2 + 1,) and events_size(3) == 9\n"
+            "print(len(seen))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0"]
