@@ -130,7 +130,7 @@ def call_breakdown(mod, calls=2000):
     from ..run import simulate as sim
     stages = {"driver": ("integrate_fixed", "integrate_adaptive"),
               "trajectory": ("fixed_step_trajectory", "adaptive_trajectory")}
-    times, saved = {}, {}
+    times, saved = {stage: [] for stage in stages}, {}
 
     def timed(stage, fn):
         def wrapper(*args, **kwargs):

@@ -39,9 +39,8 @@ SCALE_ROWS = 1001
 #: conserving energy (central differences are good to about 1e-8 here).
 POWER_RTOL = 1e-6
 _SAMPLES = 4
-#: Saved rows up to which energy_warning computes the scale before is_conservative (which
-#: costs about as many kernel calls: _SAMPLES times a forward dynamics and six energies).
-SCALE_FIRST_ROWS = 32
+#: Rows of the first, lower-bound estimate of the scale (energy_warning).
+FEW_ROWS = 17
 
 
 def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
@@ -51,17 +50,15 @@ def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
     floor = 64 * sys.float_info.epsilon * float(np.max(np.abs(energy)))
     if not err > floor:
         return None
-    # The cheaper test first: is_conservative costs about SCALE_FIRST_ROWS kernel calls, the
-    # scale one per row (up to SCALE_ROWS); an accurate run is decided by the scale alone.
-    scale = None
-    if min(len(t), SCALE_ROWS) <= SCALE_FIRST_ROWS:
-        scale = energy_scale(module, q, t, energy, p)
-        if not err > ENERGY_FRACTION * scale:
-            return None
+    # Cheapest first. The scale over a few rows is at most the scale over all of them (a max
+    # and a range over a subset), so an error below the fraction of it is below the fraction
+    # of the whole scale: an accurate run is decided by FEW_ROWS kernel calls. Then
+    # is_conservative (a few dozen kernel calls), then the scale over up to SCALE_ROWS rows.
+    if not err > ENERGY_FRACTION * energy_scale(module, q, t, energy, p, FEW_ROWS):
+        return None
     if not is_conservative(module, q[0], v[0], t[0], p):
         return None
-    if scale is None:
-        scale = energy_scale(module, q, t, energy, p)
+    scale = energy_scale(module, q, t, energy, p)
     if not err > ENERGY_FRACTION * scale:
         return None
     from ..steppers.core.registry import INFO
@@ -74,10 +71,11 @@ def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
             f"(K v = omega^2 H v, K = dg/dq), and {method} is {stable}; {advice}")
 
 
-def energy_scale(module, q, t, energy, p):
-    """max T + (max V - min V) over up to SCALE_ROWS saved rows; V = E(q, 0, t), T = E - V."""
-    rows = (np.arange(len(t)) if len(t) <= SCALE_ROWS else
-            np.unique(np.linspace(0, len(t) - 1, SCALE_ROWS).astype(np.int64)))
+def energy_scale(module, q, t, energy, p, most=SCALE_ROWS):
+    """max T + (max V - min V) over up to ``most`` saved rows, evenly spaced, the first and the
+    last included; V = E(q, 0, t), T = E - V."""
+    rows = (np.arange(len(t)) if len(t) <= most else
+            np.unique(np.linspace(0, len(t) - 1, most).astype(np.int64)))
     zero = np.zeros(module.N_COORDS)
     energy_of = unchecked(module.energy)      # arrays made here, of the kernel's shapes
     V = np.array([energy_of(np.ascontiguousarray(q[k], dtype=np.float64), zero, float(t[k]), p)
