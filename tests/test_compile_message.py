@@ -1,10 +1,14 @@
-"""The first-use notice: a glue call that outlasts compile_notice.NOTICE_AFTER_S prints one line
-on stderr naming the glue and the model; a quick call (a cache hit) prints nothing."""
+"""The first-use notice: a glue call in which numba compiles and that outlasts
+compile_notice.NOTICE_AFTER_S prints one line on stderr naming the glue and the model; a call
+that compiles nothing (a warm call, a cache hit, a slow call without a compile) prints nothing
+and starts no thread."""
 
 import re
+import threading
 import time
 from types import SimpleNamespace
 
+import numba
 import numpy as np
 import pytest
 
@@ -16,12 +20,28 @@ LINE = re.compile(r"^lagrange-gen: compiling (\S+) for (\S+) \(first use\) \.\.\
                   r"(done in|failed after) (\d+\.\d) s\n$")
 
 
-def _glue(seconds, error=None):
-    """A stand-in for a generated run_<method>: takes any arguments, sleeps, maybe raises."""
+def _compiling_glue(error=False):
+    """A stand-in for a generated run_<method>: takes any arguments and calls a function numba
+    compiles on its first call (a new one per stand-in, never cached); with error, one whose
+    typing fails."""
+    if error:
+        @numba.njit
+        def work(x):
+            return x + "a string"
+    else:
+        @numba.njit
+        def work(x):
+            return x + 1.0
+
+    def run(*args):
+        work(1.0)
+        return 0, 0, 0
+    return run
+
+
+def _sleeping_glue(seconds):
     def run(*args):
         time.sleep(seconds)
-        if error:
-            raise error
         return 0, 0, 0
     return run
 
@@ -35,9 +55,11 @@ def _fixed_warm_up(run):
     return seconds
 
 
-def test_slow_fixed_step_first_call_prints_one_line(monkeypatch, capsys):
+def test_compiling_first_call_prints_one_line(monkeypatch, capsys):
     monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
-    seconds = _fixed_warm_up(_glue(0.3))
+    before = compile_notice.compiles()
+    seconds = _fixed_warm_up(_compiling_glue())
+    assert compile_notice.compiles() > before
     err = capsys.readouterr().err
     match = LINE.match(err)
     assert match, repr(err)
@@ -45,25 +67,80 @@ def test_slow_fixed_step_first_call_prints_one_line(monkeypatch, capsys):
     assert float(match.group(4)) == pytest.approx(seconds, abs=0.06)
 
 
-def test_fast_call_prints_nothing(capsys):
+def test_warm_call_prints_nothing_and_starts_no_thread(monkeypatch, capsys):
+    monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
+    run = _compiling_glue()
+    _fixed_warm_up(run)
+    capsys.readouterr()
+    started = []
+    monkeypatch.setattr(threading.Timer, "start", lambda self: started.append(self))
+    before = compile_notice.compiles()
+    _fixed_warm_up(run)                 # everything compiled: nothing to say
+    assert started == []
+    assert compile_notice.compiles() == before
+    assert capsys.readouterr().err == ""
+
+
+def test_slow_call_without_a_compile_prints_nothing(monkeypatch, capsys):
+    monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
+    _fixed_warm_up(_sleeping_glue(0.2))
+    time.sleep(0.05)
+    assert capsys.readouterr().err == ""
+
+
+def test_default_threshold_is_a_second(capsys):
     assert compile_notice.NOTICE_AFTER_S == 1.0
-    _fixed_warm_up(_glue(0.0))
+    _fixed_warm_up(_compiling_glue())       # a compile well under a second
     time.sleep(0.05)            # a timer that was not cancelled would have no reason to wait
     assert capsys.readouterr().err == ""
 
 
 def test_adaptive_first_call_names_method_and_model(monkeypatch, capsys):
     monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
-    task = SimpleNamespace(glue=lambda args: _glue(0.2), t0=0.0, p=np.ones(5), settings=(), method="dop853",
-                           module=SimpleNamespace(NAME="cart_pendulum"))
+    run = _compiling_glue()
+    task = SimpleNamespace(glue=lambda args: run, t0=0.0, p=np.ones(5), settings=(),
+                           method="dop853", module=SimpleNamespace(NAME="cart_pendulum"))
     _warm_up(task, np.zeros(2), np.zeros(2), np.zeros(0), np.empty(7), np.zeros((0, 7)))
     match = LINE.match(capsys.readouterr().err)
     assert match and match.group(1, 2, 3) == ("run_dop853", "cart_pendulum", "done in")
 
 
-def test_failing_slow_call_ends_its_line_and_raises(monkeypatch, capsys):
+def test_failing_compile_ends_its_line_and_raises(monkeypatch, capsys):
     monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
-    with pytest.raises(TypeError, match="bad types"):
-        _fixed_warm_up(_glue(0.2, TypeError("bad types")))
+    with pytest.raises(numba.core.errors.TypingError):
+        _fixed_warm_up(_compiling_glue(error=True))
     match = LINE.match(capsys.readouterr().err)
     assert match and match.group(3) == "failed after"
+
+
+def test_nested_notice_names_the_inner_call(monkeypatch, capsys):
+    monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
+    run = _compiling_glue()
+    with compile_notice.first_use_notice("run_verlet for outer"):
+        with compile_notice.first_use_notice("run_verlet for inner"):
+            run()
+    match = LINE.match(capsys.readouterr().err)
+    assert match and match.group(2) == "inner"
+
+
+def test_layout_sizes_from_python_compile_nothing():
+    """The sizes simulate computes from Python in every new process (out_last, out_events)
+    come from the layout functions' Python bodies: a new process compiles nothing for them
+    (a jitted helper called from Python would compile a twin each time, a second or so)."""
+    import subprocess
+    import sys
+    code = ("from numba.core import event\n"
+            "seen = []\n"
+            "class L(event.Listener):\n"
+            "    def on_start(self, ev): seen.append(ev.data['dispatcher'])\n"
+            "    def on_end(self, ev): pass\n"
+            "event.register('numba:compile', L())\n"
+            "import numpy as np\n"
+            "from lagrange_gen.steppers.core.layout import events_size, last_size, read_last\n"
+            "last = np.zeros(last_size(3, 2, with_work=True))\n"
+            "read_last(last, 3, with_work=True)\n"
+            "assert last.shape == (1 + 6 + 2 + 2 + 1,) and events_size(3) == 9\n"
+            "print(len(seen))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["0"]

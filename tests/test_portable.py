@@ -105,6 +105,7 @@ def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypa
     monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
     monkeypatch.setattr(fixed_run, "SPECIALIZE_AFTER_S", 0.0)
     monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
+    monkeypatch.setattr(fixed_run, "_READY", {})     # no choice remembered from another test
     auto = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3)
     assert auto.jit == "portable, then specialized from step 100"
     specialized = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3,
@@ -115,6 +116,7 @@ def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypa
 def test_auto_keeps_portable_on_a_short_run(generated, monkeypatch):
     monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
     monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
+    monkeypatch.setattr(fixed_run, "_READY", {})     # no choice remembered from another test
     run = simulate(generated("double_pendulum"), "symplectic_euler", [0.3, 0.2], None,
                    t_end=0.5, h=1e-3)
     assert run.jit == "portable"

@@ -7,9 +7,13 @@
    (bench/steppers.py) against that loop.
 3. 16-link chain (models/n_link_pendulum.py, n = 16): ns per step of symplectic_euler, verlet
    and rk4 against MuJoCo's Euler and RK4 on the same chain (bench/mujoco_chain.py).
-4. First simulate of a model just written: a new process with a fresh NUMBA_CACHE_DIR that
-   generates the model into a fresh directory and simulates a few steps (seconds beyond the
-   interpreter's imports); then a new process to its first step with everything cached.
+4. First simulate of a model just written: a new process with a fresh NUMBA_CACHE_DIR and
+   LAGRANGE_GEN_PORTABLE_DIR that generates the model into a fresh directory and simulates a few
+   steps (seconds beyond the interpreter's imports, and how much of it numba spends compiling
+   the kernels and the stepper); then a new process to its first step with everything cached.
+5. The cost of one call: the whole lg.simulate call as a user makes it against its jitted run,
+   warm, with the stages around the run (call_breakdown); and dop853's whole call at error 1e-8
+   against PyDy + scipy DOP853's whole solve_ivp call.
 
 Ratios inside one run, not absolute times: the machine is shared. A peer that is not installed
 is named in the report and its rows are left unmeasured.
@@ -54,20 +58,119 @@ def measure_precision(models_dir, gen_dir, quick, progress):
     mod = runs.load_module(models_dir, CASE.stem, gen_dir)
     p = runs.params_of(mod)
     reference = precision.reference_for_case(mod, CASE, p, settings)
-    ours = {}
+    ours, dop853_points = {}, []
     for method in precision.methods_for_case(CASE, None):
         sweep = precision.sweep_adaptive if registry.spec(method).adaptive else \
             precision.sweep_ours
-        ours[method] = common.time_at(sweep(mod, method, CASE, p, reference, settings,
-                                               progress))
+        points = sweep(mod, method, CASE, p, reference, settings, progress)
+        ours[method] = common.time_at(points)
+        if method == "dop853":
+            dop853_points = points
     found = {"scipy DOP853 on our right-hand side": ref.ode_rhs(mod, p)}
     pydy = peers.pydy_rhs(Path(models_dir) / f"{CASE.stem}.py", mod.PARAMS, p)
     if pydy is not None:
         found["PyDy + scipy DOP853"] = pydy[0]
-    peer_times = {name: common.time_at(precision.sweep_peer(
-        name, f, None, "DOP853", settings.dop_rtols, mod, CASE, p, reference, settings, progress))
+    peer_points = {name: precision.sweep_peer(
+        name, f, None, "DOP853", settings.dop_rtols, mod, CASE, p, reference, settings, progress)
         for name, f in found.items()}
-    return {"ours": ours, "peers": peer_times, "pydy": pydy and pydy[2]}
+    peer_times = {name: common.time_at(points) for name, points in peer_points.items()}
+    whole = whole_call_at_target(mod, p, dop853_points, peer_points.get("PyDy + scipy DOP853"),
+                                 repeats=5 if quick else 21)
+    return {"ours": ours, "peers": peer_times, "pydy": pydy and pydy[2], "whole": whole}
+
+
+def _first_at_target(points):
+    """The first point of a sweep (coarse to fine) whose final error is at or below
+    common.TARGET, or None."""
+    return next((pt for pt in points or () if not pt.failed and pt.final <= common.TARGET), None)
+
+
+def whole_call_at_target(mod, p, dop853_points, pydy_points, repeats):
+    """The whole ``lg.simulate`` call as a user makes it (checks, set-up, the jitted run, the
+    Trajectory) for dop853 at the first rtol of its sweep that reaches common.TARGET, median
+    seconds over ``repeats`` calls, beside its jitted run alone (Trajectory.wall_time) and
+    PyDy + scipy DOP853's whole solve_ivp call at its first rtol that reaches the target (the
+    sweep's best of repeats; None when PyDy is not installed). Returns a dict."""
+    import statistics
+    import time
+    from ..run.simulate import simulate
+    ours = _first_at_target(dop853_points)
+    if ours is None:
+        return None
+    t_grid = np.linspace(0.0, CASE.t_end, CASE.samples + 1)
+    calls, runs_only = [], []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        traj = simulate(mod, "dop853", CASE.q0, CASE.v0, t_end=CASE.t_end, params=p,
+                        t_eval=t_grid, rtol=ours.param, atol=ours.param / 100)
+        calls.append(time.perf_counter() - start)
+        runs_only.append(traj.wall_time)
+    theirs = _first_at_target(pydy_points)
+    return {"rtol": ours.param, "final": ours.final, "call": statistics.median(calls),
+            "run": statistics.median(runs_only),
+            "pydy": None if theirs is None else theirs.wall,
+            "pydy_rtol": None if theirs is None else theirs.param,
+            "pydy_final": None if theirs is None else theirs.final}
+
+
+#: One warm call per row of the per-call breakdown: (label, method, simulate keywords).
+CALLS = (("midpoint, 1 step", "midpoint", {"t_end": 1e-3, "h": 1e-3}),
+         ("rk4, 1000 steps", "rk4", {"t_end": 1.0, "h": 1e-3}),
+         ("dop853, t_end = 1e-3", "dop853", {"t_end": 1e-3}))
+
+
+def call_breakdown(mod, calls=2000):
+    """Per CALLS row: median microseconds over ``calls`` warm calls of the whole lg.simulate
+    call, of the stepping (Trajectory.wall_time: the jitted run and its chunk loop) and of the
+    stages around it, timed by wrapping the functions simulate calls (run/simulate.py's names,
+    restored afterwards): the driver (glue choice, buffers, the chunk loop), the Trajectory
+    (with the energy check), and resolving the model file's path for its source record."""
+    import statistics
+    import time
+    from ..run import simulate as sim
+    stages = {"driver": ("integrate_fixed", "integrate_adaptive"),
+              "trajectory": ("fixed_step_trajectory", "adaptive_trajectory")}
+    times, saved = {stage: [] for stage in stages}, {}
+
+    def timed(stage, fn):
+        def wrapper(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                times[stage].append(time.perf_counter() - start)
+        return wrapper
+
+    model_file = Path(mod.__file__).parent / mod.MODEL_PATH
+    rows = []
+    try:
+        for stage, names in stages.items():
+            for name in names:
+                saved[name] = getattr(sim, name)
+                setattr(sim, name, timed(stage, saved[name]))
+        for label, method, kwargs in CALLS:
+            sim.simulate(mod, method, CASE.q0, CASE.v0, **kwargs)          # compile or load
+            times.update(driver=[], trajectory=[])
+            whole, stepping = [], []
+            for _ in range(calls):
+                start = time.perf_counter()
+                traj = sim.simulate(mod, method, CASE.q0, CASE.v0, **kwargs)
+                whole.append(time.perf_counter() - start)
+                stepping.append(traj.wall_time)
+            resolve = []
+            for _ in range(min(calls, 500)):
+                start = time.perf_counter()
+                model_file.resolve()
+                resolve.append(time.perf_counter() - start)
+            med = {k: 1e6 * statistics.median(v) for k, v in
+                   dict(whole=whole, stepping=stepping, resolve=resolve, **times).items()}
+            rows.append({"label": label, "jit": traj.jit, **med,
+                         "beyond": med["whole"] - med["stepping"],
+                         "checks": med["whole"] - med["driver"] - med["trajectory"]})
+    finally:
+        for name, fn in saved.items():
+            setattr(sim, name, fn)
+    return rows
 
 
 def portable_step_ns(mod, method, steps, repeats):
@@ -119,9 +222,24 @@ _COLD_CHILD = r"""
 import json, sys, time
 t0 = time.perf_counter()
 import numba, numpy  # noqa: F401
+from numba.core import event
 from lagrange_gen.run.loader import load
 from lagrange_gen.run.simulate import simulate
 t1 = time.perf_counter()
+# where the compile time goes: numba's outermost compiles, by what they compile
+compiles, depth = {"kernels": 0.0, "stepper": 0.0, "other": 0.0}, []
+class Outermost(event.Listener):
+    def on_start(self, ev):
+        depth.append((time.perf_counter(), ev.data["dispatcher"]))
+    def on_end(self, ev):
+        start, dispatcher = depth.pop()
+        if not depth:
+            name = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+            kind = ("kernels" if name.startswith("lagrange_gen_generated") else "stepper"
+                    if name.startswith(("lagrange_gen_portable", "lagrange_gen.steppers"))
+                    else "other")
+            compiles[kind] += time.perf_counter() - start
+event.register("numba:compile", Outermost())
 path, out_dir, method, options, q0, jit = sys.argv[1], sys.argv[2], sys.argv[3], \
     json.loads(sys.argv[4]), json.loads(sys.argv[5]), sys.argv[6]
 mod = load(path, out_dir=out_dir, methods=[method], options=options)
@@ -129,7 +247,7 @@ t2 = time.perf_counter()
 traj = simulate(mod, method, q0, None, t_end=0.01, h=1e-3, jit=jit)
 t3 = time.perf_counter()
 print(json.dumps({"imports": t1 - t0, "generate": t2 - t1, "first_simulate": t3 - t2,
-                  "path": mod.__file__, "jit": traj.jit}))
+                  "path": mod.__file__, "jit": traj.jit, "compiles": compiles}))
 """
 
 
@@ -142,8 +260,10 @@ WARMUP_DEFAULT = ("double_pendulum", [0.1, 0.2])
 
 def _cold_child(models_dir, stem, options, method, q0, out_dir, cache, jit="auto"):
     """Run _COLD_CHILD in a new process with NUMBA_CACHE_DIR=cache (numba's cache of the
-    portable glue included: it lives there too) and simulate(jit=jit); its timings (dict)."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+    portable glue included: it lives there too) and LAGRANGE_GEN_PORTABLE_DIR=cache-portable
+    (the portable glue's sources), and simulate(jit=jit); its timings (dict)."""
+    from ..jit.portable import DIR_ENV
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), **{DIR_ENV: f"{cache}-portable"})
     done = subprocess.run([sys.executable, "-c", _COLD_CHILD, str(Path(models_dir) / f"{stem}.py"),
                            str(out_dir), method, json.dumps(options), json.dumps(q0), jit],
                           env=env, capture_output=True, text=True)
@@ -177,6 +297,7 @@ def measure_cold(models_dir, work):
         own = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"sgen{i}",
                           Path(work) / f"scache{i}", jit="specialized")
         rows.append({"label": label, "method": method, "goal": goal, "cache": cache, **cold,
+                     "library_compiles": lib["compiles"],
                      "total": cold["generate"] + cold["first_simulate"],
                      "library_cached": lib["generate"] + lib["first_simulate"],
                      "library_generate": lib["generate"], "library_jit": lib["jit"],
@@ -202,6 +323,7 @@ def run_speed_bench(models_dir="models", gen_dir="generated", reports_dir="repor
         results["warm"] = measure_new_process(rk4["path"], "rk4", rk4["cache"])
     bar = common.Progress(0, "speed", enabled=False)
     results["precision"] = measure_precision(models_dir, gen_dir, quick, bar)
+    results["calls"] = call_breakdown(mod, calls=300 if quick else 2000)
     steps, repeats = (20_000, 2) if quick else (100_000, 5)
     results["steps"] = [r for r in measure_step_times(mod, steps, repeats)
                         if r["method"] in HAND_CLOSED_FORM]

@@ -6,6 +6,8 @@ from __future__ import annotations
 #: The goals each row is judged against: a warm start beyond the imports (s), the speed-up over
 #: PyDy at equal error, our step time over a hand-written loop, MuJoCo's RK4 over ours.
 WARM_GOAL_S, PEER_GOAL, HAND_GOAL, MUJOCO_RK4_GOAL = 0.5, 100.0, 1.5, 3.0
+#: Microseconds a warm lg.simulate call may cost beyond its stepping (small model).
+CALL_GOAL_US = 50.0
 
 PYDY = "PyDy + scipy DOP853"
 
@@ -37,6 +39,32 @@ def _precision_row(res):
             _met(ratio >= PEER_GOAL)]
 
 
+def _whole_call_row(res):
+    """dop853's whole lg.simulate call at error 1e-8 against PyDy's whole solve_ivp call."""
+    work = ("cart pendulum, the whole lg.simulate call (checks, set-up, run, Trajectory) at "
+            "final error 1e-8, against PyDy + scipy DOP853's whole solve_ivp call")
+    whole = res.get("whole")
+    if whole is None:
+        return [work, "dop853 did not reach the target: not measured", ">= 100x", "-"]
+    ours = (f"dop853 rtol {whole['rtol']:.0e}: {whole['call'] * 1e3:.2f} ms whole "
+            f"({whole['run'] * 1e3:.2f} ms the jitted run)")
+    if whole["pydy"] is None:
+        return [work, f"{ours}; PyDy not installed (pip install 'lagrange-gen[peers]'): "
+                      f"not compared", ">= 100x", "-"]
+    ratio = whole["pydy"] / whole["call"]
+    return [work, f"{ratio:.0f}x faster ({ours}; PyDy rtol {whole['pydy_rtol']:.0e} "
+                  f"{whole['pydy'] * 1e3:.1f} ms)", f">= {PEER_GOAL:.0f}x",
+            _met(ratio >= PEER_GOAL)]
+
+
+def _call_rows(calls):
+    """One row per warm call of bench/speed.py CALLS: microseconds beyond the stepping."""
+    return [[f"warm lg.simulate call, cart pendulum, {r['label']}: cost beyond the stepping",
+             f"{r['beyond']:.0f} us (whole call {r['whole']:.0f} us, stepping "
+             f"{r['stepping']:.0f} us)", f"<= {CALL_GOAL_US:.0f} us",
+             _met(r["beyond"] <= CALL_GOAL_US)] for r in calls]
+
+
 def _hand_row(steps):
     ratios = {r["method"]: r["ours_ns"] / r["hand_ns"] for r in steps}
     text = ", ".join(f"{m} {x:.1f}x" for m, x in ratios.items()) + " slower"
@@ -63,13 +91,14 @@ def _chain_rows(chain, n_links):
 
 
 def _cold_rows(cold):
-    """One row per cold case: derive + generate + load + compile + first steps of a model just
-    written (the stepper library cached by an earlier model), the fully cold total beside it."""
-    return [[f"first simulate of a model just written, beyond imports: {r['label']}",
-             f"{r['library_cached']:.1f} s (first model after an install, everything cold: "
-             f"{r['total']:.1f} s)", f"<= {r['goal']:.0f} s",
-             f"{_met(r['library_cached'] <= r['goal'])} (everything cold: "
-             f"{_met(r['total'] <= r['goal'])})"] for r in cold]
+    """One row per cold case: derive + generate + load + compile + first steps on a clean
+    machine (empty numba cache and portable directory), judged against the goal; the model
+    just written (the stepper library cached by an earlier model) beside it."""
+    return [[f"first simulate on a clean machine (empty caches), beyond imports: {r['label']}",
+             f"{r['total']:.1f} s (a model just written, the stepper cached: "
+             f"{r['library_cached']:.1f} s)", f"<= {r['goal']:.0f} s",
+             f"{_met(r['total'] <= r['goal'])} (model just written: "
+             f"{_met(r['library_cached'] <= r['goal'])})"] for r in cold]
 
 
 def _warm_row(warm):
@@ -81,7 +110,8 @@ def _warm_row(warm):
 
 def markdown(results):
     """Lines of reports/speed.md."""
-    rows = [_precision_row(results["precision"]), _hand_row(results["steps"]),
+    rows = [_precision_row(results["precision"]), _whole_call_row(results["precision"]),
+            *_call_rows(results["calls"]), _hand_row(results["steps"]),
             *_chain_rows(results["chain"], results["chain_n"]), *_cold_rows(results["cold"]),
             _warm_row(results["warm"])]
     quick = " --quick" if results["quick"] else ""
@@ -91,6 +121,7 @@ def markdown(results):
              "| work | this run | goal | |", "|---|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     return lines + ["", *_precision_details(results["precision"], results["case"]),
+                    *_call_details(results["calls"], results["precision"].get("whole")),
                     *_step_details(results["steps"]), *_chain_details(results["chain"], results["chain_n"]),
                     *_cold_details(results["cold"], results["warm"])]
 
@@ -108,6 +139,31 @@ def _precision_details(res, case):
              "| method | wall time to 1e-8 |", "|---|---|"]
     lines += [f"| {m} | {_ms(t)} |" for m, t in res["ours"].items()]
     lines += [f"| {name} | {_ms(t)} |" for name, t in res["peers"].items()]
+    return lines + [""]
+
+
+def _call_details(calls, whole):
+    lines = ["## The cost of one call (microseconds, medians of warm calls)", "",
+             "The whole `lg.simulate(mod, method, q0, v0, ...)` call timed around it, against "
+             "its stepping (Trajectory.wall_time: the jitted run and the chunk loop around it); "
+             "the stages are timed by wrapping the functions simulate calls (bench/speed.py "
+             "call_breakdown). Checks and set-up: the whole call less the driver and the "
+             "Trajectory. The model file's path is resolved for the Trajectory's source record "
+             "(part of the Trajectory column).", "",
+             "| call | glue | whole call | stepping | beyond the stepping | checks and set-up | "
+             "driver (incl. stepping) | Trajectory (incl. energy check) | resolving the "
+             "model file's path |", "|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"| {r['label']} | {r['jit']} | {r['whole']:.0f} | {r['stepping']:.0f} | "
+              f"{r['beyond']:.0f} | {r['checks']:.0f} | {r['driver']:.0f} | "
+              f"{r['trajectory']:.0f} | {r['resolve']:.0f} |" for r in calls]
+    if whole is not None:
+        lines += ["", f"dop853 at rtol {whole['rtol']:.0e} (final error {whole['final']:.2g}): "
+                      f"whole call {whole['call'] * 1e3:.3f} ms, jitted run "
+                      f"{whole['run'] * 1e3:.3f} ms"
+                      + ("" if whole["pydy"] is None else
+                         f"; PyDy + scipy DOP853 at rtol {whole['pydy_rtol']:.0e} (final error "
+                         f"{whole['pydy_final']:.2g}): {whole['pydy'] * 1e3:.2f} ms per "
+                         f"solve_ivp call") + "."]
     return lines + [""]
 
 
@@ -143,17 +199,19 @@ def _cold_details(cold, warm):
              "a numba cache in which another model (bench/speed.py WARMUP_STEM) already ran the "
              "method, so the portable stepper is cached and nothing of this model is; what "
              "every new model but the first after an install costs. \"Everything cold\": a "
-             "fresh NUMBA_CACHE_DIR, the portable stepper compiled too (once per method and "
+             "fresh NUMBA_CACHE_DIR and LAGRANGE_GEN_PORTABLE_DIR (a clean machine), the portable stepper compiled too (once per method and "
              "library version). \"Specialized\": everything cold with jit=\"specialized\", "
              "the model's own stepper compiled (what every new model cost before the portable "
              "glue).", "",
              "| model, method | derive + generate | load, compile, first steps | model just "
-             "written | loop | everything cold | specialized, everything cold | goal |",
-             "|---|---|---|---|---|---|---|---|"]
+             "written | loop | everything cold | of which numba compiling kernels / stepper "
+             "/ other | specialized, everything cold | goal |",
+             "|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['label']} | {r['library_generate']:.2f} | "
               f"{r['library_cached'] - r['library_generate']:.2f} | {r['library_cached']:.2f} | "
-              f"{r['library_jit']} | {r['total']:.2f} | {r['specialized']:.2f} | "
-              f"<= {r['goal']:.0f} |" for r in cold]
+              f"{r['library_jit']} | {r['total']:.2f} | {r['compiles']['kernels']:.2f} / "
+              f"{r['compiles']['stepper']:.2f} / {r['compiles']['other']:.2f} | "
+              f"{r['specialized']:.2f} | <= {r['goal']:.0f} |" for r in cold]
     return lines + ["", f"Warm cache (cart pendulum, rk4): interpreter + numpy/numba imports "
                         f"{warm['imports']:.2f} s, module import {warm['module_import']:.2f} s, "
                         f"run_rk4 load + first step {warm['first_step']:.3f} s.", ""]

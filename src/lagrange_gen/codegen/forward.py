@@ -87,7 +87,9 @@ def accelerations(q, qd, t=0.0, params=None):
         PARAMS, DEFAULTS, params, NAME, frozen=FROZEN)
     H = np.empty((N_COORDS, N_COORDS))
     qdd = np.empty(N_COORDS)
-    if forward_dynamics(q, qd, float(t), p, H, qdd) != OK:
+    # the arguments are this function's own, of the right shapes: the kernel's call without
+    # its check from Python (set by check_python_calls)
+    if _forward_dynamics_unchecked(q, qd, float(t), p, H, qdd) != OK:
         raise SingularMass(f"{NAME}: singular mass matrix H(q) at q = {q.tolist()}", state=q.copy())
     return qdd
 '''

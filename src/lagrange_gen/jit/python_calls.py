@@ -23,7 +23,9 @@ __all__ = ["check_python_calls", "check_kernel_arguments", "unchecked"]
 
 def check_python_calls(namespace):
     """Make every kernel of the generated module whose globals are ``namespace`` (its KERNELS
-    and forward_dynamics) check its arguments when called from Python; returns nothing."""
+    and forward_dynamics) check its arguments when called from Python, and give the module
+    ``_forward_dynamics_unchecked``, the call without the check, for its ``accelerations``
+    (which makes the arguments itself); returns nothing."""
     dimensions = kernel_dimensions(namespace)
     model = namespace.get("NAME", namespace.get("__name__", "module"))
     for kernel in tuple(namespace.get("KERNELS", ())) + ("forward_dynamics",):
@@ -34,6 +36,8 @@ def check_python_calls(namespace):
         dispatcher.__class__ = _checked_class(type(dispatcher))
         dispatcher.python_call_fast = _fast_check(shapes)
         dispatcher.python_call_check = functools.partial(_full_check, f"{model}.{kernel}", shapes)
+    if "forward_dynamics" in namespace:
+        namespace["_forward_dynamics_unchecked"] = unchecked(namespace["forward_dynamics"])
 
 
 def unchecked(kernel):

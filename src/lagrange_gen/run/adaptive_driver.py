@@ -15,13 +15,15 @@ import time
 import numpy as np
 
 from .failures import raise_for_status
-from .fixed_driver import EVENT_ROWS, ProgressBar
+from .fixed_driver import EVENT_ROWS, ProgressBar, ready_glue, remember_glue
 from ..jit.compile_notice import first_use_notice
 from ..steppers.core import status as st
 from ..steppers.core.layout import N_STATS, events_size, last_size, read_last
 
-#: Rows per call into the jitted loop when every accepted step is saved.
+#: Rows per call into the jitted loop when every accepted step is saved (the first call has
+#: FIRST_ROWS, each next one four times more, up to CHUNK_ROWS).
 CHUNK_ROWS = 50_000
+FIRST_ROWS = 256
 
 # counters: [h (in: first step, 0 = automatic; out: next proposal), accepted, rejected, evaluations]
 C_H, C_ACCEPTED, C_REJECTED, C_EVALS = 0, 1, 2, 3
@@ -40,12 +42,35 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
     counters = np.array([task.h or 0.0, 0.0, 0.0, 0.0])
     events = np.zeros((EVENT_ROWS if getattr(m, "N_EVENTS", 0) else 0, events_size(n)))
     wanted = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=np.float64)
-    run, compile_time = _warm_up(task, q, v, initial, last.copy(), events[:0])
-    parts, n_events, t, start = [], 0, t0, time.perf_counter()
+    label = f"run_{task.method} for {m.NAME}"
+    run, compile_time = ready_glue(task), 0.0
+    if run is None:
+        run, compile_time = _warm_up(task, q, v, initial, last.copy(), events[:0])
+        remember_glue(task, run)
+    start = time.perf_counter()
     bar = ProgressBar(1000) if progress else None
+    with first_use_notice(label):     # nothing compiles past the warm-up; if it does, say so
+        parts, n_events = _calls(task, run, q, v, initial, last, counters, events, wanted,
+                                 t_end, t_eval, bar)
+    wall = time.perf_counter() - start
+    if bar:
+        bar.close()
+    out = {k: np.concatenate([part[k] for part in parts]) for k in parts[0]}
+    out.update(events=events, n_events=n_events, last=last, counters=counters)
+    return out, compile_time, wall
+
+
+def _calls(task, run, q, v, initial, last, counters, events, wanted, t_end, t_eval, bar):
+    """The calls of the adaptive glue from (q, v) at task.t0 until t_end, every requested time
+    or a terminal event; returns (the rows of each call, events located)."""
+    m, n, t0 = task.module, task.module.N_COORDS, task.t0
+    n_saved = initial.shape[0]
+    parts, n_events, t = [], 0, t0
     extra0 = initial.copy()
     while True:
-        rows = len(wanted) + 1 if len(wanted) else CHUNK_ROWS
+        # Buffers of FIRST_ROWS rows first, four times more per call up to CHUNK_ROWS: a short
+        # run does not allocate (and zero) the rows of a long one.
+        rows = len(wanted) + 1 if len(wanted) else min(CHUNK_ROWS, FIRST_ROWS * 4 ** len(parts))
         rows = min(rows, CHUNK_ROWS)
         buf = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
                    stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)))
@@ -71,12 +96,7 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
         if t >= t_end or (t_eval is not None and not len(wanted)) or _stopped(m, events,
                                                                                 n_events, t):
             break
-    wall = time.perf_counter() - start
-    if bar:
-        bar.close()
-    out = {k: np.concatenate([part[k] for part in parts]) for k in parts[0]}
-    out.update(events=events, n_events=n_events, last=last, counters=counters)
-    return out, compile_time, wall
+    return parts, n_events
 
 
 def _stopped(module, events, n_events, t):

@@ -19,6 +19,8 @@ that simulate, ensemble and Stepper refuse the same inputs the same way.
 from __future__ import annotations
 
 import math
+import sys
+import time
 
 import numpy as np
 
@@ -85,7 +87,9 @@ def vector(name, value, n, coords):
     if value is None:
         return np.zeros(n)
     try:
-        arr = np.asarray(value, dtype=np.float64).reshape(-1)
+        # a copy: the caller's array stays untouched, and the glue always sees a writable
+        # C-contiguous float64 array (one numba type for every call)
+        arr = np.array(value, dtype=np.float64).reshape(-1)
     except (TypeError, ValueError):
         raise SimulationError(f"{name} must be a sequence of {n} numbers, got {value!r}") from None
     if arr.shape[0] != n:
@@ -258,8 +262,8 @@ def check_time_resolution(t0, t_last, h, n_steps):
     max(TIME_RESOLUTION, 2 n_steps eps) h in float64 (e.g. t0 = 1.7e9 with h = 1e-7: saved
     times repeat, forces see frozen times)."""
     biggest = max(abs(t0), abs(t_last))
-    spacing = float(np.spacing(biggest))
-    allowed = max(TIME_RESOLUTION, 2 * n_steps * np.finfo(float).eps) * h
+    spacing = math.ulp(biggest)              # np.spacing of a float, without numpy's overhead
+    allowed = max(TIME_RESOLUTION, 2 * n_steps * sys.float_info.epsilon) * h
     if spacing > allowed:
         raise SimulationError(
             f"t0 = {t0:g} with h = {h:g}: float64 numbers near |t| = {biggest:g} are "
@@ -298,6 +302,15 @@ def saved_bytes(rows, n, n_saved):
     return rows * 8 * (2 * n + 2 * n_saved + _ROW_COLUMNS)
 
 
+#: check_memory reads the available memory (a dozen /proc and cgroup files, most of a short
+#: run's cost) again only for a need above SMALL_FRACTION of the last reading or when that
+#: reading is older than REREAD_AFTER_S: a run of many short simulate calls checks once a second.
+SMALL_FRACTION = 0.01
+REREAD_AFTER_S = 1.0
+#: [the available_memory read (a test may replace it), when (time.monotonic), bytes or None]
+_LAST_READING = [None, 0.0, None]
+
+
 def check_memory(model, n_steps, save_every, n, n_saved, need=None, what=None):
     """Refuse, before allocating, a run whose saved rows do not fit in the available memory,
     suggesting the save_every that would leave half of it free. need: the bytes the caller
@@ -305,7 +318,13 @@ def check_memory(model, n_steps, save_every, n, n_saved, need=None, what=None):
     (default "saving S states (N steps, save_every = K)")."""
     rows = saved_rows(n_steps, save_every)
     need = saved_bytes(rows, n, n_saved) if need is None else need
+    reader, stamp, seen = _LAST_READING
+    now = time.monotonic()
+    if (reader is available_memory and seen is not None and now - stamp < REREAD_AFTER_S
+            and need <= SMALL_FRACTION * seen):
+        return
     free = available_memory()
+    _LAST_READING[:] = [available_memory, now, free]
     if free is None or need <= free:
         return
     suggest = save_every * math.ceil(need / (0.5 * free))

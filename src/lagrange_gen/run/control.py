@@ -7,7 +7,10 @@ vector p, so every generated kernel reads them without a change of signature. Be
 changed input re-runs the method's prepare, which may have cached forces). Supplied by
 
 * a controller ``u = f(t, q, qd, p)``, a numba-jitted function returning a float (one input),
-  a 1-D array or a tuple (n_inputs), evaluated at the state at the start of each step;
+  a 1-D array or a tuple (n_inputs), evaluated at the state at the start of each step; with
+  ``control_params=c`` (a 1-D array of numbers: gains, set points) it is ``f(t, q, qd, p, c)``,
+  and new values of c run the loop already compiled for f (a new controller function compiles
+  the loop again, seconds: tune gains through c);
 * a :class:`Signal` of samples (times (S,), values (S, n_inputs)), held between samples
   (``hold="zoh"``) or interpolated linearly (``hold="linear"``, evaluated at the middle of each
   step, which keeps an input error of O(h^2) in the step);
@@ -137,32 +140,66 @@ def _signal_apply(data, t, q, v, p):
 _APPLY = {}
 
 
-def make_apply(controller):
+def make_apply(controller, with_params=False):
     """The loop hook apply(data, t, q, v, p) of a jitted controller u = f(t, q, qd, p); data =
-    (first input slot,). One per controller (kept, so its compilation is reused)."""
+    (first input slot,). with_params: u = f(t, q, qd, p, c), data = (first input slot, c (k,)).
+    One per controller (kept, so its compilation is reused)."""
     if not hasattr(controller, "py_func"):
         raise SimulationError(f"control: {getattr(controller, '__name__', controller)!r} is not "
                               "numba-jitted; decorate it with @numba.njit (it runs inside the loop)")
-    _check_arity(controller)
-    if controller not in _APPLY:
-        @njit(**FAST)
-        def apply(data, t, q, v, p):
-            return _write_inputs(controller(t, q, v, p), p, data[0])
-        _APPLY[controller] = apply
-    return _APPLY[controller]
+    _check_arity(controller, with_params)
+    key = (controller, with_params)
+    if key not in _APPLY:
+        if with_params:
+            @njit(**FAST)
+            def apply(data, t, q, v, p):
+                return _write_inputs(controller(t, q, v, p, data[1]), p, data[0])
+        else:
+            @njit(**FAST)
+            def apply(data, t, q, v, p):
+                return _write_inputs(controller(t, q, v, p), p, data[0])
+        _APPLY[key] = apply
+    return _APPLY[key]
 
 
-def _check_arity(controller):
+def _check_arity(controller, with_params=False):
     """numba's "too many arguments" would come from inside the loop's compile: a controller must
-    take (t, q, qd, p), checked on its Python function."""
+    take (t, q, qd, p), or (t, q, qd, p, c) with control_params, checked on its Python
+    function."""
     import inspect
+    args = ("t, q, qd, p, c", (0.0, None, None, None, None)) if with_params else \
+        ("t, q, qd, p", (0.0, None, None, None))
     try:
-        inspect.signature(controller.py_func).bind(0.0, None, None, None)
+        inspect.signature(controller.py_func).bind(*args[1])
     except TypeError:
+        given = " (control_params given)" if with_params else ""
         raise SimulationError(f"control: the controller {controller.__name__}"
-                              f"{inspect.signature(controller.py_func)} must take (t, q, qd, p)") from None
+                              f"{inspect.signature(controller.py_func)} must take "
+                              f"({args[0]}){given}") from None
     except ValueError:         # no signature to read: numba tells
         pass
+
+
+def control_params_vector(control, values):
+    """control_params as a C-contiguous float64 vector (k,), or a SimulationError naming what is
+    wrong: it needs a jitted controller, and finite numbers in a flat sequence."""
+    if control is None or isinstance(control, Signal):
+        what = "no controller" if control is None else "a Signal"
+        raise SimulationError(f"control_params= are the parameters of a controller "
+                              f"u = f(t, q, qd, p, c); control= is {what}")
+    try:
+        c = np.array(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise SimulationError(f"control_params must be a sequence of numbers, got "
+                              f"{values!r}") from None
+    if c.ndim > 1:
+        raise SimulationError(f"control_params must be a flat sequence of numbers, got an array "
+                              f"of shape {c.shape}")
+    c = np.ascontiguousarray(c.reshape(-1))
+    bad = np.flatnonzero(~np.isfinite(c))
+    if bad.size:
+        raise SimulationError(f"control_params[{bad[0]}] = {float(c[bad[0]])!r} is not finite")
+    return c
 
 
 def blame_inputs(error, module, p, control):
@@ -220,13 +257,15 @@ def controlled_run(module, method, apply):
     return _RUNS[key]
 
 
-def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None):
+def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None, control_params=None):
     """(p (n_params,), hook, data) for a run: the parameters with the inputs' slots filled
-    (controller and signal: by the loop; hook None for constant inputs). A model input with no
+    (controller and signal: by the loop; hook None for constant inputs). control_params: the
+    controller's own parameters c (then u = f(t, q, qd, p, c)). A model input with no
     value (no control, no params entry, no default), or a controller whose value at (t0, q0,
     v0) has the wrong size, is a SimulationError naming it."""
     first, k = input_slots(module)
     names = list(module.PARAMS[first:])
+    c = None if control_params is None else control_params_vector(control, control_params)
     if control is None:
         if params is None or isinstance(params, dict):
             missing = [u for u, d in zip(names, module.DEFAULTS[first:])
@@ -254,17 +293,17 @@ def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None):
                                   f"value(s) per sample for {k} input(s) ({', '.join(names)})")
         return p, _signal_apply, (control.times, control.values, control.hold == "linear",
                                   first, 0.5 * h)
-    apply = make_apply(control)
+    apply = make_apply(control, c is not None)
     if q0 is not None:
-        _check_size(module, control, float(t0), q0, v0, p, names)
-    return p, apply, (first,)
+        _check_size(module, control, float(t0), q0, v0, p, names, c)
+    return p, apply, (first,) if c is None else (first, c)
 
 
-def _check_size(module, controller, t0, q0, v0, p, names):
+def _check_size(module, controller, t0, q0, v0, p, names, c=None):
     """The jitted loop writes a controller's value without bounds checks: its size must be
     n_inputs, checked here once (the controller called from Python at the initial state)."""
-    u = np.atleast_1d(np.asarray(controller(t0, np.array(q0, dtype=np.float64),
-                                            np.array(v0, dtype=np.float64), p.copy())))
+    args = (t0, np.array(q0, dtype=np.float64), np.array(v0, dtype=np.float64), p.copy())
+    u = np.atleast_1d(np.asarray(controller(*args) if c is None else controller(*args, c.copy())))
     if u.ndim != 1 or u.shape[0] != len(names):
         raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns "
                               f"{u.size} value(s) at t0 for {len(names)} input(s) "

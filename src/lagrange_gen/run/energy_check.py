@@ -26,8 +26,11 @@ dependence with power as not; a model left undecided (every sample singular) get
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
+from ..jit.python_calls import unchecked
 from ..steppers.core.status import OK
 
 ENERGY_FRACTION = 0.1
@@ -36,16 +39,23 @@ SCALE_ROWS = 1001
 #: conserving energy (central differences are good to about 1e-8 here).
 POWER_RTOL = 1e-6
 _SAMPLES = 4
+#: Rows of the first, lower-bound estimate of the scale (energy_warning).
+FEW_ROWS = 17
 
 
 def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
     """One line (str) or None. q, v (S, n), t (S,), energy (S,) of a finished unconstrained run,
     p (n_params,), h the step (an adaptive run: its mean step), advice what to change."""
     err = float(np.max(np.abs(energy - energy[0])))
-    floor = 64 * np.finfo(float).eps * float(np.max(np.abs(energy)))
+    floor = 64 * sys.float_info.epsilon * float(np.max(np.abs(energy)))
     if not err > floor:
         return None
-    # The cheap test first: a few kernel calls, against up to SCALE_ROWS for the scale.
+    # Cheapest first. The scale over a few rows is at most the scale over all of them (a max
+    # and a range over a subset), so an error below the fraction of it is below the fraction
+    # of the whole scale: an accurate run is decided by FEW_ROWS kernel calls. Then
+    # is_conservative (a few dozen kernel calls), then the scale over up to SCALE_ROWS rows.
+    if not err > ENERGY_FRACTION * energy_scale(module, q, t, energy, p, FEW_ROWS):
+        return None
     if not is_conservative(module, q[0], v[0], t[0], p):
         return None
     scale = energy_scale(module, q, t, energy, p)
@@ -61,11 +71,15 @@ def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
             f"(K v = omega^2 H v, K = dg/dq), and {method} is {stable}; {advice}")
 
 
-def energy_scale(module, q, t, energy, p):
-    """max T + (max V - min V) over up to SCALE_ROWS saved rows; V = E(q, 0, t), T = E - V."""
-    rows = np.unique(np.linspace(0, len(t) - 1, min(len(t), SCALE_ROWS)).astype(np.int64))
+def energy_scale(module, q, t, energy, p, most=SCALE_ROWS):
+    """max T + (max V - min V) over up to ``most`` saved rows, evenly spaced, the first and the
+    last included; V = E(q, 0, t), T = E - V."""
+    rows = (np.arange(len(t)) if len(t) <= most else
+            np.unique(np.linspace(0, len(t) - 1, most).astype(np.int64)))
     zero = np.zeros(module.N_COORDS)
-    V = np.array([module.energy(np.ascontiguousarray(q[k]), zero, float(t[k]), p) for k in rows])
+    energy_of = unchecked(module.energy)      # arrays made here, of the kernel's shapes
+    V = np.array([energy_of(np.ascontiguousarray(q[k], dtype=np.float64), zero, float(t[k]), p)
+                  for k in rows])
     T = energy[rows] - V
     return float(np.max(T) + np.max(V) - np.min(V))
 

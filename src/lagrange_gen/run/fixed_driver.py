@@ -66,13 +66,37 @@ def integrate_fixed(task, q, v, out, progress):
     integration seconds). Raises the exception of a failure status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     last = np.zeros(last_size(n, out["extra"].shape[1], with_work=True))
-    args = warm_up_args(q, v, t0, h, task.p, task.settings, out["extra"][:1].copy(),
-                        last.copy(), out["events"][:0])
+
+    def args():
+        return warm_up_args(q, v, t0, h, task.p, task.settings, out["extra"][:1].copy(),
+                            last.copy(), out["events"][:0])
+
     label = f"run_{task.method} for {m.NAME}"
-    run, compile_time = warm_up(lambda: task.glue(args), args, label)
+    run = ready_glue(task)
+    compile_time = 0.0
+    if run is None:
+        first = args()
+        run, compile_time = warm_up(lambda: task.glue(first), first, label)
+        remember_glue(task, run)
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
+    # Nothing should compile past the warm-up; if numba does (arguments of a type the
+    # warm-up did not see), the notice says so instead of a silent pause.
+    with first_use_notice(label):
+        done, row, switch, compile_time = _chunks(task, run, q, v, out, last, args, label, bar,
+                                                  chunk, start, compile_time)
+    wall = time.perf_counter() - start - switch
+    if bar:
+        bar.close()
+    out["last"], out["rows"], out["steps"] = last, row + 1, done
+    return compile_time, wall
+
+
+def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_time):
+    """The chunk loop of integrate_fixed (args(): the arguments of a warm-up call); returns
+    (steps done, last row, seconds spent switching to the specialized glue, compile seconds)."""
+    m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     done, row, switch = 0, 0, 0.0
     while True:
         k = min(chunk, task.n_steps - done)
@@ -105,15 +129,40 @@ def integrate_fixed(task, q, v, out, progress):
             break
         if task.ran == "portable" and task.jit == "auto" and _worth_specializing(
                 time.perf_counter() - start - switch, done, task.n_steps):
-            run, seconds = warm_up(lambda: task.run, args, label + ", specialized for this long run")
+            run, seconds = warm_up(lambda: task.run, args(), label + ", specialized for this long run")
             compile_time += seconds
             switch += seconds
             task.ran = f"portable, then specialized from step {done}"
-    wall = time.perf_counter() - start - switch
-    if bar:
-        bar.close()
-    out["last"], out["rows"], out["steps"] = last, row + 1, done
-    return compile_time, wall
+    return done, row, switch, compile_time
+
+
+#: {task.ready_key(): (what ran, the portable glue or None, the specialized glue's overload
+#: count then)}: the glue choice of each kind of run that has run in this process, so that a
+#: warm call neither looks numba's cache up nor makes a warm-up call (ready_glue).
+_READY: dict = {}
+
+
+def ready_glue(task):
+    """The glue of a run of the kind ``task`` is (task.ready_key) that already ran in this
+    process, its choice recorded in task.ran; None when none did, or when a portable choice
+    under jit="auto" should be made again because the specialized glue gained an overload."""
+    entry = _READY.get(task.ready_key())
+    if entry is None:
+        return None
+    ran, portable, overloads = entry
+    if portable is None:
+        task.ran = ran
+        return task.run
+    if task.jit == "auto" and len(getattr(task.run, "overloads", ())) != overloads:
+        return None
+    task.ran = ran
+    return portable
+
+
+def remember_glue(task, run):
+    """Record the glue a warm-up chose for runs of task's kind (ready_glue)."""
+    portable = None if task.ran == "specialized" else run
+    _READY[task.ready_key()] = (task.ran, portable, len(getattr(task.run, "overloads", ())))
 
 
 def warm_up_args(q, v, t0, h, p, settings, extra, last, events):

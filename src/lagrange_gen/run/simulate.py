@@ -88,8 +88,8 @@ def element_method(module, method):
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
              save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
-             element_state0=None, force=False, keep=None, control=None, jit=None,
-             **settings) -> Trajectory:
+             element_state0=None, force=False, keep=None, control=None, control_params=None,
+             jit=None, **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -127,6 +127,9 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S). Runs
         with a control= hook are always specialized. None: the environment variable
         LAGRANGE_GEN_JIT, else "auto". Trajectory.jit says what ran.
+    control_params: parameters of the controller (a 1-D sequence of numbers c, e.g. gains),
+        which then takes them last: u = f(t, q, qd, p, c). The loop compiled for a controller
+        (seconds, once per controller function and process) runs every new c without compiling.
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.run.consistent), and the Trajectory carries the multipliers and
@@ -153,7 +156,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     config = make_settings(spec, settings)
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
-    p, hook, data = resolve_inputs(module, params, control, h, t0, q, v)     # inputs: run/control.py
+    p, hook, data = resolve_inputs(module, params, control, h, t0, q, v,      # run/control.py
+                                   control_params)
     if hook is not None:
         run = _with_data(controlled_run(module, method, hook), data)
         jit = "specialized"       # the control glue is compiled per model and controller
@@ -192,7 +196,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
-                 jit=jit)
+                 jit=jit, hook=hook)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     try:
@@ -256,6 +260,14 @@ class _Task:
     controlled: bool = False    # inputs written by a controller or a signal (run/control.py)
     jit: str = "specialized"    # simulate(jit=): "auto", "specialized" or "portable"
     ran: str = ""               # what ran (Trajectory.jit), set by fixed_run / adaptive_run
+    hook: object = None         # the input hook compiled into ``run`` (control.make_apply)
+
+    def ready_key(self):
+        """What the glue's choice and compile depend on, besides argument types that simulate
+        makes the same for every run of a module and method (fresh writable float64 arrays, the
+        method's settings record): the drivers remember the choice per key (ready_glue)."""
+        m = self.module
+        return (m.__name__, m.KEY, self.spec.name, self.jit, type(self.settings), self.hook)
 
     def glue(self, args):
         """The glue to run (``run`` or the portable one, see portable.choose) for a first call

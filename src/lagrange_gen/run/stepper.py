@@ -25,6 +25,7 @@ from .control import input_slots
 from ..errors import SimulationError
 from ..jit import njit
 from ..jit.api import jitclass, typeof
+from ..jit.compile_notice import first_use_notice
 from .failures import raise_for_status
 from .params import is_number
 from ..linear.linearize import parameter_vector
@@ -159,11 +160,15 @@ class Stepper:
         self.p = p
         self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
         self._failure = None        # the message of the failure that ended this stepper
-        ws = _workspace(module, method)
-        cls = _core_class(module, method, typeof(self.settings), typeof(ws))
-        self._core = cls(self.q, self.v, np.zeros(n), p, np.zeros(0), self._clock, self._info,
-                         self.settings, ws, self.h, first)
-        self._check(self._core.prepare(), 0)
+        self._label = f"Stepper({method}) for {module.NAME}"
+        self._warm = set()          # the core's methods step() has called (compiled) already
+        with first_use_notice(self._label):
+            ws = _workspace(module, method)
+            cls = _core_class(module, method, typeof(self.settings), typeof(ws))
+            self._core = cls(self.q, self.v, np.zeros(n), p, np.zeros(0), self._clock,
+                             self._info, self.settings, ws, self.h, first)
+            status = self._core.prepare()
+        self._check(status, 0)
 
     @property
     def t(self):
@@ -189,14 +194,24 @@ class Stepper:
         k = int(k)
         core = self._core
         if u is None:
-            code = core.advance(k)
+            kind = "advance"
         elif self.n_inputs == 1 and isinstance(u, float):
-            code = core.step_scalar(u, k)
+            kind = "step_scalar"
         else:
+            kind = "step_vector"
             u = np.asarray(u, dtype=np.float64).ravel()
             if u.shape[0] != self.n_inputs:
                 raise SimulationError(f"Stepper: u has {u.shape[0]} entries for "
                                       f"{self.n_inputs} input(s)")
+        if kind not in self._warm:          # numba compiles each method on its first call
+            with first_use_notice(self._label):
+                code = self._call(kind, u, k)
+            self._warm.add(kind)
+        elif u is None:
+            code = core.advance(k)
+        elif kind == "step_scalar":
+            code = core.step_scalar(u, k)
+        else:
             code = core.step_vector(u, k)
         if code:
             try:
@@ -204,6 +219,10 @@ class Stepper:
             except SimulationError as exc:
                 self._failure = str(exc)
                 raise
+
+    def _call(self, kind, u, k):
+        """The core's method ``kind`` for step(u, k)."""
+        return self._core.advance(k) if kind == "advance" else getattr(self._core, kind)(u, k)
 
     def _check(self, code, k):
         if code == st.OK:

@@ -90,7 +90,9 @@ def event_width(n):
 
 def last_size(n, n_saved, with_work=False) -> int:
     """Length of out_last for n coordinates and n_saved saved fields (plus W: with_work)."""
-    return work_at.py_func(n, n_saved) + (1 if with_work else 0)
+    # extra_at.py_func, not work_at.py_func: work_at's body calls the dispatcher extra_at,
+    # which from Python compiles a twin in every new process (jit.callee).
+    return extra_at.py_func(n) + n_saved + (1 if with_work else 0)
 
 
 def events_size(n) -> int:

@@ -195,6 +195,11 @@ def steps(method, kern, n_saved, n_event_fns, q, v, mom, ws, extra, t0, h, n_ste
             if status != OK:
                 write_last(out_last, t, q, v, iters_acc, 0.0, extra)
                 return status, i, n_events
+            if kern.WORK:
+                # The power at the step's start with the input held over this step: the one
+                # from the end of the last step had the old input, an O(h) error per step
+                # that would cap the energy balance at order 1.
+                P0, D0 = work.rate(kern, ww, q, v, t, p)
         if kern.WORK and kern.N_ELEMENTS > 0:
             work.elements_begin(kern, ww, q, p, extra)
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
