@@ -73,6 +73,17 @@ def test_an_ensemble_from_another_folder_uses_the_same_place(project, monkeypatc
     assert not (project / "elsewhere" / "generated").exists()
 
 
+def test_load_and_simulate_from_another_folder_use_the_same_place(project, monkeypatch):
+    """lg.load and lg.simulate on a model file: the module goes to the model's own place from
+    any working directory (it went to ./generated, a second copy, before)."""
+    monkeypatch.chdir(project / "elsewhere")
+    module = lg.load("../models/where_osc.py", methods=["rk4"])
+    assert Path(module.__file__).resolve() == (project / "generated" / "where_osc.py").resolve()
+    traj = lg.simulate("../models/where_osc.py", "rk4", q0=[1.0], t_end=0.5, h=0.01)
+    assert traj.q[-1, 0] == pytest.approx(np.cos(1.0), abs=1e-6)
+    assert not (project / "elsewhere" / "generated").exists()
+
+
 def test_o_chooses_another_folder(project, monkeypatch, capsys):
     monkeypatch.chdir(project / "elsewhere")
     assert main(["../models/where_osc.py", "--methods", "rk4", "-o", "mine"]) == 0

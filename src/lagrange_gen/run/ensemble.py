@@ -22,7 +22,6 @@ kept, its rows after the failure are NaN, the other members finish.
 from __future__ import annotations
 
 import math
-import os
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -30,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import checks as run_checks
-from ..codegen.keys import default_generated_dir, regeneration_command_for
+from ..codegen.keys import regeneration_command_for
 from .ensemble_inputs import grid, member_count, member_params, member_states
 from .ensemble_outputs import allocate_outputs, dataframe, member_args, run_members
 from ..errors import LagrangeGenError, SimulationError
@@ -137,8 +136,6 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     if method not in registry.METHODS:
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     jit = jit_mode(jit)
-    if out_dir is None and isinstance(module_or_path, (str, os.PathLike)):
-        out_dir = default_generated_dir(module_or_path)
     module = load_module(module_or_path, out_dir, method)
     method = element_method(module, method)
     from .consistent import check_method

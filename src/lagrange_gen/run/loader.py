@@ -9,7 +9,7 @@ import importlib.util
 import sys
 from pathlib import Path
 
-from ..codegen.keys import check_current, read_key
+from ..codegen.keys import check_current, default_generated_dir, read_key
 from ..errors import GenerationError, StaleModuleError
 from . import model_cache
 from ..jit.cache import GENERATED_MODULE_PREFIX
@@ -42,7 +42,7 @@ def import_generated(path):
     return module
 
 
-def load(path, out_dir="generated", methods=None, options=None, regenerate=True, freeze=None,
+def load(path, out_dir=None, methods=None, options=None, regenerate=True, freeze=None,
          force=False):
     """Return the generated module for ``path``.
 
@@ -54,11 +54,14 @@ def load(path, out_dir="generated", methods=None, options=None, regenerate=True,
     otherwise), or when methods are missing (added to its own). A current module generated with
     another freeze or build, or from another model file, is refused in one line naming what
     differs and the command that regenerates it (``force=True`` regenerates it);
-    ``regenerate=False`` raises StaleModuleError instead of generating.
+    ``regenerate=False`` raises StaleModuleError instead of generating. ``out_dir`` None: the
+    model's own place, the same from any working directory (codegen.keys.default_generated_dir).
     """
     path = Path(path)
     if read_key(path) is not None:
         return import_generated(path)
+    if out_dir is None:
+        out_dir = default_generated_dir(path)
     # a module this file gave before, current and complete: import it without running the file
     known = None if force else model_cache.current_module(path, out_dir, methods, options, freeze)
     if known is not None:

@@ -37,7 +37,7 @@ from .trajectory import Trajectory
 __all__ = ["simulate", "Trajectory", "load_module"]
 
 
-def load_module(module_or_path, out_dir="generated", method=None, force=False, options=None):
+def load_module(module_or_path, out_dir=None, method=None, force=False, options=None):
     """A generated module from: the module itself, a generated .py, or a model file (generated
     into ``out_dir`` first when missing or stale, keeping the freeze, build options and methods
     of the module on disk, see loader.load). When the module lacks the glue of the method that
@@ -87,13 +87,14 @@ def element_method(module, method):
 
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
-             save_every=1, t_eval=None, t0=0.0, progress=False, out_dir="generated",
+             save_every=1, t_eval=None, t0=0.0, progress=False, out_dir=None,
              element_state0=None, force=False, keep=None, control=None, control_params=None,
              jit=None, **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
-        into out_dir when missing or stale; see load_module, and ``force`` there).
+        into out_dir, default the model's own place, when missing or stale; see load_module, and
+        ``force`` there).
     method: one of steppers.registry.METHODS.
     q0, v0: initial coordinates and velocities (n,), default zeros.
     h: the step of a fixed-step method (required); for an adaptive method (dop853) only the
