@@ -6,6 +6,8 @@ Trajectory documents them: t (S,), q, v (S, n), energy (S,).
 
 from __future__ import annotations
 
+import functools
+
 import math
 import warnings
 from pathlib import Path
@@ -125,9 +127,16 @@ def _source(module):
     module without MODEL_PATH (hand-made modules in tests)."""
     if getattr(module, "MODEL_PATH", None) is None:
         return {}
-    model_file = (Path(module.__file__).parent / module.MODEL_PATH).resolve()
-    return dict(model_file=str(model_file), build=dict(module.OPTIONS.get("build", {})),
+    return dict(model_file=_model_file(module.__file__, module.MODEL_PATH),
+                build=dict(module.OPTIONS.get("build", {})),
                 frozen=dict(getattr(module, "FROZEN", {})))
+
+
+@functools.lru_cache(maxsize=256)
+def _model_file(module_file, model_path):
+    """The absolute model file of a generated module (resolving a path reads the file system,
+    a noticeable part of a short run's call)."""
+    return str((Path(module_file).parent / model_path).resolve())
 
 
 def _events(module, out):
