@@ -159,6 +159,7 @@ def kernel_call_args(module):
         "elements_hessian": (q, we, p, A),
         "contacts": (q, 0.0, p, np.empty(nc), np.empty((nc, n)), np.empty((nc, n)),
                      np.empty((nc, 2))),
+        "contact_rates": (q, q, 0.0, p, np.empty(2 * nc)),
         "nonholonomic": (q, q, 0.0, p, np.empty((nr, n)), np.empty(nr), np.empty(nr)),
         "forward_dynamics": (q, q, 0.0, p, A, v),
         "events": (q, q, 0.0, p, np.empty(getattr(module, "N_EVENTS", 0))),
