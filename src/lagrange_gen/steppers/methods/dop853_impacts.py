@@ -41,7 +41,9 @@ the impacts and projections summed per contact, ``contact_mode`` (c) FREE 0, STI
 SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, ``contact_work`` (1) the work of the impulses,
 r . (u- + u+) / 2, plus that of the persistent contacts' forces, lambda . (W v) integrated by
 the trapezoid rule over each step (exact for a constant force on a slip velocity linear in t:
-the block on a ramp). E - E0 - contact_work is then the balance for conservative forces. In
+the block on a ramp). E - E0 - contact_work is then the balance for conservative forces. Row 0
+is the state after the start's classification (an impact at t0 is in the impulse sums); the
+work counts from it. In
 every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
 
@@ -103,8 +105,8 @@ class Settings(NamedTuple):
 #: coef_impact (c, 2); last_impact (c,) times; Y (2c, n), D (2c, 2c) (contact_problem);
 #: switch values at the step's start and end and at trial times sw_prev, sw_new (2c,) with
 #: the events workspace sw (refine's); power (2,) = [at the last evaluation, at the step's
-#: start]; solver (3,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
-#: switching functions; left_at (c,) the time a free contact was last touching (-inf: not
+#: start]; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
+#: switching functions, and 1 while the start state is not classified yet; left_at (c,) the time a free contact was last touching (-inf: not
 #: since the step it cleared gap_tol).
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
                                     "v_old span M f s piv acc g WN WT coef rate r uf zero un "
@@ -128,7 +130,7 @@ def workspace(kern, n):
                      np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
                      np.zeros(2 * c, np.int64), np.zeros(c), np.zeros(c), np.zeros((c, 2)),
                      np.full(c, -np.inf), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)), sw,
-                     np.zeros(2), np.zeros(3), np.full(c, -np.inf))
+                     np.zeros(2), np.zeros(4), np.full(c, -np.inf))
 
 
 @njit(inline="always")
@@ -240,6 +242,7 @@ def prepare(kern, q, v, t, p, settings, ws):
     ws.solver[0] = settings.contact_tol
     ws.solver[1] = settings.max_sweeps
     ws.solver[2] = settings.gap_tol
+    ws.solver[3] = 1.0           # the next apply_switch classifies the start state
     for a in range(kern.N_CONTACTS):
         ws.mode[a] = FREE
         ws.persistent[a] = 0.0
@@ -437,6 +440,7 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     first stage ka[0], the switching functions and the power at the new start. Returns
     status."""
     n, c = kern.N_COORDS, kern.N_CONTACTS
+    work_before = extra[_work_at(c)]
     if not _mass_and_rhs(kern, ws, q, v, t, p):
         return SINGULAR_MASS
     kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
@@ -470,6 +474,9 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
         if not converged:
             return CONTACT_NOT_CONVERGED
         _record_impulses(kern, ws, ws.persistent, v, extra)
+    if ws.solver[3] != 0.0:        # row 0 is the state after this: the work counts from it
+        extra[_work_at(c)] = work_before
+        ws.solver[3] = 0.0
     for a in range(c):
         extra[1 + 2 * c + a] = ws.mode[a]
         ws.left_at[a] = t if ws.mode[a] == FREE and ws.g[a] <= settings.gap_tol else -np.inf
