@@ -20,3 +20,19 @@ def test_summary_of_a_bouncing_ball(generated, capsys):
     # at rest (after the Zeno time 2.7 s) the impacts took all of m g h0 = 9.81 but h V0 g.
     assert float(balance.group(1)) <= 1e-11 * 9.81
     assert abs(float(balance.group(2)) + 9.81) <= 9.81 * 1e-3 * 4.43
+
+
+def test_summary_of_an_event_driven_bouncing_ball(generated, capsys):
+    """dop853_impacts: the same balance line, closed to rounding (exact parabolas, impacts at
+    located times), and no solver-sweep line (an adaptive run counts steps)."""
+    module = generated("bouncing_ball")
+    assert main(["simulate", module.__file__, "--method", "dop853_impacts", "--t-end", "5",
+                 "--q0", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "Gauss-Seidel" not in out and "Newton iterations" not in out
+    balance = re.search(r"max \|E - E0 - W\| = (\S+) \(E0 = 9.81, W the work of the contact "
+                        r"impulses, final W = (\S+)\)", out)
+    assert balance, out
+    assert float(balance.group(1)) <= 1e-11 * 9.81
+    # at rest from the Zeno time (2.7 s) on: all of m g h0 went into the impacts
+    assert abs(float(balance.group(2)) + 9.81) <= 1e-9

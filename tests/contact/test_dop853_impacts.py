@@ -112,6 +112,35 @@ def test_block_on_ramp(generated, mu, u0):
     assert traj.saved["contact_mode"][-1, 0] == final_mode
     residual = traj.energy - traj.energy[0] - traj.saved["contact_work"][:, 0]
     assert np.abs(residual).max() <= 1e-13 * G
+    # friction's work: -mu m g cos a times the path slid (up to the stop, then down)
+    path = abs(s_stop) + abs(exact - s_stop)
+    assert traj.saved["contact_work"][-1, 0] == pytest.approx(-mu * G * c * path, abs=1e-12)
+
+
+def test_rocking_block_keeps_housners_energy_fraction_per_impact(generated):
+    """Housner's rocking block (tests/contact/test_rocking_block.py) released tilted by 0.15 on
+    its left corner, e = 0, mu = 1: it pivots on the sticking corner (persistent, its gap held
+    at the acceleration level with the contact_rates term), and each impact on the other corner
+    keeps (E - m g c) / (E0 - m g c) = r^k, r = (1 - 3/2 sin^2 alpha)^2, the corner hit taking
+    over as the pivot while the other lifts (modes (1, 0) and (0, 1) alternate). Between
+    impacts E is conserved to the tolerance (rtol = 1e-10: 1e-8 of the ratio after 6)."""
+    b, c, phi0 = 0.2, 0.6, 0.15
+    r = (1 - 1.5 * math.sin(math.atan2(b, c))**2) ** 2
+    q0 = [-b + b * math.cos(phi0) - c * math.sin(phi0), b * math.sin(phi0) + c * math.cos(phi0),
+          phi0]
+    traj = simulate(generated("rocking_block"), method="dop853_impacts", q0=q0, t_end=2.1,
+                    rtol=1e-10, atol=1e-12,
+                    params={"g": G, "b": b, "c": c, "e": 0.0, "mu": 1.0, "a_ground": 0.0})
+    rows = _impact_rows(traj)
+    assert len(rows) == 5
+    ratio = (traj.energy - G * c) / (traj.energy[0] - G * c)
+    assert np.abs(ratio[rows] - r ** np.arange(1, 6)).max() <= 1e-8
+    modes = traj.saved["contact_mode"][rows]
+    assert (modes == [[0, 1], [1, 0], [0, 1], [1, 0], [0, 1]]).all()
+    left_lifts = np.diff(traj.saved["normal_impulse_sum"][:, 0])[rows[0] - 1]
+    assert left_lifts == 0.0                 # the pivot takes no impulse: Housner's assumption
+    residual = traj.energy - traj.energy[0] - traj.saved["contact_work"][:, 0]
+    assert np.abs(residual).max() <= 1e-8 * G * c
 
 
 def test_newtons_cradle_simultaneous_impact_at_t0(generated):

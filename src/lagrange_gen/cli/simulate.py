@@ -193,7 +193,8 @@ def _summary(traj):
     if traj.constraint_names:
         print(f"max |Phi| = {traj.constraint_error.max():.3e}, "
               f"max |J v| = {traj.velocity_constraint_error.max():.3e}")
-    if traj.newton_iters.sum():      # the contact methods count their solver's sweeps there
+    # the fixed-step contact methods count their solver's sweeps there (an adaptive run: steps)
+    if traj.newton_iters.sum() and not traj.step_counts:
         what = "Gauss-Seidel sweeps" if contact_work is not None else "Newton iterations"
         print(f"{what} per step: {traj.newton_iters.sum() / max(traj.n_steps, 1):.2f}")
 
