@@ -53,6 +53,7 @@ CONTRACT = {
     # only a model with unilateral contacts has it
     "contacts": (("q", "t", "p"), (("gap", "c"), ("WN", "cn"), ("WT", "cn"), ("coef", "c2")),
                  ("contact_gap", "contact_WN", "contact_WT", "contact_coef")),
+    "contact_rates": (_QQTP, (("out", "2c"),), ("contact_rate",)),
     # the kernels of a module generated from bodies (README, Robots); qdd is the State's w
     "inverse_dynamics": (("q", "qd", "qdd", "t", "p"), (("tau", "n"),), ("tau_id",)),
     "gravity_forces": (("q", "t", "p"), (("out", "n"),), ("gravity",)),
@@ -61,7 +62,7 @@ CONTRACT = {
 #: the kernels only a module generated from bodies has (tests/harness/test_spatial_trees.py)
 BODY_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
 #: the kernels only a module of a model with unilateral contacts has
-CONTACT_KERNELS = ("contacts",)
+CONTACT_KERNELS = ("contacts", "contact_rates")
 
 
 @dataclass
@@ -142,7 +143,7 @@ ACCUMULATING = {"transport", "transport_dq"}
 def _shape(key, n, m, ne, ng=0, nc=0):
     return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n),
             "e3": (ne, 3), "g": (ng,), "P": (2 * n + 2,), "c": (nc,), "cn": (nc, n),
-            "c2": (nc, 2)}[key]
+            "c2": (nc, 2), "2c": (2 * nc,)}[key]
 
 
 def call_kernel(kern, name, state, sizes):
