@@ -82,7 +82,17 @@ v, t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern
 direction, p, settings, ws) -> (status, |h|), attempt(kern, q, v, t, h, p, settings, ws) ->
 (status, err) into ws.q_new, ws.v_new, accept(kern, t_new, p, ws) -> status, dense(kern, q, v,
 t, h, p, ws) -> status, interpolate(ws, t, q_out, v_out), advance(q, v, ws), and the constants
-ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS.
+ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS, ROWS_PER_STEP (rows one step
+may write in every-step mode).
+
+Switches (dop853_impacts; dop853's are no-ops): after each accepted step,
+switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters) -> (status, switched, t_end of
+the step): when switched, the step ends early at that time with the state there in ws.q_new,
+ws.v_new and the dense output of the whole step built (the step's rows and the model's events
+use it up to there); then apply_switch(kern, ws, q, v, t, p, settings, extra) -> status makes
+the state the run continues from (in place: impulses, new modes) and every-step mode writes it
+as a second row at the same time. apply_switch also runs once on the start state, after
+prepare, before row 0 is written.
 
 Over 300 lines with this contract: the loop, its step-size control and its two ways of saving
 (t_eval rows, events) share the loop's state (t, h, the counters, the rows written), so they
