@@ -4,6 +4,8 @@ work of the contact impulses, not a bare max |E - E0| (the impacts dissipate).""
 
 import re
 
+import pytest
+
 from lagrange_gen.cli.main import main
 
 
@@ -30,6 +32,10 @@ def test_summary_of_an_event_driven_bouncing_ball(generated, capsys):
                  "--q0", "1"]) == 0
     out = capsys.readouterr().out
     assert "Gauss-Seidel" not in out and "Newton iterations" not in out
+    first = re.search(r"impacts: (\d+); first t = (\S+) \(contact 0, p_N = (\S+)\)", out)
+    assert first, out
+    assert float(first.group(2)) == pytest.approx((2 / 9.81) ** 0.5, abs=1e-10)
+    assert float(first.group(3)) == pytest.approx((1 + 0.8) * (2 * 9.81) ** 0.5, abs=1e-9)
     balance = re.search(r"max \|E - E0 - W\| = (\S+) \(E0 = 9.81, W the work of the contact "
                         r"impulses, final W = (\S+)\)", out)
     assert balance, out

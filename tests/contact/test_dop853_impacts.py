@@ -52,6 +52,10 @@ def test_ball_impact_times_speeds_and_impulses(ball):
     assert np.abs(ball.v[rows[:20] - 1, 0] + E**(k - 1) * V0).max() <= 1e-10
     impulse = np.diff(ball.saved["normal_impulse_sum"][:, 0])[rows[:20] - 1]
     assert np.abs(impulse - (1 + E) * E**(k - 1) * V0).max() <= 1e-10      # m = 1
+    table = ball.impacts                  # the same, as Trajectory.impacts gives them
+    assert len(table) == int(ball.saved["impacts"][-1, 0])
+    assert np.array_equal(table["t"][:20], ball.t[rows[:20]])
+    assert np.array_equal(table["normal"][:20], impulse) and (table["contact"] == 0).all()
 
 
 def test_ball_apex_heights(generated):

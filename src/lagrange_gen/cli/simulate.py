@@ -185,6 +185,12 @@ def _summary(traj):
         balance = float(abs(traj.energy_error - contact_work[:, 0]).max())
         print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
               f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
+        impacts = traj.impacts
+        if "impacts" in traj.saved:      # event-driven: the located impacts
+            shown = ", ".join(f"t = {row['t']:.9g} (contact {row['contact']}, p_N = "
+                              f"{row['normal']:.6g})" for row in impacts[:3])
+            print(f"impacts: {int(traj.saved['impacts'][-1, 0])}"
+                  + (f"; first {shown}" if shown else ""))
     elif traj.work is None:
         print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
     else:       # forced, damped or rheonomic: E changes by the work W done on the system
