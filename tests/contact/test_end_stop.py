@@ -83,3 +83,19 @@ def test_plastic_end_stop_stops_the_slider_and_holds_it(generated):
     assert traj.saved["contact_work"][-1, 0] == pytest.approx(-kinetic, rel=1e-8)
     residual = traj.energy - traj.energy[0] - traj.saved["contact_work"][:, 0]
     assert np.abs(residual).max() <= 1e-8 * abs(E0)
+
+
+def test_moreau_jean_stops_the_slider_at_a_plastic_end_stop(generated):
+    """moreau_jean, e = 0: the impulse of the step where the free motion would cross the stop
+    zeroes the stop's velocity (Newton's law at the velocity level, exact), and the impulses of
+    the following steps hold the slider there; the impact lands within a step of T_STOP and
+    the crank within h |th'_s| of TH_STOP (positions move with (v + v+) / 2 in the impact
+    step)."""
+    h = 1e-3
+    traj = simulate(generated("slider_crank_stop"), method="moreau_jean", q0=[TH0], v0=[W0],
+                    t_end=1.0, h=h, params={"r": R, "L": L, "J": J, "m": M, "tau": TAU,
+                                            "x_stop": X_STOP, "e": 0.0})
+    first = np.flatnonzero(traj.saved["normal_impulse"][:, 0] > 0)[0]
+    assert abs(traj.t[first] - T_STOP) <= h
+    assert np.abs(traj.v[first:, 0]).max() <= 1e-9 * abs(RATE_STOP)
+    assert np.abs(traj.q[first:, 0] - TH_STOP).max() <= h * abs(RATE_STOP)
