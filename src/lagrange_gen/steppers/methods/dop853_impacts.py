@@ -49,6 +49,10 @@ impact's impulses).
 
 A run continued in chunks reclassifies the contacts at each chunk's start; the Zeno guard's
 memory of the last impact time does not cross chunks.
+
+Over 300 lines: the switching functions, the classification at a switch (impact, modes,
+projection) and the work accounting read and write one workspace and one ``extra`` layout, so
+they stay beside each other and the docstring that defines them.
 """
 
 import sys
