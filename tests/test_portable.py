@@ -33,7 +33,8 @@ CASES = [(m, "driven_pendulum", [2.9], 1e-3, 0.2) for m in registry.METHODS
 CASES += [(m, "slider_crank", ([0.0, 1.3, 0.1], [1.8, 0.0, 0.0]), 1e-3, 0.1)
           for m in registry.CONSTRAINED_METHODS]
 CASES += [("nonsmooth_euler", "prandtl", [0.0], 1e-3, 2.0)]
-CASES += [("moreau_jean", "bouncing_ball", [1.0], 1e-3, 1.5)]
+CASES += [("moreau_jean", "bouncing_ball", [1.0], 1e-3, 1.5),
+          ("dop853_impacts", "bouncing_ball", [1.0], None, 4.5)]
 CASES += [(m, "chaplygin_sleigh", ([0.0, 0.0, 0.0], [0.3, 1.0, 2.0]), 1e-3, 1.0)
           for m in registry.NONHOLONOMIC_METHODS]
 EVENT_CASES = [("verlet", "cart_pendulum_events", [0.3, 1.0], 1e-3, 3.0),

@@ -49,8 +49,9 @@ def test_not_a_contact_is_refused():
         Model("ball", coords=[y], T=y.d**2 / 2, contacts=[3])
 
 
-def test_only_moreau_jean_applies_to_contacts_and_not_elsewhere():
-    assert registry.applicable_methods(0, 0, 1) == ("moreau_jean",)
+def test_only_the_contact_methods_apply_to_contacts_and_not_elsewhere():
+    assert registry.applicable_methods(0, 0, 1) == ("moreau_jean", "dop853_impacts")
     assert "moreau_jean" not in registry.applicable_methods(0, 0, 0)
+    assert "dop853_impacts" not in registry.applicable_methods(0, 0, 0)
     assert "unilateral contacts" in registry.inapplicable("verlet", 0, 0, 2)
     assert "has none" in registry.inapplicable("moreau_jean", 0, 0, 0)

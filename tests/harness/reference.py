@@ -39,7 +39,8 @@ def _jumps_settled(expr):
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
 VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
-           "power", "b", "tau_id", "gravity", "bias", "contact_gap", "nh_b", "nh_gamma"}
+           "power", "b", "tau_id", "gravity", "bias", "contact_gap", "contact_rate", "nh_b",
+           "nh_gamma"}
 
 
 def _vector(exprs):
@@ -197,6 +198,11 @@ class Reference:
         """Rows d slip/d qd; zero for a frictionless contact without a slip velocity."""
         slips = _vector([slip if slip is not None else 0 for _, _, _, slip in self.drawn.contacts])
         return slips.jacobian(self.qd)
+
+    def _contact_rate(self):
+        """(dW_N/dt qd, dW_T/dt qd): d(W qd)/dq qd with W = [W_N; W_T]."""
+        local = self.expr("contact_WN").col_join(self.expr("contact_WT")) * self.qd
+        return local.jacobian(self.q) * self.qd
 
     def _contact_coef(self):
         rows = [[restitution, friction] for _, restitution, friction, _ in self.drawn.contacts]

@@ -34,6 +34,11 @@ def unconstrained_methods():
         or registry.spec(m).contacts or registry.spec(m).nonholonomic))
 
 
+def smooth_adaptive_methods():
+    """Adaptive methods for unconstrained smooth models (dop853; not the contact one)."""
+    return tuple(m for m in registry.ADAPTIVE_METHODS if not registry.spec(m).contacts)
+
+
 def methods_for(mod, methods=None):
     """Methods that apply to a module (constrained ones on constrained models, else the rest),
     restricted to ``methods`` when given."""

@@ -89,6 +89,11 @@ def _compile(args):
     print(run_compile_bench(Path(args.reports) / "compile.md", progress=not args.no_progress))
 
 
+def _contact(args):
+    from .contact import run_contact
+    print(run_contact(**_suite_kwargs(args))["report"])
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -116,6 +121,8 @@ SUITES = {
                 _stepapi),
     "compile": ("first compile with each numba speedup on and off (LAGRANGE_GEN_SPEEDUPS)",
                 _compile),
+    "contact": ("work-precision of moreau_jean and dop853_impacts on the bouncing ball and the "
+                "rocking block against closed forms (Siconos when installed)", _contact),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

@@ -259,7 +259,7 @@ def methods_for_case(case, methods):
     """Our methods for a case: the constrained ones, or the fixed-step unconstrained ones and
     the adaptive ones; restricted to ``methods`` when given."""
     pool = runs.constrained_methods() if case.constrained else \
-        runs.unconstrained_methods() + registry.ADAPTIVE_METHODS
+        runs.unconstrained_methods() + runs.smooth_adaptive_methods()
     return [m for m in pool if methods is None or m in methods]
 
 

@@ -60,7 +60,7 @@ def energy_row(prec):
 
 def accuracy_row(prec):
     cart = _result(prec, "cart_pendulum")
-    pool = runs.unconstrained_methods() + registry.ADAPTIVE_METHODS
+    pool = runs.unconstrained_methods() + runs.smooth_adaptive_methods()
     method, t = _fastest(cart, pool, "final", common.TARGET) if cart else (None, None)
     why = "-" if method is None else \
         f"fastest to final-state error {common.TARGET:g} on the cart pendulum: {_ms(t)} " \

@@ -189,6 +189,12 @@ def _summary(traj):
         balance = float(abs(traj.energy_error - contact_work[:, 0]).max())
         print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
               f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
+        impacts = traj.impacts
+        if "impacts" in traj.saved:      # event-driven: the located impacts
+            shown = ", ".join(f"t = {row['t']:.9g} (contact {row['contact']}, p_N = "
+                              f"{row['normal']:.6g})" for row in impacts[:3])
+            print(f"impacts: {int(traj.saved['impacts'][-1, 0])}"
+                  + (f"; first {shown}" if shown else ""))
     elif traj.work is None:
         unknown = (", W not tracked: E also changes by the work of forces, damping and explicit "
                    "time, which only fixed-step methods integrate") if traj.work_note else ""
@@ -199,7 +205,8 @@ def _summary(traj):
     if traj.constraint_names:
         print(f"max |Phi| = {traj.constraint_error.max():.3e}, "
               f"max |J v| = {traj.velocity_constraint_error.max():.3e}")
-    if traj.newton_iters.sum():      # the contact methods count their solver's sweeps there
+    # the fixed-step contact methods count their solver's sweeps there (an adaptive run: steps)
+    if traj.newton_iters.sum() and not traj.step_counts:
         what = "Gauss-Seidel sweeps" if contact_work is not None else "Newton iterations"
         print(f"{what} per step: {traj.newton_iters.sum() / max(traj.n_steps, 1):.2f}")
 

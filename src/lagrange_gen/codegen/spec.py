@@ -176,11 +176,15 @@ def robot_kernels(dyn) -> dict:
 
 
 def contact_kernels(dyn) -> dict:
-    """The ``contacts`` kernel of a model with unilateral contacts ({} without any)."""
+    """The ``contacts`` and ``contact_rates`` kernels of a model with unilateral contacts ({}
+    without any)."""
     if not dyn.n_contacts:
         return {}
     nat = dyn.native
-    return {"contacts": lambda: KernelSpec(
+    return {"contact_rates": lambda: KernelSpec(
+        "contact_rates", ["q", "qd", "t", "p"], [Output("out", nat["contact_rate"])],
+        doc="(dW_N/dt qd, dW_T/dt qd) (2c,): the local accelerations are W qdd + these"),
+            "contacts": lambda: KernelSpec(
         "contacts", ["q", "t", "p"],
         [Output("gap", nat["contact_gap"]), Output("WN", nat["contact_WN"]),
          Output("WT", nat["contact_WT"]), Output("coef", nat["contact_coef"])],

@@ -6,6 +6,7 @@ u_N+ = -e u_N- (restitution e in [0, 1]); while it stays closed the normal impul
 closed. With friction mu > 0 a tangential impulse along W_T = d(slip)/d(qdot) obeys Coulomb's
 law on the slip velocity u_T = W_T qdot: |p_T| <= mu p_N, and p_T opposes u_T when it slides.
 2D contacts: one slip velocity per contact (the 3D friction cone is not implemented).
+``Contact.point_on_plane`` builds one from a sympy.physics.mechanics Point and a plane.
 
 The checks (one ModelError line each) run when a Model is built (check_contacts).
 """
@@ -39,6 +40,22 @@ class Contact:
         self.friction = sp.sympify(friction)
         self.slip = None if slip is None else sp.sympify(slip)
         self.name = name
+
+    @classmethod
+    def point_on_plane(cls, point, origin, frame, normal, tangent=None, restitution=0,
+                       friction=0, name=None):
+        """The contact of a sympy.physics.mechanics Point with a plane fixed in ``frame``.
+
+        point: the Point that may not cross the plane; origin: a Point of the plane, fixed in
+        ``frame`` (the inertial frame); normal: the plane's unit normal (a Vector), pointing to
+        the side the point stays on; tangent: a unit Vector in the plane along which friction
+        acts (required with friction; one tangent: the 2D law). gap = r_(origin -> point) . normal,
+        slip = (d r_(origin -> point) / dt in frame) . tangent. Coordinates may be the model's
+        dynamicsymbols (Model converts them)."""
+        r = point.pos_from(origin)
+        gap = r.dot(normal)
+        slip = None if tangent is None else r.dt(frame).dot(tangent)
+        return cls(gap=gap, restitution=restitution, friction=friction, slip=slip, name=name)
 
     def coefficients(self):
         """(restitution, friction): what the generated ``contacts`` kernel writes per contact."""

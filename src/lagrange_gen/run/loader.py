@@ -162,6 +162,7 @@ def kernel_call_args(module):
         "elements_hessian": (q, we, p, A),
         "contacts": (q, 0.0, p, np.empty(nc), np.empty((nc, n)), np.empty((nc, n)),
                      np.empty((nc, 2))),
+        "contact_rates": (q, q, 0.0, p, np.empty(2 * nc)),
         "nonholonomic": (q, q, 0.0, p, np.empty((nr, n)), np.empty(nr), np.empty(nr)),
         "nonholonomic_dq": (q, q, w, np.zeros(nr), 0.0, p, np.empty((nr, n)), B,
                             np.empty((nr, n)), np.empty((nr, n)), np.empty((nr, n))),

@@ -82,7 +82,17 @@ v, t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern
 direction, p, settings, ws) -> (status, |h|), attempt(kern, q, v, t, h, p, settings, ws) ->
 (status, err) into ws.q_new, ws.v_new, accept(kern, t_new, p, ws) -> status, dense(kern, q, v,
 t, h, p, ws) -> status, interpolate(ws, t, q_out, v_out), advance(q, v, ws), and the constants
-ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS.
+ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS, ROWS_PER_STEP (rows one step
+may write in every-step mode).
+
+Switches (dop853_impacts; dop853's are no-ops): after each accepted step,
+switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters) -> (status, switched, t_end of
+the step): when switched, the step ends early at that time with the state there in ws.q_new,
+ws.v_new and the dense output of the whole step built (the step's rows and the model's events
+use it up to there); then apply_switch(kern, ws, q, v, t, p, settings, extra) -> status makes
+the state the run continues from (in place: impulses, new modes) and every-step mode writes it
+as a second row at the same time. apply_switch also runs once on the start state, after
+prepare, before row 0 is written.
 
 Over 300 lines with this contract: the loop, its step-size control and its two ways of saving
 (t_eval rows, events) share the loop's state (t, h, the counters, the rows written), so they
@@ -169,24 +179,27 @@ def _first_step(method, kern, q, v, t0, t_end, p, settings, ws, counters):
 
 
 @njit(inline="always")
-def _room(t_eval, j, t, h, rows, size):
+def _room(t_eval, j, t, h, rows, size, per_step):
     """Before the first attempt of a step of size h from t: (fits, h). fits False: the rows
-    this step may output do not fit (the call returns first). A fresh buffer (rows == 1) too
-    small for the t_eval values of the step shortens h to end at the last one that fits."""
+    this step may output do not fit (the call returns first). per_step: the rows one step may
+    write in every-step mode (method.ROWS_PER_STEP). A fresh buffer (rows == 1) too small for
+    the t_eval values of the step shortens h to end at the last one that fits; one too small
+    for per_step rows takes the step (the rows past the end are not written)."""
     direction = 1.0 if h > 0.0 else -1.0
-    k = points_in(t_eval, j, t + h, direction, size) if t_eval.shape[0] > 0 else 1
+    k = points_in(t_eval, j, t + h, direction, size) if t_eval.shape[0] > 0 else per_step
     if rows + k <= size:
         return True, h
-    if rows > 1:
-        return False, h
+    if rows > 1 or t_eval.shape[0] == 0:
+        return rows == 1, h
     return True, t_eval[j + size - 2] - t
 
 
 @njit(inline="always")
 def _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j, rows, since, extra,
-            out_t, out_q, out_v, out_stats, out_extra, out_last, counters):
+            out_t, out_q, out_v, out_stats, out_extra, out_last, counters, built):
     """The rows of an accepted step from (q, v) at t to (ws.q_new, ws.v_new) at t_new: its end
-    state, or the t_eval values it covers (dense output, built at most once). Returns
+    state, or the t_eval values it covers (dense output, built at most once; ``built``: it is
+    already, and ws.q_new is no longer the end of the step it was built for). Returns
     (status, rows, j, since); on failure out_last and counters[0] are set (_stop)."""
     if t_eval.shape[0] == 0:
         if not _save_row(kern, rows, t_new, ws.q_new, ws.v_new, p, since, err, out_t, out_q,
@@ -195,7 +208,6 @@ def _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j, rows, since,
             return NON_FINITE, rows, j, since
         return OK, rows + 1, j, 0.0
     direction = 1.0 if h > 0.0 else -1.0
-    built = False
     while j < t_eval.shape[0] and (t_eval[j] - t_new) * direction <= 0.0:
         qr, vr = ws.q_new, ws.v_new           # a value equal to the step end: the end state
         if t_eval[j] != t_new:
@@ -272,6 +284,8 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     if status == OK:
         status = method.prepare(kern, q, v, t0, p, settings, ws)
         counters[3] += 1
+    if status == OK:             # a switching right-hand side classifies the start state
+        status = method.apply_switch(kern, ws, q, v, t0, p, settings, extra)
     write_last(out_last, t0, q, v, 0.0, 0.0, extra)
     if status != OK:
         return status, 0, 0
@@ -299,7 +313,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
         if last:
             h = t_end - t
         if not rejected:          # first attempt of a step: does its output fit?
-            fits, h_room = _room(t_eval, j, t, h, rows, size)
+            fits, h_room = _room(t_eval, j, t, h, rows, size, method.ROWS_PER_STEP)
             if not fits:
                 _stop(out_last, counters, t, q, v, since, err_last, extra, h)
                 return OK, rows, n_events
@@ -328,10 +342,18 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
         counters[1] += 1
         since += 1.0
         err_last = err
+        # A switching right-hand side (dop853_impacts) may end the step early, at t_new, with
+        # the state there in ws.q_new, ws.v_new and the dense output of the whole step built.
+        status, switched, t_new = method.switch_point(kern, ws, q, v, t, h, t_new, p, extra,
+                                                      counters)
+        if status != OK:
+            _stop(out_last, counters, t, q, v, since, err, extra, h)
+            return status, rows, n_events
         if n_event_fns > 0:
             if events.crossed(kern, ew, ws.q_new, ws.v_new, t_new, p):
-                status = method.dense(kern, q, v, t, h, p, ws)
-                counters[3] += method.DENSE_EVALS
+                if not switched:
+                    status = method.dense(kern, q, v, t, h, p, ws)
+                    counters[3] += method.DENSE_EVALS
                 if status != OK:
                     _stop(out_last, counters, t, q, v, since, err, extra, h)
                     return status, rows, n_events
@@ -345,12 +367,25 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
             events.advance(ew)
         status, rows, j, since = _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j,
                                          rows, since, extra, out_t, out_q, out_v, out_stats,
-                                         out_extra, out_last, counters)
+                                         out_extra, out_last, counters, switched)
         if status != OK:
             return status, rows, n_events
         h = next_step(h, err, method.ERROR_EXPONENT, settings.h_max, rejected)
         rejected = False
         method.advance(q, v, ws)
         t = t_new
+        if switched:             # the state after the switch (impulses) continues the run
+            status = method.apply_switch(kern, ws, q, v, t, p, settings, extra)
+            counters[3] += 1
+            if status != OK:
+                _stop(out_last, counters, t, q, v, since, err, extra, h)
+                return status, rows, n_events
+            if t_eval.shape[0] == 0 and rows < size:
+                if not _save_row(kern, rows, t, q, v, p, since, err, out_t, out_q, out_v,
+                                 out_stats, extra, out_extra):
+                    _stop(out_last, counters, t, q, v, since, err, extra, h)
+                    return NON_FINITE, rows, n_events
+                rows += 1
+                since = 0.0
     _stop(out_last, counters, t, q, v, since, err_last, extra, h)
     return OK, rows, n_events

@@ -31,6 +31,7 @@ counted, not written: the driver compares n_events with E); the first terminal o
 step (later crossings of the step are not recorded).
 """
 
+import sys
 import warnings
 from collections import namedtuple
 
@@ -98,18 +99,28 @@ def advance(ew):
 
 
 @njit(**FAST)
-def g_at(interp, iws, kern, ew, p, k, t):
-    """g_k at time t of the step, on the interpolant (leaves the state in ew.q, ew.v)."""
+def event_values(kern, iws, q, v, t, p, out):
+    """The model's event functions at (q, v, t) into out (N_EVENTS,): what ``refine`` roots when
+    this module is its ``source``."""
+    kern.events(q, v, t, p, out)
+
+
+@njit(**FAST)
+def g_at(interp, iws, source, kern, ew, p, k, t):
+    """g_k at time t of the step, on the interpolant (leaves the state in ew.q, ew.v); the
+    values come from ``source.event_values(kern, iws, q, v, t, p, out)``."""
     interp.interpolate(iws, t, ew.q, ew.v)
-    kern.events(ew.q, ew.v, t, p, ew.g_try)
+    source.event_values(kern, iws, ew.q, ew.v, t, p, ew.g_try)
     return ew.g_try[k]
 
 
 @njit(**FAST)
-def refine(interp, iws, kern, ew, p, k, t_a, g_a, t_b, g_b):
+def refine(interp, iws, source, kern, ew, p, k, t_a, g_a, t_b, g_b):
     """The crossing time of g_k in [t_a, t_b] (g_a, g_b of opposite signs or g_b = 0) by the
     Illinois method: regula falsi whose retained end has its g halved when it is retained twice,
-    so that the bracket closes from both sides (superlinear, about 10 evaluations)."""
+    so that the bracket closes from both sides (superlinear, about 10 evaluations). ``source``
+    is a module giving the values, ``event_values(kern, iws, q, v, t, p, out)``: this module for
+    the model's events; dop853_impacts for its contact switching functions."""
     if g_b == 0.0:
         return t_b
     tol = ROOT_RTOL * abs(t_b - t_a) + 4.0 * EPS * max(abs(t_a), abs(t_b))
@@ -121,7 +132,7 @@ def refine(interp, iws, kern, ew, p, k, t_a, g_a, t_b, g_b):
         t = t_b - g_b * (t_b - t_a) / (g_b - g_a)
         if not (min(t_a, t_b) < t < max(t_a, t_b)):
             t = 0.5 * (t_a + t_b)          # rounding put the secant point on an end
-        g = g_at(interp, iws, kern, ew, p, k, t)
+        g = g_at(interp, iws, source, kern, ew, p, k, t)
         if g == 0.0:
             return t
         if (g < 0.0) == (g_b < 0.0):       # the root is between t_a and t: t replaces t_b
@@ -164,7 +175,7 @@ def locate(interp, iws, kern, ew, p, t_a, t_b, out_events, n_events):
         ew.sense[k] = crossing(ew.g_prev[k], ew.g_new[k], kern.EVENT_DIRECTION[k])
         ew.t_cross[k] = np.nan
         if ew.sense[k] != 0:
-            ew.t_cross[k] = refine(interp, iws, kern, ew, p, k, t_a, ew.g_prev[k], t_b,
+            ew.t_cross[k] = refine(interp, iws, _THIS, kern, ew, p, k, t_a, ew.g_prev[k], t_b,
                                    ew.g_new[k])
     while True:
         first, s_first = -1, np.inf
@@ -181,6 +192,10 @@ def locate(interp, iws, kern, ew, p, t_a, t_b, out_events, n_events):
         if kern.EVENT_TERMINAL[first]:
             ew.stop[0] = t
             return n_events, True
+
+
+# This module as the ``source`` of refine (modules, not dispatchers, are passed to jitted code).
+_THIS = sys.modules[__name__]
 
 
 def events_table(module, out_events, n_events):

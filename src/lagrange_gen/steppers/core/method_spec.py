@@ -80,6 +80,11 @@ SETTING_HELP = {
     "contact_tol": "contact problem tolerance: largest impulse change of a Gauss-Seidel sweep "
                    "relative to the largest impulse",
     "max_sweeps": "cap on the projected Gauss-Seidel sweeps of one step's contact problem",
+    "zeno_interval": "an impact of a contact less than this after its previous one is plastic "
+                     "(the contact then rests)",
+    "gap_tol": "a contact touches when its gap is at most this",
+    "rest_velocity": "a touching contact whose normal (slip) velocity is at most this is at "
+                     "rest (sticks)",
 }
 
 #: Validation of the common fields: (lower bound, bound included, inf allowed).

@@ -15,7 +15,7 @@ import importlib
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
            "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
            "constrained_midpoint", "constrained_implicit_euler", "spook", "index1", "moreau_jean",
-           "nonholonomic_rk4", "nonholonomic_midpoint")
+           "dop853_impacts", "nonholonomic_rk4", "nonholonomic_midpoint")
 
 #: {method: its Spec}.
 INFO = {m: importlib.import_module(f"lagrange_gen.steppers.methods.{m}").SPEC for m in METHODS}

@@ -256,7 +256,15 @@ def attempt(kern, q, v, t, h, p, settings, ws):
     """One trial step of size h from (q, v) at t (ka[0] = a(q, v, t)) into ws.q_new, ws.v_new.
     Returns (status, err): err the scaled error norm (accept when err <= 1; NaN when the trial
     went non-finite); status OK or the stage acceleration's failure. STAGE_EVALS evaluations."""
-    status = rk_step(_THIS, kern, (p, ws.H), A, B, C, q, v, t, h, ws.kv, ws.ka, ws.qs,
+    return attempt_on(_THIS, kern, (p, ws.H), q, v, t, h, settings, ws)
+
+
+@njit(**FAST)
+def attempt_on(source, kern, ctx, q, v, t, h, settings, ws):
+    """attempt with the accelerations of ``source.stage_acceleration(kern, ctx, ...)``
+    (explicit_rk's contract): what a method stepping another right-hand side with this
+    tableau (dop853_impacts) calls."""
+    status = rk_step(source, kern, ctx, A, B, C, q, v, t, h, ws.kv, ws.ka, ws.qs,
                      ws.q_new, ws.v_new, True)
     if status != OK:
         return status, 0.0
@@ -278,9 +286,15 @@ def attempt(kern, q, v, t, h, p, settings, ws):
 def accept(kern, t_new, p, ws):
     """After an accepted trial: the FSAL stage K[12] = f(t_new, y_new) (kv[12], ka[12]).
     ACCEPT_EVALS evaluations; OK or SINGULAR_MASS."""
+    return accept_on(_THIS, kern, (p, ws.H), t_new, ws)
+
+
+@njit(**FAST)
+def accept_on(source, kern, ctx, t_new, ws):
+    """accept with the accelerations of ``source`` (see attempt_on)."""
     for i in range(ws.v_new.shape[0]):
         ws.kv[N_STAGES, i] = ws.v_new[i]
-    return accel(kern, ws.q_new, ws.v_new, t_new, p, ws.H, ws.ka[N_STAGES])
+    return source.stage_acceleration(kern, ctx, ws.q_new, ws.v_new, t_new, ws.ka[N_STAGES])
 
 
 @njit(**FAST)
@@ -304,10 +318,15 @@ def dense(kern, q, v, t, h, p, ws):
     """Build the 7th-order interpolant of the accepted step (q, v) at t -> (q_new, v_new) at
     t + h: the stages K[13..15], then the coefficients, the start state and span into ws. Call
     after accept, before advance. DENSE_EVALS evaluations; OK or SINGULAR_MASS."""
-    ctx = (p, ws.H)
+    return dense_on(_THIS, kern, (p, ws.H), q, v, t, h, ws)
+
+
+@njit(**FAST)
+def dense_on(source, kern, ctx, q, v, t, h, ws):
+    """dense with the accelerations of ``source`` (see attempt_on)."""
     for i in range(N_STAGES + 1, N_DENSE):
         stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, kern.N_COORDS)
-        status = stage_acceleration(kern, ctx, ws.qs, ws.kv[i], t + C[i] * h, ws.ka[i])
+        status = source.stage_acceleration(kern, ctx, ws.qs, ws.kv[i], t + C[i] * h, ws.ka[i])
         if status != OK:
             return status
     _coefficients(ws.kv, q, ws.q_new, h, ws.dense_q)
@@ -348,6 +367,23 @@ def advance(q, v, ws):
         q[i] = ws.q_new[i]
         v[i] = ws.v_new[i]
         ws.ka[0, i] = ws.ka[N_STAGES, i]
+
+
+#: Rows one accepted step may output in every-step mode (adaptive.run_adaptive's room check).
+ROWS_PER_STEP = 1
+
+
+@njit(inline="always")
+def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
+    """adaptive.run_adaptive's hook for a right-hand side that switches at located states
+    (dop853_impacts): this one never switches. Returns (status, switched, t_new)."""
+    return OK, False, t_new
+
+
+@njit(inline="always")
+def apply_switch(kern, ws, q, v, t, p, settings, extra):
+    """adaptive.run_adaptive's hook (see switch_point): nothing to apply. Returns status."""
+    return OK
 
 
 # This module as a value for rk_step (see core/run_loop.py: modules, not dispatchers, are passed).

@@ -23,7 +23,8 @@ v_free = v + A^-1 (h f + h^2 theta K v) and the Delassus operator D = W A^-1 W^T
                           a contact already opening at the step's start gets u_N >= 0)
     Coulomb (2D):         p_T in [-mu p_N, mu p_N], p_T = -mu p_N sign(u_T) when u_T != 0
 
-solved by projected Gauss-Seidel, contact by contact:
+solved by projected Gauss-Seidel (core/contact_problem.py, shared with dop853_impacts), contact
+by contact:
 p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then p_T <- clamp(p_T - u_T / D_TT, -mu p_N, mu p_N),
 until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
 (CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
@@ -48,6 +49,7 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core.options import FAST, inline_step
+from ..core.contact_problem import delassus, gauss_seidel, local_velocity
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.solve import failed_solve_status
@@ -57,8 +59,9 @@ from ..core.status import CONTACT_NOT_CONVERGED, OK
 #: scratch s and pivots piv; (n, n): H, the iteration matrix A (LU-factored in place), d rhs/dq
 #: Jq, d rhs/dv Jqd; (c,): gaps g, normal velocities before the step un; W_N, W_T (c, n);
 #: coef (c, 2) = (e, mu); (2c,): impulses r = (p_N, p_T), free local velocities uf, active flag
-#: of each contact (first c entries); Y (2c, n) the rows A^-1 W^T; D (2c, 2c) the Delassus matrix.
-Workspace = namedtuple("Workspace", "f vf s piv H A Jq Jqd g un WN WT coef r uf active Y D")
+#: of each contact (first c entries); law (2c,) every contact UNILATERAL / COULOMB
+#: (core/contact_problem.py); Y (2c, n) the rows A^-1 W^T; D (2c, 2c) the Delassus matrix.
+Workspace = namedtuple("Workspace", "f vf s piv H A Jq Jqd g un WN WT coef r uf active law Y D")
 
 
 class MoreauJeanSettings(NamedTuple):
@@ -78,7 +81,7 @@ def workspace(kern, n):
                      np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
                      np.zeros(c), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
                      np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
-                     np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)))
+                     np.zeros(2 * c, np.int64), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)))
 
 
 @njit(inline="always")
@@ -100,69 +103,6 @@ def prepare(kern, q, v, mom, t, p, settings, ws, extra):
         extra[i] = 0.0
     extra[2 * c + 1] = _min_gap(ws.g)
     return OK
-
-
-@njit(inline="always")
-def _row(k, c, WN, WT):
-    """Row k of W^T (2c, n): W_N's rows, then W_T's."""
-    return WN[k] if k < c else WT[k - c]
-
-
-@njit(inline="always")
-def _delassus(c, n, active, WN, WT, A, piv, scratch, Y, D):
-    """Y_k = A^-1 W_k^T (rows of the active contacts) and D = W A^-1 W^T (2c, 2c) on them."""
-    for k in range(2 * c):
-        if active[k % c] == 0.0:
-            continue
-        w = _row(k, c, WN, WT)
-        for i in range(n):
-            Y[k, i] = w[i]
-        lu_solve_inplace(A, piv, Y[k], scratch)
-    for a in range(2 * c):
-        for b in range(2 * c):
-            s = 0.0
-            if active[a % c] != 0.0 and active[b % c] != 0.0:
-                w = _row(a, c, WN, WT)
-                for i in range(n):
-                    s += w[i] * Y[b, i]
-            D[a, b] = s
-
-
-@njit(inline="always")
-def _local_velocity(k, c, uf, D, r):
-    """(u_free + D r)_k, the local velocity of row k after the impulses r."""
-    s = uf[k]
-    for b in range(2 * c):
-        s += D[k, b] * r[b]
-    return s
-
-
-@njit(inline="always")
-def _gauss_seidel(c, tol, max_sweeps, active, coef, un, uf, D, r):
-    """Projected Gauss-Seidel on the impulses r (2c,) (see the module docstring). Returns
-    (converged, sweeps, the last sweep's largest change)."""
-    change = 0.0
-    for sweep in range(max_sweeps):
-        change, largest = 0.0, 0.0
-        for a in range(c):
-            if active[a] == 0.0 or D[a, a] <= 0.0:
-                continue
-            e, mu = coef[a, 0], coef[a, 1]
-            # restitution reverses an approaching velocity only (u_N- < 0)
-            pn = max(0.0, r[a] - (_local_velocity(a, c, uf, D, r) + e * min(un[a], 0.0)) / D[a, a])
-            change = max(change, abs(pn - r[a]))
-            r[a] = pn
-            t = c + a
-            pt = 0.0
-            if mu > 0.0 and D[t, t] > 0.0:
-                pt = r[t] - _local_velocity(t, c, uf, D, r) / D[t, t]
-                pt = min(max(pt, -mu * pn), mu * pn)
-            change = max(change, abs(pt - r[t]))
-            r[t] = pt
-            largest = max(largest, abs(pn), abs(pt))
-        if change <= tol * largest:
-            return True, sweep + 1, change
-    return False, max_sweeps, change
 
 
 @njit(inline=inline_step, **FAST)
@@ -200,9 +140,9 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         r[a], r[c + a] = 0.0, 0.0
     sweeps, change = 0, 0.0
     if n_active > 0:
-        _delassus(c, n, active, WN, WT, A, ws.piv, ws.s, ws.Y, ws.D)
-        converged, sweeps, change = _gauss_seidel(c, settings.contact_tol, settings.max_sweeps,
-                                                  active, ws.coef, ws.un, uf, ws.D, r)
+        delassus(c, n, active, WN, WT, A, ws.piv, ws.s, ws.Y, ws.D)
+        converged, sweeps, change = gauss_seidel(c, settings.contact_tol, settings.max_sweeps,
+                                                 active, ws.law, ws.coef, ws.un, uf, ws.D, r)
         if not converged:
             return CONTACT_NOT_CONVERGED, sweeps, change
     work = 0.0
@@ -212,8 +152,8 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         ut_minus = 0.0
         for i in range(n):
             ut_minus += WT[a, i] * v[i]
-        work += r[a] * 0.5 * (ws.un[a] + _local_velocity(a, c, uf, ws.D, r))
-        work += r[c + a] * 0.5 * (ut_minus + _local_velocity(c + a, c, uf, ws.D, r))
+        work += r[a] * 0.5 * (ws.un[a] + local_velocity(a, c, uf, ws.D, r))
+        work += r[c + a] * 0.5 * (ut_minus + local_velocity(c + a, c, uf, ws.D, r))
     for i in range(n):
         vi = vf[i]
         for k in range(2 * c):

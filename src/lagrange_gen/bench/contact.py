@@ -1,0 +1,235 @@
+"""`lagrange-gen bench contact`: work-precision of the contact methods against closed forms.
+
+Two cases, each with an error measured against a closed form:
+
+* bouncing ball (models/bouncing_ball.py, h0 = 1, e = 0.8, g = 9.81) at t_end = 3, in the
+  flight after the 6th impact: max(|y - y_exact|, |v - v_exact|) at t_end, the exact motion
+  being the parabolas between the impacts t_1 = sqrt(2 h0 / g), t_(k+1) = t_k + 2 e^k V0 / g;
+* rocking block (models/rocking_block.py, Housner: b = 0.2, c = 0.6, e = 0, mu = 1) released at
+  rest tilted by 0.15 rad on its left corner, at t_end = 1.5, after 3 impacts: between impacts
+  the energy is conserved (the pivot sticks) and each plastic impact keeps the fraction
+  r = (1 - 3/2 sin^2 alpha)^2 of the kinetic energy at phi = 0, so
+  (E(t) - m g c) / (E0 - m g c) = r^k after k impacts; the error is that ratio's distance
+  from r^3.
+
+Methods: moreau_jean (h = t_end / (n0 2^k)) and dop853_impacts (rtol sweep, atol = rtol / 100).
+Siconos (Moreau-Jean time stepping, the reference peer) runs when the package ``siconos`` is
+importable; the report says so when it is not. Time: simulate's integration wall time (the glue
+compiled before the clock starts), the fastest of ``repeats``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from . import common
+from ..analysis import runs
+
+G = 9.81
+
+
+@dataclass(frozen=True)
+class Case:
+    """One model of the suite: start, end time, parameters, the error of a run (a function of
+    the Trajectory) and what it measures."""
+
+    stem: str
+    title: str
+    q0: tuple
+    v0: tuple
+    t_end: float
+    params: tuple
+    error: object
+    measures: str
+
+
+def ball_state(t, h0=1.0, e=0.8, g=G):
+    """The exact (y, v) of the ball dropped from rest at h0 on the floor y = 0, at time t
+    (before the accumulation time)."""
+    v0 = math.sqrt(2 * g * h0)
+    t_impact = math.sqrt(2 * h0 / g)
+    if t < t_impact:
+        return h0 - g * t * t / 2, -g * t
+    speed = e * v0
+    while t >= t_impact + 2 * speed / g:
+        t_impact += 2 * speed / g
+        speed *= e
+    s = t - t_impact
+    return speed * s - g * s * s / 2, speed - g * s
+
+
+def _ball_error(traj):
+    y, v = ball_state(float(traj.t[-1]))
+    return max(abs(traj.q[-1, 0] - y), abs(traj.v[-1, 0] - v))
+
+
+B, C, PHI0, ROCK_IMPACTS = 0.2, 0.6, 0.15, 3
+
+
+def rocking_ratio(k):
+    """Housner's energy fraction after k plastic impacts, r^k, r = (1 - 3/2 sin^2 alpha)^2."""
+    alpha = math.atan2(B, C)
+    return (1 - 1.5 * math.sin(alpha) ** 2) ** (2 * k)
+
+
+def rocking_start():
+    """(x, y, phi) with the left corner at the origin, tilted by PHI0."""
+    return (-B + B * math.cos(PHI0) - C * math.sin(PHI0), B * math.sin(PHI0) + C * math.cos(PHI0),
+            PHI0)
+
+
+def _rocking_error(traj):
+    rest = G * C                                    # m = 1: E of the block flat at rest
+    ratio = (traj.energy[-1] - rest) / (traj.energy[0] - rest)
+    return abs(ratio - rocking_ratio(ROCK_IMPACTS))
+
+
+CASES = (
+    Case("bouncing_ball", "Bouncing ball (e = 0.8), t = 3 after 6 impacts", (1.0,), (0.0,), 3.0,
+         (("g", G), ("e", 0.8)), _ball_error, "max(|y - y_exact|, |v - v_exact|) at t_end"),
+    Case("rocking_block", "Rocking block (Housner, e = 0), t = 1.5 after 3 impacts",
+         rocking_start(), (0.0, 0.0, 0.0), 1.5,
+         (("g", G), ("b", B), ("c", C), ("e", 0.0), ("mu", 1.0), ("a_ground", 0.0)),
+         _rocking_error, "|(E - m g c) / (E0 - m g c) - r^3| at t_end"),
+)
+
+
+@dataclass(frozen=True)
+class Settings:
+    n0: int             # moreau_jean's steps at k = 0
+    k_max: int
+    rtols: tuple
+    repeats: int
+    budget: float       # stop a sweep after a run slower than this (s)
+
+
+FULL = Settings(n0=100, k_max=9, rtols=tuple(10.0 ** -k for k in range(3, 13)), repeats=3,
+                budget=5.0)
+QUICK = Settings(n0=50, k_max=1, rtols=(1e-4, 1e-8), repeats=1, budget=1.0)
+
+
+@dataclass
+class Point:
+    method: str
+    param: float        # h (moreau_jean) or rtol (dop853_impacts)
+    wall: float
+    error: float = math.nan
+    failed: str = ""
+
+
+def _runs(case, settings):
+    """[(method, param, simulate keywords)] of the sweeps, in order."""
+    out = []
+    for k in range(settings.k_max + 1):
+        n = settings.n0 * 2 ** k
+        h = case.t_end / n
+        out.append(("moreau_jean", h, dict(h=h, save_every=n)))
+    for rtol in settings.rtols:
+        out.append(("dop853_impacts", rtol, dict(h=None, rtol=rtol, atol=rtol / 100)))
+    return out
+
+
+def sweep(mod, case, settings, progress):
+    """The runs of one case -> [Point]; a method's sweep stops after a run over the budget."""
+    p = runs.params_of(mod, **dict(case.params))
+    q0, v0 = np.array(case.q0, float), np.array(case.v0, float)
+    points, slow = [], set()
+    for method, param, kwargs in _runs(case, settings):
+        progress.step(f"{case.stem} {method} {param:.1e}")
+        if method in slow:
+            continue
+        h = kwargs.pop("h")
+        run = runs.guarded_run(mod, method, q0, v0, h, case.t_end, p,
+                               repeats=settings.repeats, **kwargs)
+        if not run.ok:
+            points.append(Point(method, param, run.wall, failed=runs.short_error(run.error)))
+            continue
+        points.append(Point(method, param, run.wall, case.error(run.traj)))
+        if run.wall > settings.budget:
+            slow.add(method)
+    return points
+
+
+def fitted_order(points, method="moreau_jean"):
+    """The slope of log(error) against log(h) over a method's fixed-step points (None with
+    fewer than 3 finite ones)."""
+    xs = [(math.log(pt.param), math.log(pt.error)) for pt in points
+          if pt.method == method and pt.error > 0 and math.isfinite(pt.error)]
+    if len(xs) < 3:
+        return None
+    x, y = np.array(xs).T
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def figure(results, path):
+    """Error against wall time, one panel per case, one line per method."""
+    fig, axes = common.new_figure(1, len(results), figsize=(5.5 * len(results), 4.2))
+    axes = np.atleast_1d(axes)
+    for ax, (case, points) in zip(axes, results):
+        for method, marker in (("moreau_jean", "o"), ("dop853_impacts", "s")):
+            pts = [pt for pt in points if pt.method == method and not pt.failed]
+            if pts:
+                ax.loglog([max(pt.wall, 1e-7) for pt in pts],
+                          [max(pt.error, 1e-17) for pt in pts], marker=marker, label=method)
+        ax.set_title(case.title, fontsize=9)
+        ax.set_xlabel("integration wall time (s)")
+        ax.set_ylabel("error against the closed form")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    common.save_figure(fig, path)
+
+
+def _table(points):
+    rows = [(pt.method, f"{pt.param:.2e}", runs.fmt(pt.wall * 1e3, ".3g"),
+             pt.failed or runs.fmt(pt.error)) for pt in points]
+    return runs.md_table(["method", "h or rtol", "wall (ms)", "error"], rows)
+
+
+def siconos_line():
+    """What the report says about the Siconos peer."""
+    if importlib.util.find_spec("siconos") is None:
+        return ("Siconos (the reference Moreau-Jean implementation) is not installed in this "
+                "environment, so it is not compared here.")
+    return ("Siconos is installed, but this suite does not drive it yet: its runs are not in "
+            "the tables.")
+
+
+def run_contact(models_dir="models", gen_dir="generated", reports_dir="reports", quick=False,
+                progress=True):
+    """Run the suite; writes reports_dir/contact.md and contact_precision.png. Returns
+    {"results": [(case, [Point])], "report": path}."""
+    settings = QUICK if quick else FULL
+    cases = [c for c in CASES if runs.model_available(models_dir, c.stem)]
+    total = len(cases) * (settings.k_max + 1 + len(settings.rtols))
+    bar = common.Progress(total, "contact", enabled=progress)
+    lines = ["# Contact and impacts: work-precision", "",
+             "moreau_jean (order 1, fixed step) against dop853_impacts (event-driven, "
+             "adaptive), each run's error against a closed form; time is simulate's "
+             "integration wall time (fastest of "
+             f"{settings.repeats}){' (--quick settings)' if quick else ''}.", "",
+             siconos_line(), ""]
+    results = []
+    for case in cases:
+        mod = runs.load_module(models_dir, case.stem, gen_dir)
+        points = sweep(mod, case, settings, bar)
+        results.append((case, points))
+        order = fitted_order(points)
+        lines += [f"## {case.title}", "", f"Error: {case.measures}.", ""]
+        if order is not None:
+            lines += [f"moreau_jean's fitted order (slope of log error against log h): "
+                      f"{order:.2f}.", ""]
+        lines += [*_table(points), ""]
+    bar.finish()
+    missing = [c.stem for c in CASES if c not in cases]
+    if missing:
+        lines += [f"Model files missing from {models_dir}: {', '.join(missing)}.", ""]
+    if results:
+        figure(results, Path(reports_dir) / "contact_precision.png")
+        lines += ["![work-precision](contact_precision.png)", ""]
+    path = common.write_report(Path(reports_dir) / "contact.md", lines)
+    return {"results": results, "report": path}

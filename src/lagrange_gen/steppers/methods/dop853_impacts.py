@@ -1,0 +1,510 @@
+"""Event-driven stepping of unilateral contacts: dop853 between switches, Newton's impact law at
+located impacts, persistent contacts held at the acceleration level, a Zeno guard.
+
+Each contact a is in one mode: FREE (its gap g_a(q) > 0 may close) or persistent (g_a = 0 held,
+the contact force lambda_N >= 0 watched), and a persistent one with friction STICKs (u_T = 0,
+|lambda_T| <= mu lambda_N) or SLIDEs (lambda_T = -mu lambda_N sign(u_T)). Between switches the
+motion is smooth: dop853's tableau, error control and dense output (dop853.attempt_on,
+accept_on, dense_on) on the acceleration
+
+    M a = f + W^T lambda,   W a + Wdot v = 0 on the persistent rows (normal; tangent if sticking)
+
+with lambda from the contact problem at the acceleration level (core/contact_problem.py:
+BILATERAL normals, STICK or SLIDE tangents; Wdot v the generated ``contact_rates``).
+
+Switches are zero crossings, located on the dense output by events.refine (Illinois), of one
+function per contact and direction (all falling through 0): FREE: the gap g_a; persistent:
+lambda_N (lift-off); STICK: mu lambda_N - |lambda_T| (slip starts); SLIDE: s u_T (the slip
+velocity reverses; s its sign). The step ends at the earliest one (adaptive.run_adaptive's
+switch_point / apply_switch hooks); the run goes on from there after ``classify``:
+
+1. Impact: the contacts touching (g <= gap_tol) and not separating (u_N <= rest_velocity)
+   take part; if one approaches (u_N < -rest_velocity), Newton's impact law with Coulomb
+   friction at the velocity level, u_N+ + e min(u_N-, 0) >= 0 _|_ p_N >= 0 (several
+   simultaneous contacts: one problem, the same projected Gauss-Seidel as moreau_jean), and
+   v+ = v- + M^-1 W^T p.
+   Zeno guard: a contact whose previous impact was less than zeno_interval ago gets e = 0 in
+   this impact (an accumulation of impacts, t_k -> t_inf, ends there in a plastic one).
+2. Modes: a touching contact with |u_N| <= rest_velocity is persistent if its force at the
+   acceleration level is positive (else FREE); with friction it sticks if |u_T| <= rest_velocity
+   and the sticking force fits the cone (else it slides, away from the sticking force). The
+   velocities are then projected onto the persistent rows (u_N = 0; u_T = 0 when sticking) by
+   the same solver, so that rest stays rest.
+
+Orders: 8 between switches; the switch times are roots of the dense output (order 7), to
+events.ROOT_RTOL of the step. The gap of a persistent contact is held at the acceleration
+level, so it drifts by the integration error (rtol, atol).
+
+Reported (SPEC.saved, c = kern.N_CONTACTS), cumulative since t0 except the modes: ``impacts``
+(1) the impacts so far, ``normal_impulse_sum``, ``tangent_impulse_sum`` (c) the impulses of
+the impacts and projections summed per contact, ``contact_mode`` (c) FREE 0, STICK 1,
+SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, ``contact_work`` (1) the work of the impulses,
+r . (u- + u+) / 2, plus that of the persistent contacts' forces, lambda . (W v) integrated by
+the trapezoid rule over each step (exact for a constant force on a slip velocity linear in t:
+the block on a ramp). E - E0 - contact_work is then the balance for conservative forces. Row 0
+is the state after the start's classification (an impact at t0 is in the impulse sums); the
+work counts from it. In
+every-step mode a switch writes two rows at its time: before and after (diff the sums for an
+impact's impulses).
+
+A run continued in chunks reclassifies the contacts at each chunk's start; the Zeno guard's
+memory of the last impact time does not cross chunks.
+
+Over 300 lines: the switching functions, the classification at a switch (impact, modes,
+projection) and the work accounting read and write one workspace and one ``extra`` layout, so
+they stay beside each other and the docstring that defines them.
+"""
+
+import sys
+from collections import namedtuple
+from typing import NamedTuple
+
+import numpy as np
+from ...jit.cache import njit
+
+from ..core import events
+from ..core.contact_problem import (BILATERAL, COULOMB, SLIDE_NEGATIVE, SLIDE_POSITIVE, STICK,
+                                    UNILATERAL, contact_row, delassus, gauss_seidel)
+from ..core.linalg import lu_inplace, lu_solve_inplace
+from ..core.method_spec import Spec
+from ..core.options import FAST
+from ..core.status import CONTACT_NOT_CONVERGED, OK, SINGULAR_MASS
+from . import dop853
+
+#: Contact modes (saved as contact_mode); STICK, SLIDE_* as the tangent laws.
+FREE = 0
+
+ERROR_EXPONENT = dop853.ERROR_EXPONENT
+STAGE_EVALS = dop853.STAGE_EVALS
+ACCEPT_EVALS = dop853.ACCEPT_EVALS
+DENSE_EVALS = dop853.DENSE_EVALS
+#: A switch writes the state before it and the state after it (every-step mode).
+ROWS_PER_STEP = 2
+
+#: Saved-field offsets in ``extra`` (c contacts): impacts, normal sums, tangent sums, modes, work.
+IMPACTS = 0
+
+
+class Settings(NamedTuple):
+    """Settings of dop853_impacts (simulate's keywords)."""
+
+    rtol: float = 1e-9              # relative tolerance of the local error estimate
+    atol: float = 1e-12             # absolute tolerance (same units as q and v)
+    h_max: float = np.inf           # largest step size
+    max_steps: int = 100000         # cap on attempted (accepted + rejected) steps per call
+    blowup_bound: float = 1e150     # UNSTABLE when max(|q|, |v|) exceeds it
+    zeno_interval: float = 1e-5     # impacts of a contact closer than this: the next is plastic
+    gap_tol: float = 1e-9           # a contact touches when its gap is at most this
+    rest_velocity: float = 1e-9     # |u_N| (|u_T|) at most this: at rest (sticking)
+    contact_tol: float = 1e-12      # projected Gauss-Seidel stop: max change <= tol * max|r|
+    max_sweeps: int = 1000          # cap on the Gauss-Seidel sweeps of one contact problem
+
+
+#: dop853's fields (its functions read them by name), then, c contacts: M (n, n) the mass
+#: matrix (LU-factored), f (n,) rhs, s (n,) scratch, piv (n,) pivots, acc (n,) scratch
+#: acceleration; g (c,), WN, WT (c, n), coef (c, 2) = (e, mu), rate (2c,) = Wdot v; r (2c,)
+#: forces or impulses, uf (2c,) free local velocities/accelerations, zero (c,) zeros, un (c,)
+#: normal velocities before an impact; mode (c,) int; law (2c,) int (acceleration level),
+#: impact_law (2c,) zeros (UNILATERAL / COULOMB); persistent (c,) and touching (c,) 0/1 flags;
+#: coef_impact (c, 2); last_impact (c,) times; Y (2c, n), D (2c, 2c) (contact_problem);
+#: switch values at the step's start and end and at trial times sw_prev, sw_new (2c,) with
+#: the events workspace sw (refine's); power (2,) = [at the last evaluation, at the step's
+#: start]; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
+#: switching functions, and 1 while the start state is not classified yet; left_at (c,) the time a free contact was last touching (-inf: not
+#: since the step it cleared gap_tol).
+Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
+                                    "v_old span M f s piv acc g WN WT coef rate r uf zero un "
+                                    "mode law impact_law persistent touching coef_impact "
+                                    "last_impact Y D sw power solver left_at")
+
+
+@njit
+def workspace(kern, n):
+    """Allocated once per run by adaptive.run_adaptive."""
+    c = kern.N_CONTACTS
+    nd = dop853.N_DENSE
+    sw = events.Workspace(np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
+                          np.zeros(2 * c, np.int64), np.zeros(n), np.zeros(n), np.zeros(1))
+    return Workspace(np.zeros((nd, n)), np.zeros((nd, n)), np.zeros(n), np.zeros(n),
+                     np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)),
+                     np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2),
+                     np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
+                     np.zeros(n), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
+                     np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
+                     np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
+                     np.zeros(2 * c, np.int64), np.zeros(c), np.zeros(c), np.zeros((c, 2)),
+                     np.full(c, -np.inf), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)), sw,
+                     np.zeros(2), np.zeros(4), np.full(c, -np.inf))
+
+
+@njit(inline="always")
+def _mass_and_rhs(kern, ws, q, v, t, p):
+    """M (LU-factored in ws.M, ws.piv) and rhs into ws.f; False when M is singular."""
+    kern.dynamics(q, v, t, p, ws.M, ws.f)
+    return lu_inplace(ws.M, ws.piv)
+
+
+@njit(inline="always")
+def _local(ws, k, c, x):
+    """W_k . x for row k of W (2c, n) (normal rows, then tangent rows)."""
+    w = contact_row(k, c, ws.WN, ws.WT)
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += w[i] * x[i]
+    return s
+
+
+@njit(inline="always")
+def _apply(ws, c, flags, r, x):
+    """x (n,) += sum_k Y_k r_k over the rows of the contacts flagged."""
+    for k in range(2 * c):
+        if flags[k % c] != 0.0:
+            for i in range(x.shape[0]):
+                x[i] += ws.Y[k, i] * r[k]
+
+
+@njit(**FAST)
+def contact_acceleration(kern, ws, q, v, t, p, a):
+    """a (n,) = M^-1 (f + W^T lambda) with lambda (ws.r) the persistent contacts' forces under
+    ws.law; ws.power[0] <- lambda . (W v). OK, SINGULAR_MASS or CONTACT_NOT_CONVERGED."""
+    n, c = kern.N_COORDS, kern.N_CONTACTS
+    if not _mass_and_rhs(kern, ws, q, v, t, p):
+        return SINGULAR_MASS
+    for i in range(n):
+        a[i] = ws.f[i]
+    lu_solve_inplace(ws.M, ws.piv, a, ws.s)
+    ws.power[0] = 0.0
+    n_persistent = 0
+    for k in range(c):
+        n_persistent += int(ws.persistent[k])
+    if n_persistent == 0:
+        return OK
+    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    kern.contact_rates(q, v, t, p, ws.rate)
+    delassus(c, n, ws.persistent, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
+    for k in range(2 * c):
+        ws.r[k] = 0.0
+        ws.uf[k] = _local(ws, k, c, a) + ws.rate[k] if ws.persistent[k % c] != 0.0 else 0.0
+    converged, _, _ = gauss_seidel(c, ws.solver[0], int(ws.solver[1]), ws.persistent, ws.law,
+                                   ws.coef, ws.zero, ws.uf, ws.D, ws.r)
+    if not converged:
+        return CONTACT_NOT_CONVERGED
+    _apply(ws, c, ws.persistent, ws.r, a)
+    power = 0.0
+    for k in range(2 * c):
+        if ws.persistent[k % c] != 0.0:
+            power += ws.r[k] * _local(ws, k, c, v)
+    ws.power[0] = power
+    return OK
+
+
+@njit(**FAST)
+def stage_acceleration(kern, ctx, q, v, t, a):
+    """explicit_rk's callback: contact_acceleration; ctx = (p, ws)."""
+    p, ws = ctx
+    return contact_acceleration(kern, ws, q, v, t, p, a)
+
+
+@njit(**FAST)
+def event_values(kern, ws, q, v, t, p, out):
+    """The switching functions at (q, v, t) into out (2c,) (module docstring; each switches
+    when it falls through 0): rows a < c the normal ones, c + a the tangent ones (1 when the
+    contact has none). Leaves the contact forces in ws.r and their power in ws.power[0], the
+    gaps at q in ws.g.
+
+    A free contact that was touching at t_s = ws.left_at (it just bounced or lifted off) has
+    g / (t - t_s) instead of g (u_N at t_s, its limit): g itself starts the step at 0 and
+    would return below 0 within one long step (a parabola is one step of dop853) without a
+    sign change; g / (t - t_s) is positive until the landing, where it crosses 0 with g."""
+    c = kern.N_CONTACTS
+    status = contact_acceleration(kern, ws, q, v, t, p, ws.acc)
+    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    for a in range(c):
+        out[c + a] = 1.0
+        if ws.mode[a] == FREE:
+            out[a] = ws.g[a]
+            if ws.left_at[a] == t:
+                out[a] = _local(ws, a, c, v)
+            elif ws.left_at[a] > -np.inf:
+                out[a] = ws.g[a] / (t - ws.left_at[a])
+            continue
+        out[a] = ws.r[a] if status == OK else 0.0
+        if ws.coef[a, 1] > 0.0:
+            if ws.mode[a] == STICK:
+                out[c + a] = ws.coef[a, 1] * ws.r[a] - abs(ws.r[c + a])
+            elif ws.mode[a] == SLIDE_POSITIVE:
+                out[c + a] = _local(ws, c + a, c, v)
+            else:
+                out[c + a] = -_local(ws, c + a, c, v)
+    return status
+
+
+@njit(**FAST)
+def prepare(kern, q, v, t, p, settings, ws):
+    """The solver settings into the workspace; every contact FREE until apply_switch
+    classifies them (run_adaptive calls it next); stage 0 at the start state."""
+    ws.solver[0] = settings.contact_tol
+    ws.solver[1] = settings.max_sweeps
+    ws.solver[2] = settings.gap_tol
+    ws.solver[3] = 1.0           # the next apply_switch classifies the start state
+    for a in range(kern.N_CONTACTS):
+        ws.mode[a] = FREE
+        ws.persistent[a] = 0.0
+    return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
+
+
+@njit(**FAST)
+def initial_step(kern, q, v, t, direction, p, settings, ws):
+    """dop853's starting step: from ka[0] (the contact acceleration prepare wrote) and one
+    contact-free evaluation (a guess of the scale only)."""
+    return dop853.initial_step(kern, q, v, t, direction, p, settings, ws)
+
+
+@njit(**FAST)
+def attempt(kern, q, v, t, h, p, settings, ws):
+    """dop853's trial step on the contact acceleration (dop853.attempt_on)."""
+    return dop853.attempt_on(_THIS, kern, (p, ws), q, v, t, h, settings, ws)
+
+
+@njit(**FAST)
+def accept(kern, t_new, p, ws):
+    """dop853.accept_on: the FSAL stage on the contact acceleration."""
+    return dop853.accept_on(_THIS, kern, (p, ws), t_new, ws)
+
+
+@njit(**FAST)
+def dense(kern, q, v, t, h, p, ws):
+    """dop853.dense_on: the dense output on the contact acceleration."""
+    return dop853.dense_on(_THIS, kern, (p, ws), q, v, t, h, ws)
+
+
+interpolate = dop853.interpolate
+advance = dop853.advance
+
+
+@njit(inline="always")
+def _work_at(c):
+    """Index of contact_work in extra."""
+    return 1 + 3 * c
+
+
+@njit(**FAST)
+def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
+    """After an accepted step from (q, v) at t to (ws.q_new, ws.v_new) at t_new: the switching
+    functions there; on a crossing, the dense output, the earliest crossing time t* (refined)
+    and the state there into ws.q_new, ws.v_new. Adds the persistent forces' work over
+    [t, t_end of the step] to extra. Returns (status, switched, step end)."""
+    c = kern.N_CONTACTS
+    sw = ws.sw
+    status = event_values(kern, ws, ws.q_new, ws.v_new, t_new, p, sw.g_new)
+    if status != OK:
+        return status, False, t_new
+    crossed = False
+    for k in range(2 * c):
+        if events.crossing(sw.g_prev[k], sw.g_new[k], -1) != 0:
+            crossed = True
+    if not crossed:
+        extra[_work_at(c)] += 0.5 * (t_new - t) * (ws.power[1] + ws.power[0])
+        ws.power[1] = ws.power[0]
+        for k in range(2 * c):
+            sw.g_prev[k] = sw.g_new[k]
+        for a in range(c):           # clear of the surface: the plain gap from here on
+            if ws.left_at[a] > -np.inf and ws.g[a] > ws.solver[2]:
+                ws.left_at[a] = -np.inf
+                sw.g_prev[a] = ws.g[a]
+        return OK, False, t_new
+    status = dense(kern, q, v, t, h, p, ws)
+    counters[3] += DENSE_EVALS
+    if status != OK:
+        return status, False, t_new
+    t_star, first = t_new, -1
+    for k in range(2 * c):
+        if events.crossing(sw.g_prev[k], sw.g_new[k], -1) != 0:
+            tk = events.refine(_THIS, ws, _THIS, kern, sw, p, k, t, sw.g_prev[k], t_new,
+                               sw.g_new[k])
+            if first < 0 or (tk - t_star) * (t_new - t) < 0.0:
+                t_star, first = tk, k
+    status, t_star = _past_crossing(kern, ws, p, t, t_new, first, t_star)
+    if status != OK:
+        return status, False, t_new
+    extra[_work_at(c)] += 0.5 * (t_star - t) * (ws.power[1] + ws.power[0])
+    return status, True, t_star
+
+
+@njit(inline="always")
+def _past_crossing(kern, ws, p, t, t_new, first, t_star):
+    """The refined crossing t_star of function ``first`` moved, if needed, to where that
+    function is <= 0 (refine returns the bracket end nearer the root, possibly on the positive
+    side: the classification must see the switch done, or the run would switch again at once).
+    The state there into ws.q_new, ws.v_new and the functions into sw.g_new. Returns
+    (status, t_star)."""
+    sw = ws.sw
+    delta = events.ROOT_RTOL * abs(t_new - t) + 4.0 * events.EPS * abs(t_new)
+    delta = delta if t_new > t else -delta
+    status = OK
+    for _ in range(64):
+        dop853.interpolate(ws, t_star, ws.q_new, ws.v_new)
+        status = event_values(kern, ws, ws.q_new, ws.v_new, t_star, p, sw.g_new)
+        if sw.g_new[first] <= 0.0 or status != OK or t_star == t_new:
+            break
+        t_star = t_star + delta
+        if (t_star - t_new) * delta > 0.0:
+            t_star = t_new
+        delta *= 2.0
+    return status, t_star
+
+
+@njit(inline="always")
+def _impact(kern, ws, v, t, settings, extra):
+    """Newton's impact law with Coulomb friction on the touching contacts (ws.touching) at
+    velocity v (n,), in place; ws.M holds the factored mass matrix, WN, WT, coef the contacts.
+    The Zeno guard sets e = 0 for a contact hit again within zeno_interval. Returns status."""
+    n, c = kern.N_COORDS, kern.N_CONTACTS
+    delassus(c, n, ws.touching, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
+    for a in range(c):
+        ws.coef_impact[a, 0] = ws.coef[a, 0]
+        ws.coef_impact[a, 1] = ws.coef[a, 1]
+        ws.un[a] = _local(ws, a, c, v)
+        if ws.touching[a] != 0.0 and t - ws.last_impact[a] < settings.zeno_interval:
+            ws.coef_impact[a, 0] = 0.0
+    for k in range(2 * c):
+        ws.r[k] = 0.0
+        ws.uf[k] = _local(ws, k, c, v) if ws.touching[k % c] != 0.0 else 0.0
+    converged, _, _ = gauss_seidel(c, settings.contact_tol, settings.max_sweeps, ws.touching,
+                                   ws.impact_law, ws.coef_impact, ws.un, ws.uf, ws.D, ws.r)
+    if not converged:
+        return CONTACT_NOT_CONVERGED
+    _record_impulses(kern, ws, ws.touching, v, extra)
+    for a in range(c):
+        if ws.touching[a] != 0.0 and ws.r[a] > 0.0:
+            ws.last_impact[a] = t
+    extra[IMPACTS] += 1.0
+    return OK
+
+
+@njit(inline="always")
+def _record_impulses(kern, ws, flags, v, extra):
+    """v += M^-1 W^T r over the flagged contacts; the impulses' sums and their work
+    r . (u- + u+) / 2 into extra."""
+    c = kern.N_CONTACTS
+    work = 0.0
+    for k in range(2 * c):
+        if flags[k % c] != 0.0:
+            work += 0.5 * ws.r[k] * _local(ws, k, c, v)
+    _apply(ws, c, flags, ws.r, v)
+    for k in range(2 * c):
+        if flags[k % c] != 0.0:
+            work += 0.5 * ws.r[k] * _local(ws, k, c, v)
+            extra[1 + k] += ws.r[k]
+    extra[_work_at(c)] += work
+
+
+@njit(inline="always")
+def _set_modes(kern, ws, q, v, t, p, settings):
+    """Modes of the touching contacts at rest (module docstring, step 2): persistent when the
+    force at the acceleration level is positive, sticking when that fits the cone. Returns
+    status."""
+    c = kern.N_CONTACTS
+    for a in range(c):
+        rest = ws.touching[a] != 0.0 and abs(_local(ws, a, c, v)) <= settings.rest_velocity
+        ws.persistent[a] = 1.0 if rest else 0.0
+        ws.mode[a] = FREE
+        ws.law[a] = BILATERAL
+        ws.law[c + a] = STICK
+        if rest:
+            ut = _local(ws, c + a, c, v)
+            ws.mode[a] = STICK
+            if ws.coef[a, 1] > 0.0 and abs(ut) > settings.rest_velocity:
+                ws.mode[a] = SLIDE_POSITIVE if ut > 0.0 else SLIDE_NEGATIVE
+            ws.law[c + a] = ws.mode[a]
+    status = OK
+    for _ in range(2 * c + 1):          # each pass frees or starts sliding one contact at least
+        status = contact_acceleration(kern, ws, q, v, t, p, ws.acc)
+        if status != OK:
+            return status
+        changed = False
+        for a in range(c):
+            if ws.persistent[a] == 0.0:
+                continue
+            if ws.r[a] <= 0.0:
+                ws.persistent[a], ws.mode[a], changed = 0.0, FREE, True
+            elif ws.mode[a] == STICK and abs(ws.r[c + a]) > ws.coef[a, 1] * ws.r[a]:
+                # it slides away from the sticking force
+                ws.mode[a] = SLIDE_POSITIVE if ws.r[c + a] < 0.0 else SLIDE_NEGATIVE
+                ws.law[c + a], changed = ws.mode[a], True
+        if not changed:
+            break
+    return status
+
+
+@njit(**FAST)
+def apply_switch(kern, ws, q, v, t, p, settings, extra):
+    """Classify the contacts at (q, v, t) and continue from there (module docstring: the
+    impact, the modes, the projection onto the persistent rows); v changes in place. Then the
+    first stage ka[0], the switching functions and the power at the new start. Returns
+    status."""
+    n, c = kern.N_COORDS, kern.N_CONTACTS
+    work_before = extra[_work_at(c)]
+    if not _mass_and_rhs(kern, ws, q, v, t, p):
+        return SINGULAR_MASS
+    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    approaching = False
+    for a in range(c):
+        un = _local(ws, a, c, v)
+        touching = ws.g[a] <= settings.gap_tol and un <= settings.rest_velocity
+        ws.touching[a] = 1.0 if touching else 0.0
+        approaching = approaching or (touching and un < -settings.rest_velocity)
+    if approaching:
+        status = _impact(kern, ws, v, t, settings, extra)
+        if status != OK:
+            return status
+    status = _set_modes(kern, ws, q, v, t, p, settings)
+    if status != OK:
+        return status
+    n_persistent = 0
+    for a in range(c):
+        n_persistent += int(ws.persistent[a])
+    if n_persistent > 0:     # rest stays rest: u_N = 0 (and u_T = 0 sticking) on the velocities
+        if not _mass_and_rhs(kern, ws, q, v, t, p):
+            return SINGULAR_MASS
+        kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+        delassus(c, n, ws.persistent, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
+        for k in range(2 * c):
+            ws.r[k] = 0.0
+            ws.uf[k] = _local(ws, k, c, v) if ws.persistent[k % c] != 0.0 else 0.0
+        converged, _, _ = gauss_seidel(c, settings.contact_tol, settings.max_sweeps,
+                                       ws.persistent, ws.law, ws.coef, ws.zero, ws.uf, ws.D,
+                                       ws.r)
+        if not converged:
+            return CONTACT_NOT_CONVERGED
+        _record_impulses(kern, ws, ws.persistent, v, extra)
+    if ws.solver[3] != 0.0:        # row 0 is the state after this: the work counts from it
+        extra[_work_at(c)] = work_before
+        ws.solver[3] = 0.0
+    for a in range(c):
+        extra[1 + 2 * c + a] = ws.mode[a]
+        ws.left_at[a] = t if ws.mode[a] == FREE and ws.g[a] <= settings.gap_tol else -np.inf
+    status = event_values(kern, ws, q, v, t, p, ws.sw.g_prev)
+    ws.power[1] = ws.power[0]
+    if status != OK:
+        return status
+    return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
+
+
+# This module as a value for rk_step and events.refine (modules, not dispatchers, are passed).
+_THIS = sys.modules[__name__]
+
+SPEC = Spec(
+    name="dop853_impacts", order=8, family="nonsmooth", implicit=False, symplectic=False,
+    symmetric=False, adaptive=True, contacts=True,
+    summary="event-driven contacts: dop853 between located impacts (Newton's law), "
+            "persistent contacts and stick-slip switches, Zeno guard",
+    settings=Settings,
+    saved=(("impacts", 1), ("normal_impulse_sum", "c"), ("tangent_impulse_sum", "c"),
+           ("contact_mode", "c"), ("contact_work", 1)),
+    limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
+            "h_max": (0.0, False, True), "max_steps": (1, True, False),
+            "zeno_interval": (0.0, True, False), "gap_tol": (0.0, True, False),
+            "rest_velocity": (0.0, True, False), "contact_tol": (0.0, False, False),
+            "max_sweeps": (1, True, False)},
+    kernels=("contacts", "contact_rates", "dynamics", "forward_dynamics"))

@@ -1,0 +1,36 @@
+"""`lagrange-gen bench contact --quick` through the CLI on a model directory holding the bouncing
+ball and the rocking block: the report names both methods and both cases, says whether Siconos
+ran, and draws its figure; the event-driven runs' errors against the closed forms are small
+(the bouncing ball's parabolas are exact between located impacts). No timing asserts."""
+
+import re
+import shutil
+
+import matplotlib.image as mpimg
+import numpy as np
+
+from lg_test_support import MODELS_DIR
+from lagrange_gen.cli.main import main
+
+
+def test_bench_contact_quick_writes_its_report(tmp_path, gen_dir, monkeypatch):
+    models = tmp_path / "models"
+    models.mkdir()
+    for stem in ("bouncing_ball", "rocking_block"):
+        shutil.copy(MODELS_DIR / f"{stem}.py", models)
+    (tmp_path / "generated").symlink_to(gen_dir)
+    monkeypatch.chdir(tmp_path)
+    assert main(["bench", "contact", "--quick", "--no-progress", "--models", "models",
+                 "--reports", "reports"]) == 0
+    text = (tmp_path / "reports" / "contact.md").read_text()
+    assert text.startswith("# Contact and impacts: work-precision")
+    assert "## Bouncing ball" in text and "## Rocking block" in text
+    assert "Siconos" in text
+    rows = re.findall(r"\| dop853_impacts \| \S+ \| \S+ \| (\S+) \|", text)
+    assert len(rows) == 4
+    assert float(rows[0]) <= 1e-9                 # the ball: exact parabolas, located impacts
+    assert float(rows[3]) <= 1e-6                 # the block at rtol 1e-8
+    assert len(re.findall(r"\| moreau_jean \|", text)) == 4
+    figure = tmp_path / "reports" / "contact_precision.png"
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert float(np.ptp(mpimg.imread(figure)[..., :3])) > 0.0       # not a blank image
