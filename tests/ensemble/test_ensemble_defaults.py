@@ -14,7 +14,8 @@ from lagrange_gen.jit import compile_notice
 from lagrange_gen.run import ensemble as ensemble_module
 from lagrange_gen.run.ensemble import ensemble_bytes
 
-DAMPED = Path(__file__).resolve().parents[2] / "generated" / "damped_oscillator.py"
+ROOT = Path(__file__).resolve().parents[2]
+DAMPED = ROOT / "generated" / "damped_oscillator.py"
 STEPS = 400
 
 
@@ -48,11 +49,20 @@ def test_small_ensembles_save_every_step_and_an_explicit_save_every_is_kept(monk
     assert not [w for w in recwarn if "save_every" in str(w.message)]
 
 
-def test_the_warm_up_of_the_ensemble_glue_prints_the_compile_notice(monkeypatch, capsys):
+def test_the_warm_up_of_the_ensemble_glue_prints_the_compile_notice(monkeypatch, capsys,
+                                                                   tmp_path):
+    """A module generated just now (nothing of it in numba's cache): its first ensemble
+    compiles and says so; the second call compiles nothing and says nothing."""
+    from lagrange_gen.codegen.generated_files import generate_model
+    fresh = generate_model(ROOT / "models" / "damped_oscillator.py", tmp_path,
+                           methods=["rk4"]).path
     monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
-    _ensemble(save_every=1)
+    run = dict(q0=[1.0], t_end=0.05, h=0.01, save_every=1)
+    lg.ensemble(fresh, "rk4", **run)
     err = capsys.readouterr().err
     assert "lagrange-gen: compiling ensemble_rk4 for damped_oscillator (first use) ..." in err
+    lg.ensemble(fresh, "rk4", **run)
+    assert "compiling" not in capsys.readouterr().err
 
 
 def test_sweep_reports_compile_time_apart_from_stepping(tmp_path, capsys):
