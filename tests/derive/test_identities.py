@@ -7,6 +7,10 @@ import sympy as sp
 from lg_test_support import MODEL_FILES, ROBOT_MODELS
 
 STEMS = [f.stem for f in MODEL_FILES if f.stem not in ROBOT_MODELS]
+#: The Christoffel form differentiates H once more in plain sympy; on the bicycle's expanded
+#: 8 x 8 H that is over a minute, and its H, h and linearization are checked against the
+#: published benchmark (tests/rolling/test_bicycle_benchmark.py).
+CHRISTOFFEL_STEMS = [stem for stem in STEMS if stem != "bicycle"]
 
 
 def random_state(rng, n):
@@ -63,7 +67,7 @@ def christoffel_C(dyn):
         for i in range(n)))
 
 
-@pytest.mark.parametrize("stem", STEMS)
+@pytest.mark.parametrize("stem", CHRISTOFFEL_STEMS)
 def test_christoffel_form_and_skew_symmetry(derived, stem):
     """h = C(q, qd) qd with Christoffel C, and Hdot - 2C is skew-symmetric."""
     dyn = derived(stem)
