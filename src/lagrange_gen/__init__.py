@@ -25,7 +25,7 @@ _LAZY = {
     "inputs": "model.model", "load_model": "model.model_file", "kinetic_energy": "model.bodies", "gravity_potential": "model.bodies",
     "equations": "derive.equations",
     "Signal": "run.control", "linearize": "linear.linearize", "equilibrium": "linear.linearize",
-    "linearize_nonholonomic": "linear.nonholonomic",
+    "linearize_nonholonomic": "linear.nonholonomic", "rolling_contact": "model.rolling",
     "Stepper": "run.stepper", "step_jacobian": "linear.step_derivatives",
     "import_generated": "run.loader", "load": "run.loader",
     "simulate": "run.simulate", "Trajectory": "run.trajectory",
