@@ -222,24 +222,14 @@ _COLD_CHILD = r"""
 import json, sys, time
 t0 = time.perf_counter()
 import numba, numpy  # noqa: F401
-from numba.core import event
+from lagrange_gen.jit.compile_notice import time_outermost_compiles
 from lagrange_gen.run.loader import load
 from lagrange_gen.run.simulate import simulate
 t1 = time.perf_counter()
 # where the compile time goes: numba's outermost compiles, by what they compile
-compiles, depth = {"kernels": 0.0, "stepper": 0.0, "other": 0.0}, []
-class Outermost(event.Listener):
-    def on_start(self, ev):
-        depth.append((time.perf_counter(), ev.data["dispatcher"]))
-    def on_end(self, ev):
-        start, dispatcher = depth.pop()
-        if not depth:
-            name = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
-            kind = ("kernels" if name.startswith("lagrange_gen_generated") else "stepper"
-                    if name.startswith(("lagrange_gen_portable", "lagrange_gen.steppers"))
-                    else "other")
-            compiles[kind] += time.perf_counter() - start
-event.register("numba:compile", Outermost())
+seconds = time_outermost_compiles(lambda name: (
+    "kernels" if name.startswith("lagrange_gen_generated") else "stepper"
+    if name.startswith(("lagrange_gen_portable", "lagrange_gen.steppers")) else "other"))
 path, out_dir, method, options, q0, jit = sys.argv[1], sys.argv[2], sys.argv[3], \
     json.loads(sys.argv[4]), json.loads(sys.argv[5]), sys.argv[6]
 mod = load(path, out_dir=out_dir, methods=[method], options=options)
@@ -247,7 +237,8 @@ t2 = time.perf_counter()
 traj = simulate(mod, method, q0, None, t_end=0.01, h=1e-3, jit=jit)
 t3 = time.perf_counter()
 print(json.dumps({"imports": t1 - t0, "generate": t2 - t1, "first_simulate": t3 - t2,
-                  "path": mod.__file__, "jit": traj.jit, "compiles": compiles}))
+                  "path": mod.__file__, "jit": traj.jit,
+                  "compiles": {"kernels": 0.0, "stepper": 0.0, "other": 0.0} | seconds}))
 """
 
 

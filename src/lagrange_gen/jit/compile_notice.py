@@ -54,6 +54,28 @@ def _listen():
     _LISTENING.append(True)
 
 
+def time_outermost_compiles(classify):
+    """Register a listener that adds the seconds of each outermost numba compile (one that is
+    not nested in another) to ``seconds[classify(module name of the compiled function)]``;
+    returns that dict, filled as compiles end (what a first-run measurement reads)."""
+    from numba.core import event
+    seconds, open_compiles = {}, []
+
+    class OutermostCompiles(event.Listener):
+        def on_start(self, ev):
+            open_compiles.append((time.perf_counter(), ev.data["dispatcher"]))
+
+        def on_end(self, ev):
+            start, dispatcher = open_compiles.pop()
+            if not open_compiles:
+                name = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
+                kind = classify(name)
+                seconds[kind] = seconds.get(kind, 0.0) + time.perf_counter() - start
+
+    event.register("numba:compile", OutermostCompiles())
+    return seconds
+
+
 class first_use_notice:
     """Context manager around a call that may compile ``label`` (e.g. "run_rattle for
     four_bar"); prints the notice on ``stream`` (default sys.stderr) only if numba compiles
