@@ -100,7 +100,7 @@ class Settings(NamedTuple):
     max_sweeps: int = 1000          # cap on the Gauss-Seidel sweeps of one contact problem
 
 
-#: dop853's fields (its functions read them by name), then, c contacts: M (n, n) the mass
+#: dop853's fields (its functions read them by name, the work's included), then, c contacts: M (n, n) the mass
 #: matrix (LU-factored), f (n,) rhs, s (n,) scratch, piv (n,) pivots, acc (n,) scratch
 #: acceleration; g (c,), WN, WT (c, n), coef (c, 2) = (e, mu), rate (2c,) = Wdot v; r (2c,)
 #: forces or impulses, uf (2c,) free local velocities/accelerations, zero (c,) zeros, un (c,)
@@ -113,7 +113,7 @@ class Settings(NamedTuple):
 #: switching functions, and 1 while the start state is not classified yet; left_at (c,) the time a free contact was last touching (-inf: not
 #: since the step it cleared gap_tol).
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
-                                    "v_old span M f s piv acc g WN WT coef rate r uf zero un "
+                                    "v_old span pk w w_new w_old dense_w pw M f s piv acc g WN WT coef rate r uf zero un "
                                     "mode law impact_law persistent touching coef_impact "
                                     "last_impact Y D sw power solver left_at")
 
@@ -128,7 +128,7 @@ def workspace(kern, n):
     return Workspace(np.zeros((nd, n)), np.zeros((nd, n)), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)),
                      np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2),
-                     np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
+                     *dop853.work_fields(n), np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
                      np.zeros(n), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
                      np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
                      np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
@@ -250,6 +250,7 @@ def prepare(kern, q, v, t, p, settings, ws):
     for a in range(kern.N_CONTACTS):
         ws.mode[a] = FREE
         ws.persistent[a] = 0.0
+    dop853.start_work(kern, q, v, t, p, ws)
     return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
 
 
@@ -263,22 +264,23 @@ def initial_step(kern, q, v, t, direction, p, settings, ws):
 @njit(**FAST)
 def attempt(kern, q, v, t, h, p, settings, ws):
     """dop853's trial step on the contact acceleration (dop853.attempt_on)."""
-    return dop853.attempt_on(_THIS, kern, (p, ws), q, v, t, h, settings, ws)
+    return dop853.attempt_on(_THIS, kern, (p, ws), p, q, v, t, h, settings, ws)
 
 
 @njit(**FAST)
 def accept(kern, t_new, p, ws):
     """dop853.accept_on: the FSAL stage on the contact acceleration."""
-    return dop853.accept_on(_THIS, kern, (p, ws), t_new, ws)
+    return dop853.accept_on(_THIS, kern, (p, ws), p, t_new, ws)
 
 
 @njit(**FAST)
 def dense(kern, q, v, t, h, p, ws):
     """dop853.dense_on: the dense output on the contact acceleration."""
-    return dop853.dense_on(_THIS, kern, (p, ws), q, v, t, h, ws)
+    return dop853.dense_on(_THIS, kern, (p, ws), p, q, v, t, h, ws)
 
 
 interpolate = dop853.interpolate
+interpolate_work = dop853.interpolate_work
 advance = dop853.advance
 
 
@@ -327,6 +329,8 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
     status, t_star = _past_crossing(kern, ws, p, t, t_new, first, t_star)
     if status != OK:
         return status, False, t_new
+    if kern.WORK:                    # the step ends at t_star: W there from the dense output
+        ws.w_new[0] = dop853.interpolate_work(ws, t_star)
     extra[_work_at(c)] += 0.5 * (t_star - t) * (ws.power[1] + ws.power[0])
     return status, True, t_star
 
@@ -488,6 +492,7 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     ws.power[1] = ws.power[0]
     if status != OK:
         return status
+    dop853.start_work(kern, q, v, t, p, ws)      # P at the velocities after the impulses
     return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
 
 
@@ -507,4 +512,4 @@ SPEC = Spec(
             "zeno_interval": (0.0, True, False), "gap_tol": (0.0, True, False),
             "rest_velocity": (0.0, True, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
-    kernels=("contacts", "contact_rates", "dynamics", "forward_dynamics"))
+    kernels=("contacts", "contact_rates", "dynamics", "forward_dynamics", "power"))
