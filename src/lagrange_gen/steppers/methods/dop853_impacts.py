@@ -41,10 +41,11 @@ the impacts and projections summed per contact, ``contact_mode`` (c) FREE 0, STI
 SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, ``contact_work`` (1) the work of the impulses,
 r . (u- + u+) / 2, plus that of the persistent contacts' forces, lambda . (W v) integrated by
 the trapezoid rule over each step (exact for a constant force on a slip velocity linear in t:
-the block on a ramp). E - E0 - contact_work is then the balance for conservative forces. Row 0
+the block on a ramp). E - E0 - contact_work is then the balance for conservative forces;
+forces that do work (kern.WORK) add W, which dop853's functions step with the state (W' = P at
+the stages, see dop853.py) and which a switch leaves as it is: E - E0 - W - contact_work. Row 0
 is the state after the start's classification (an impact at t0 is in the impulse sums); the
-work counts from it. In
-every-step mode a switch writes two rows at its time: before and after (diff the sums for an
+work counts from it. In every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
 
 A run continued in chunks reclassifies the contacts at each chunk's start; the Zeno guard's
