@@ -332,12 +332,30 @@ def _work_stages(kern, q, v, t, h, p, ws):
     """The stage powers pk[1..11] at the stage states of the trial step (recomputed from its
     stages kv, ka as rk_step made them) and W at its end, ws.w_new = w + h sum_j b_j P_j."""
     n = kern.N_COORDS
-    s = B[0] * ws.pk[0, 0]
     for i in range(1, N_STAGES):
         stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, n)
         ws.pk[i, 0] = _power(kern, ws, ws.qs, ws.kv[i], t + C[i] * h, p)
-        s += B[i] * ws.pk[i, 0]
-    ws.w_new[0] = ws.w[0] + h * s
+    ws.w_new[0] = ws.w[0] + stage_integral(ws.pk, h)
+
+
+@njit(**FAST)
+def stage_integral(K, h):
+    """h sum_j b_j K[j, 0]: the integral over a step of size h of a scalar rate whose stage
+    values are K (16, 1) (K[0..11]), as the tableau steps it (order 8)."""
+    s = 0.0
+    for j in range(N_STAGES):
+        s += B[j] * K[j, 0]
+    return h * s
+
+
+@njit(**FAST)
+def dense_integral(K, h, x, F, ends):
+    """The integral of that rate from the step's start to x h, 0 <= x <= 1, from the dense
+    output (K[12..15] too: the FSAL and dense stages); F (7, 1), ends (2,) scratch."""
+    ends[0] = 0.0
+    ends[1] = stage_integral(K, h)
+    _coefficients(K, ends[0:1], ends[1:2], h, F)
+    return _interpolant(F, ends[0:1], 0, x)
 
 
 @njit(**FAST)

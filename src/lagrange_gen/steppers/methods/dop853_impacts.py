@@ -39,9 +39,9 @@ Reported (SPEC.saved, c = kern.N_CONTACTS), cumulative since t0 except the modes
 (1) the impacts so far, ``normal_impulse_sum``, ``tangent_impulse_sum`` (c) the impulses of
 the impacts and projections summed per contact, ``contact_mode`` (c) FREE 0, STICK 1,
 SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, ``contact_work`` (1) the work of the impulses,
-r . (u- + u+) / 2, plus that of the persistent contacts' forces, lambda . (W v) integrated by
-the trapezoid rule over each step (exact for a constant force on a slip velocity linear in t:
-the block on a ramp). E - E0 - contact_work is then the balance for conservative forces;
+r . (u- + u+) / 2, plus that of the persistent contacts' forces, their power lambda . (W v)
+integrated like W (dop853.py): its values at the stages, the tableau's sum over a step and the
+dense output's integral over a step that ends at a switch (order 8, 7). E - E0 - contact_work is then the balance for conservative forces;
 forces that do work (kern.WORK) add W, which dop853's functions step with the state (W' = P at
 the stages, see dop853.py) and which a switch leaves as it is: E - E0 - W - contact_work. Row 0
 is the state after the start's classification (an impact at t0 is in the impulse sums); the
@@ -110,13 +110,16 @@ class Settings(NamedTuple):
 #: coef_impact (c, 2); last_impact (c,) times; Y (2c, n), D (2c, 2c) (contact_problem);
 #: switch values at the step's start and end and at trial times sw_prev, sw_new (2c,) with
 #: the events workspace sw (refine's); power (2,) = [at the last evaluation, at the step's
-#: start]; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
+#: start]; contact_stages (16, 1) that power at the stages of the step, stage_at (1,) the
+#: stage the next stage_acceleration evaluates, quad_F (7, 1), quad_ends (2,) scratch of its
+#: dense integral; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
 #: switching functions, and 1 while the start state is not classified yet; left_at (c,) the time a free contact was last touching (-inf: not
 #: since the step it cleared gap_tol).
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
                                     "v_old span pk w w_new w_old dense_w pw M f s piv acc g WN WT coef rate r uf zero un "
                                     "mode law impact_law persistent touching coef_impact "
-                                    "last_impact Y D sw power solver left_at")
+                                    "last_impact Y D sw power contact_stages stage_at quad_F "
+                                    "quad_ends solver left_at")
 
 
 @njit
@@ -135,6 +138,7 @@ def workspace(kern, n):
                      np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
                      np.zeros(2 * c, np.int64), np.zeros(c), np.zeros(c), np.zeros((c, 2)),
                      np.full(c, -np.inf), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)), sw,
+                     np.zeros(2), np.zeros((nd, 1)), np.zeros(1, np.int64), np.zeros((7, 1)),
                      np.zeros(2), np.zeros(4), np.full(c, -np.inf))
 
 
@@ -201,9 +205,15 @@ def contact_acceleration(kern, ws, q, v, t, p, a):
 
 @njit(**FAST)
 def stage_acceleration(kern, ctx, q, v, t, a):
-    """explicit_rk's callback: contact_acceleration; ctx = (p, ws)."""
+    """explicit_rk's callback: contact_acceleration; ctx = (p, ws). Records the persistent
+    forces' power there as stage ws.stage_at of the step (attempt, accept, dense set it)."""
     p, ws = ctx
-    return contact_acceleration(kern, ws, q, v, t, p, a)
+    status = contact_acceleration(kern, ws, q, v, t, p, a)
+    k = ws.stage_at[0]
+    if k < dop853.N_DENSE:
+        ws.contact_stages[k, 0] = ws.power[0]
+        ws.stage_at[0] = k + 1
+    return status
 
 
 @njit(**FAST)
@@ -265,18 +275,21 @@ def initial_step(kern, q, v, t, direction, p, settings, ws):
 @njit(**FAST)
 def attempt(kern, q, v, t, h, p, settings, ws):
     """dop853's trial step on the contact acceleration (dop853.attempt_on)."""
+    ws.stage_at[0] = 1
     return dop853.attempt_on(_THIS, kern, (p, ws), p, q, v, t, h, settings, ws)
 
 
 @njit(**FAST)
 def accept(kern, t_new, p, ws):
     """dop853.accept_on: the FSAL stage on the contact acceleration."""
+    ws.stage_at[0] = dop853.N_STAGES
     return dop853.accept_on(_THIS, kern, (p, ws), p, t_new, ws)
 
 
 @njit(**FAST)
 def dense(kern, q, v, t, h, p, ws):
     """dop853.dense_on: the dense output on the contact acceleration."""
+    ws.stage_at[0] = dop853.N_STAGES + 1
     return dop853.dense_on(_THIS, kern, (p, ws), p, q, v, t, h, ws)
 
 
@@ -295,10 +308,11 @@ def _work_at(c):
 def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
     """After an accepted step from (q, v) at t to (ws.q_new, ws.v_new) at t_new: the switching
     functions there; on a crossing, the dense output, the earliest crossing time t* (refined)
-    and the state there into ws.q_new, ws.v_new. Adds the persistent forces' work over
-    [t, t_end of the step] to extra. Returns (status, switched, step end)."""
+    and the state there into ws.q_new, ws.v_new (and W into ws.w_new). Adds the persistent
+    forces' work over [t, t_end of the step] to extra (from their power at the stages). Returns (status, switched, step end)."""
     c = kern.N_CONTACTS
     sw = ws.sw
+    ws.contact_stages[0, 0] = ws.power[1]
     status = event_values(kern, ws, ws.q_new, ws.v_new, t_new, p, sw.g_new)
     if status != OK:
         return status, False, t_new
@@ -307,7 +321,7 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
         if events.crossing(sw.g_prev[k], sw.g_new[k], -1) != 0:
             crossed = True
     if not crossed:
-        extra[_work_at(c)] += 0.5 * (t_new - t) * (ws.power[1] + ws.power[0])
+        extra[_work_at(c)] += dop853.stage_integral(ws.contact_stages, h)
         ws.power[1] = ws.power[0]
         for k in range(2 * c):
             sw.g_prev[k] = sw.g_new[k]
@@ -332,7 +346,8 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
         return status, False, t_new
     if kern.WORK:                    # the step ends at t_star: W there from the dense output
         ws.w_new[0] = dop853.interpolate_work(ws, t_star)
-    extra[_work_at(c)] += 0.5 * (t_star - t) * (ws.power[1] + ws.power[0])
+    extra[_work_at(c)] += dop853.dense_integral(ws.contact_stages, h, (t_star - t) / h,
+                                                 ws.quad_F, ws.quad_ends)
     return status, True, t_star
 
 
