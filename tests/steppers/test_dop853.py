@@ -229,5 +229,5 @@ def test_blow_up_reports_status_and_time(blowup):
 
 def test_declared_kernels_are_the_ones_the_code_reaches():
     reached = {name for name in method_needs("dop853", with_loop=False) if not name.isupper()}
-    assert set(registry.spec("dop853").kernels) == reached == {"forward_dynamics"}
+    assert set(registry.spec("dop853").kernels) == reached == {"forward_dynamics", "power"}
     assert "energy" in method_needs("dop853")       # the adaptive loop's

@@ -186,9 +186,11 @@ def _summary(traj):
     print(f"final q = {_vector(traj.q[-1])}, v = {_vector(traj.v[-1])}")
     contact_work = traj.saved.get("contact_work")
     if contact_work is not None:     # impacts and friction: E changes by the impulses' work
-        balance = float(abs(traj.energy_error - contact_work[:, 0]).max())
+        work = contact_work[:, 0] + (traj.work if traj.work is not None else 0.0)
+        forces = " and of the forces" if traj.work is not None else ""
+        balance = float(abs(traj.energy_error - work).max())
         print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
-              f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
+              f"contact impulses{forces}, final W = {work[-1]:.6g})")
         impacts = traj.impacts
         if "impacts" in traj.saved:      # event-driven: the located impacts
             shown = ", ".join(f"t = {row['t']:.9g} (contact {row['contact']}, p_N = "
@@ -196,9 +198,7 @@ def _summary(traj):
             print(f"impacts: {int(traj.saved['impacts'][-1, 0])}"
                   + (f"; first {shown}" if shown else ""))
     elif traj.work is None:
-        unknown = (", W not tracked: E also changes by the work of forces, damping and explicit "
-                   "time, which only fixed-step methods integrate") if traj.work_note else ""
-        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g}{unknown})")
+        print(f"max |E - E0| = {traj.max_energy_error:.3e} (E0 = {traj.energy[0]:.9g})")
     else:       # forced, damped or rheonomic: E changes by the work W done on the system
         print(f"max |E - E0 - W| = {traj.max_energy_balance_error:.3e} (E0 = {traj.energy[0]:.9g}, "
               f"final W = {traj.work[-1]:.6g})")

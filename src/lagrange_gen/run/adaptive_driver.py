@@ -18,7 +18,7 @@ from .failures import raise_for_status
 from .fixed_driver import EVENT_ROWS, ProgressBar, ready_glue, remember_glue
 from ..jit.compile_notice import first_use_notice
 from ..steppers.core import status as st
-from ..steppers.core.layout import N_STATS, events_size, last_size, read_last
+from ..steppers.core.layout import N_STATS, STAT_WORK, events_size, last_size, read_last
 
 #: Rows per call into the jitted loop when every accepted step is saved (the first call has
 #: FIRST_ROWS, each next one four times more, up to CHUNK_ROWS).
@@ -38,7 +38,7 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
     n_events, last, counters (4,)}. Raises the exception of a failure status."""
     m, n, t0 = task.module, task.module.N_COORDS, task.t0
     n_saved = initial.shape[0]
-    last = np.empty(last_size(n, n_saved))
+    last = np.empty(last_size(n, n_saved, with_work=True))
     counters = np.array([task.h or 0.0, 0.0, 0.0, 0.0])
     events = np.zeros((EVENT_ROWS if getattr(m, "N_EVENTS", 0) else 0, events_size(n)))
     wanted = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=np.float64)
@@ -66,7 +66,7 @@ def _calls(task, run, q, v, initial, last, counters, events, wanted, t_end, t_ev
     m, n, t0 = task.module, task.module.N_COORDS, task.t0
     n_saved = initial.shape[0]
     parts, n_events, t = [], 0, t0
-    extra0 = initial.copy()
+    extra0, work0 = initial.copy(), 0.0
     while True:
         # Buffers of FIRST_ROWS rows first, four times more per call up to CHUNK_ROWS: a short
         # run does not allocate (and zero) the rows of a long one.
@@ -75,6 +75,7 @@ def _calls(task, run, q, v, initial, last, counters, events, wanted, t_end, t_ev
         buf = dict(t=np.empty(rows), q=np.empty((rows, n)), v=np.empty((rows, n)),
                    stats=np.zeros((rows, N_STATS)), extra=np.zeros((rows, n_saved)))
         buf["extra"][0] = extra0
+        buf["stats"][0, STAT_WORK] = work0           # W continues from the previous call
         found = min(n_events, events.shape[0])
         code, filled, got = run(q, v, t, t_end, task.p, task.settings, wanted, buf["t"],
                                      buf["q"], buf["v"], buf["stats"], buf["extra"], last,
@@ -85,9 +86,9 @@ def _calls(task, run, q, v, initial, last, counters, events, wanted, t_end, t_ev
                              task.max_iter, counters[C_H], task.p)
         keep = slice(0 if not parts else 1, filled)
         parts.append({k: a[keep] for k, a in buf.items()})
-        final = read_last(last, n)
+        final = read_last(last, n, with_work=True)
         q, v, t = final.q.copy(), final.v.copy(), float(final.t)
-        extra0 = final.extra.copy()
+        extra0, work0 = final.extra.copy(), final.work
         if len(wanted):
             wanted = wanted[filled - 1:]
         if bar:

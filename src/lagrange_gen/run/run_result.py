@@ -23,8 +23,7 @@ from ..steppers.core import status as st
 from ..steppers.core.layout import STAT_ENERGY, STAT_ITERS, STAT_RESIDUAL, STAT_WORK, read_last
 from .trajectory import Trajectory
 
-__all__ = ["fixed_step_trajectory", "adaptive_trajectory", "element_energy", "warn_energy_lost",
-           "work_note"]
+__all__ = ["fixed_step_trajectory", "adaptive_trajectory", "element_energy", "warn_energy_lost"]
 
 
 def element_energy(module, p, state):
@@ -78,20 +77,11 @@ def adaptive_trajectory(task, out, t_eval, wall, compile_time):
     return warn_energy_lost(task, traj, h, "tighten rtol and atol")
 
 
-def _has_work(module, spec):
-    """Whether the run integrated W (steppers/core/work.py): fixed-step methods on a model whose
-    energy E = T2 - T0 + V is not conserved (WORK; modules generated before it have none)."""
-    return bool(getattr(module, "WORK", False)) and not spec.adaptive
-
-
-def work_note(module, spec) -> str:
-    """The sentence of a run on a model whose E is not conserved that did not integrate W (an
-    adaptive method's loop does not), else ""."""
-    if not getattr(module, "WORK", False) or _has_work(module, spec):
-        return ""
-    return (f"W not tracked: {spec.name} (adaptive) does not integrate the work W of forces, "
-            f"damping and explicit time, so energy_balance is E - E0, not E - E0 - W "
-            f"(fixed-step methods track W)")
+def _has_work(module):
+    """Whether the run integrated W (steppers/core/work.py): every method, fixed-step and
+    adaptive, does on a model whose energy E = T2 - T0 + V is not conserved (WORK; modules
+    generated before it have none)."""
+    return bool(getattr(module, "WORK", False))
 
 
 def _build(task, rows, out, steps, h, wall, compile_time):
@@ -109,8 +99,8 @@ def _build(task, rows, out, steps, h, wall, compile_time):
                       h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
                       coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
                       compile_time=compile_time, jit=task.ran, saved=saved,
-                      work=rows["stats"][:, STAT_WORK].copy() if _has_work(m, spec) else None,
-                      work_note=work_note(m, spec), settings=_settings(task.settings),
+                      work=rows["stats"][:, STAT_WORK].copy() if _has_work(m) else None,
+                      settings=_settings(task.settings),
                       element_names=tuple(m.ELEMENTS) if spec.elements else (),
                       constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
                       events=_events(m, out), source=_source(m))

@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,8 +19,8 @@ class Trajectory:
 
     t (S,), q (S, n), v (S, n), energy (S,) the energy function E = T2 - T0 + V (T + V for a
     scleronomic T), work (S,) or None: W, the work of the non-conservative forces, dissipation
-    and explicit time since t0 (steppers/core/work.py: fixed-step runs on models whose E is not
-    conserved), newton_iters (S,) Newton iterations summed
+    and explicit time since t0 (steppers/core/work.py; the runs of every method on models whose
+    E is not conserved), newton_iters (S,) Newton iterations summed
     over the steps since the previous saved row, newton_residual (S,) the largest final Newton
     residual over those steps. S = n_steps // save_every + 1 (+1 when the final state does not
     fall on a save).
@@ -53,9 +52,7 @@ class Trajectory:
     # where the module came from: {"model_file": absolute path, "build": {...}, "frozen": {...}}
     # (what animate needs to rebuild the model's Drawing)
     source: dict = field(default_factory=dict)
-    work: np.ndarray | None = None   # W (S,), see above; None when E is conserved or not tracked
-    # one sentence when E is not conserved but W was not tracked (adaptive methods), else ""
-    work_note: str = ""
+    work: np.ndarray | None = None   # W (S,), see above; None when E is conserved
     # the method's settings as the run used them (rtol, atol, newton_tol, ...)
     settings: dict = field(default_factory=dict)
 
@@ -97,13 +94,10 @@ class Trajectory:
 
     @property
     def energy_balance(self) -> np.ndarray:
-        """E - E0 - (W - W0) (S,): zero up to the method's error when the work is tracked
-        (``work``), else E - E0, with a UserWarning (``work_note``) when E is not conserved
-        but W was not tracked (adaptive methods). (W0 = 0 unless the trajectory was cut from a
-        longer one.)"""
+        """E - E0 - (W - W0) (S,): zero up to the method's error; E - E0 when the model conserves
+        E (``work`` None). (W0 = 0 unless the trajectory was cut from a longer one.) The work of
+        contact impulses and forces is not in W: see ``saved["contact_work"]``."""
         if self.work is None:
-            if self.work_note:
-                warnings.warn(self.work_note, UserWarning, stacklevel=2)
             return self.energy_error
         return self.energy_error - (np.asarray(self.work) - self.work[0])
 

@@ -85,12 +85,11 @@ def _steps(traj):
 
 
 def _energy_panel(traj):
-    """E - E0, or E - E0 - W with the work W (S,) when the trajectory has one; "E - E0 (W not
-    tracked)" when E is not conserved and the run did not integrate W (traj.work_note)."""
+    """E - E0, or E - E0 - W with the work W (S,) when the trajectory has one."""
     if traj.work is not None:
         label = "E - E0 - W"
         return label, lambda ax: ax.plot(traj.t, traj.energy_balance, lw=1, label=label)
-    label = "E - E0 (W not tracked)" if traj.work_note else "E - E0"
+    label = "E - E0"
     return label, lambda ax: ax.plot(traj.t, traj.energy_error, lw=1, label=label)
 
 

@@ -12,7 +12,8 @@ The generated glue of an adaptive method (codegen.glue.ADAPTIVE_GLUE_ARGS) calls
     out_t (S,), out_q (S, n), out_v (S, n), out_stats (S, N_STATS), out_extra (S, n_saved);
                 S >= 2 (ValueError otherwise, like the buffer check of run_loop.run_loop)
     out_last    (2n + 3 + n_saved,) [t, q, v, accepted steps since the last row, last accepted
-                error norm, saved fields] of the state reached (see below)
+                error norm, saved fields] of the state reached (see below), or one entry
+                longer: then W there in the last entry (layout.work_at)
     out_events  (E', 3 + 2n): located events (see "Events" below)
     counters    (4,) float64, in/out: [h, accepted, rejected, evaluations]. In: counters[0] =
                 the first step size to try (its sign is ignored; 0: Hairer's automatic starting
@@ -28,14 +29,17 @@ gets the step's end state exactly. Steps are clipped to land exactly on t_end (o
 t_end exactly), and the integration always runs to t_end, even after the last t_eval value.
 out_stats per row: STAT_ENERGY the energy, STAT_ITERS the accepted steps since the previous
 row (0 for a second t_eval value inside the same step), STAT_RESIDUAL the error norm of the
-accepted step the row comes from (<= 1; 0 in row 0).
+accepted step the row comes from (<= 1; 0 in row 0), STAT_WORK the work W since t0 (work.py),
+continued from out_stats[0, STAT_WORK] (0 for a model without kern.WORK): the method steps
+it with q, v (dop853: W' = P(q, v, t) at its stages, under its error control), a t_eval row
+gets it from the dense output like q, v.
 
 Chunks: ``rows`` rows were written. A call returns OK either complete (out_last[0] == t_end) or
 with full buffers: before a step whose output would not fit, it returns the state it would have
 stepped from in out_last (not necessarily a row: with t_eval it is the last step end) and the
-step it would have tried in counters[0]. The driver calls again from out_last's t, q, v (and
-its saved fields as row 0 of out_extra) with counters as returned, fresh buffers and (with
-t_eval) the t_eval values not yet output; row 0 of the new call is that start state, to be
+step it would have tried in counters[0]. The driver calls again from out_last's t, q, v (its
+saved fields as row 0 of out_extra, its W as out_stats[0, STAT_WORK]) with counters as
+returned, fresh buffers and (with t_eval) the t_eval values not yet output; row 0 of the new call is that start state, to be
 dropped (it repeats the previous call's last row or is not a requested time); the accepted
 steps the previous call took after its last row (out_last[1 + 2n]) belong to the STAT_ITERS of
 the new call's row 1. The continued run is bitwise the run in one call: the step sequence
@@ -77,18 +81,20 @@ valid until the next dense call. Without t_eval values inside a step, dense is n
 (it costs DENSE_EVALS evaluations).
 
 What a method module provides (dop853.py): workspace(kern, n) (a namedtuple with at least the
-(n,) arrays q_new, v_new (the trial state) and q_int, v_int (interpolation)), prepare(kern, q,
-v, t, p, settings, ws) -> status (stage 0 at the start state), initial_step(kern, q, v, t,
-direction, p, settings, ws) -> (status, |h|), attempt(kern, q, v, t, h, p, settings, ws) ->
-(status, err) into ws.q_new, ws.v_new, accept(kern, t_new, p, ws) -> status, dense(kern, q, v,
-t, h, p, ws) -> status, interpolate(ws, t, q_out, v_out), advance(q, v, ws), and the constants
+(n,) arrays q_new, v_new (the trial state) and q_int, v_int (interpolation) and the (1,) arrays
+w, w_new (W at the current and at the trial state)), prepare(kern, q, v, t, p, settings, ws)
+-> status (stage 0 at the start state), initial_step(kern, q, v, t, direction, p, settings,
+ws) -> (status, |h|), attempt(kern, q, v, t, h, p, settings, ws) -> (status, err) into
+ws.q_new, ws.v_new (ws.w_new), accept(kern, t_new, p, ws) -> status, dense(kern, q, v, t, h,
+p, ws) -> status, interpolate(ws, t, q_out, v_out), interpolate_work(ws, t) -> W (called on
+models with kern.WORK only), advance(q, v, ws) (w <- w_new too), and the constants
 ERROR_EXPONENT = 1/(p+1), STAGE_EVALS, ACCEPT_EVALS, DENSE_EVALS, ROWS_PER_STEP (rows one step
 may write in every-step mode).
 
 Switches (dop853_impacts; dop853's are no-ops): after each accepted step,
 switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters) -> (status, switched, t_end of
 the step): when switched, the step ends early at that time with the state there in ws.q_new,
-ws.v_new and the dense output of the whole step built (the step's rows and the model's events
+ws.v_new (W in ws.w_new) and the dense output of the whole step built (the step's rows and the model's events
 use it up to there); then apply_switch(kern, ws, q, v, t, p, settings, extra) -> status makes
 the state the run continues from (in place: impulses, new modes) and every-step mode writes it
 as a second row at the same time. apply_switch also runs once on the start state, after
@@ -107,7 +113,7 @@ from ...jit.cache import njit
 from . import events, layout
 from .layout import STAT_WORK
 from .options import FAST
-from .output import save_row, write_last
+from .output import save_row, write_last, write_work
 from .state_checks import check_state
 from .status import NON_FINITE, OK, STEP_TOO_SMALL, TOO_MANY_STEPS
 
@@ -148,22 +154,33 @@ def points_in(t_eval, j, t_new, direction, cap):
 
 
 @njit(inline="always")
-def _save_row(kern, row, t, q, v, p, since, err, out_t, out_q, out_v, out_stats, extra,
+def _save_row(kern, row, t, q, v, W, p, since, err, out_t, out_q, out_v, out_stats, extra,
               out_extra):
-    """Write one output row; False (nothing written) when the energy there is not finite."""
+    """Write one output row (W the work there); False (nothing written) when the energy there
+    is not finite."""
     energy = kern.energy(q, v, t, p)
     if not math.isfinite(energy):
         return False
     save_row(row, t, q, v, energy, since, err, out_t, out_q, out_v, out_stats, extra, out_extra)
-    out_stats[row, STAT_WORK] = 0.0          # the work W is tracked by fixed-step runs only
+    out_stats[row, STAT_WORK] = W
     return True
 
 
 @njit(inline="always")
-def _stop(out_last, counters, t, q, v, since, err, extra, h):
-    """Where a call ends: out_last = [t, q, v, since, err, extra], counters[0] = h."""
+def _stop(out_last, counters, t, q, v, W, since, err, extra, h):
+    """Where a call ends: out_last = [t, q, v, since, err, extra(, W)], counters[0] = h."""
     write_last(out_last, t, q, v, since, err, extra)
+    write_work(out_last, q.shape[0], extra.shape[0], W)
     counters[0] = h
+
+
+@njit(inline="always")
+def _work_at(method, kern, ws, t):
+    """W at t inside the last step, from the method's dense output (built); 0 on a model
+    without kern.WORK (nothing evaluated)."""
+    if kern.WORK:
+        return method.interpolate_work(ws, t)
+    return 0.0
 
 
 @njit(inline="always")
@@ -202,27 +219,30 @@ def _output(method, kern, ws, q, v, t, h, t_new, err, p, t_eval, j, rows, since,
     already, and ws.q_new is no longer the end of the step it was built for). Returns
     (status, rows, j, since); on failure out_last and counters[0] are set (_stop)."""
     if t_eval.shape[0] == 0:
-        if not _save_row(kern, rows, t_new, ws.q_new, ws.v_new, p, since, err, out_t, out_q,
-                         out_v, out_stats, extra, out_extra):
-            _stop(out_last, counters, t_new, ws.q_new, ws.v_new, since, err, extra, h)
+        if not _save_row(kern, rows, t_new, ws.q_new, ws.v_new, ws.w_new[0], p, since, err,
+                         out_t, out_q, out_v, out_stats, extra, out_extra):
+            _stop(out_last, counters, t_new, ws.q_new, ws.v_new, ws.w_new[0], since, err, extra,
+                  h)
             return NON_FINITE, rows, j, since
         return OK, rows + 1, j, 0.0
     direction = 1.0 if h > 0.0 else -1.0
     while j < t_eval.shape[0] and (t_eval[j] - t_new) * direction <= 0.0:
         qr, vr = ws.q_new, ws.v_new           # a value equal to the step end: the end state
+        W = ws.w_new[0]
         if t_eval[j] != t_new:
             if not built:
                 status = method.dense(kern, q, v, t, h, p, ws)
                 counters[3] += method.DENSE_EVALS
                 if status != OK:
-                    _stop(out_last, counters, t, q, v, since, err, extra, h)
+                    _stop(out_last, counters, t, q, v, ws.w[0], since, err, extra, h)
                     return status, rows, j, since
                 built = True
             method.interpolate(ws, t_eval[j], ws.q_int, ws.v_int)
             qr, vr = ws.q_int, ws.v_int
-        if not _save_row(kern, rows, t_eval[j], qr, vr, p, since, err, out_t, out_q, out_v,
+            W = _work_at(method, kern, ws, t_eval[j])
+        if not _save_row(kern, rows, t_eval[j], qr, vr, W, p, since, err, out_t, out_q, out_v,
                          out_stats, extra, out_extra):
-            _stop(out_last, counters, t_eval[j], qr, vr, since, err, extra, h)
+            _stop(out_last, counters, t_eval[j], qr, vr, W, since, err, extra, h)
             return NON_FINITE, rows, j, since
         rows += 1
         since = 0.0
@@ -238,24 +258,26 @@ def _terminal(method, kern, ws, ew, q, v, t, h, err, p, t_eval, j, rows, since, 
     the dense output), then the call ends there (out_last = the event state). Returns
     (status, rows)."""
     t_stop = ew.stop[0]
+    W_stop = _work_at(method, kern, ws, t_stop)
     direction = 1.0 if h > 0.0 else -1.0
     if t_eval.shape[0] == 0:
-        if not _save_row(kern, rows, t_stop, ew.q, ew.v, p, since, err, out_t, out_q, out_v,
-                         out_stats, extra, out_extra):
-            _stop(out_last, counters, t_stop, ew.q, ew.v, since, err, extra, h)
+        if not _save_row(kern, rows, t_stop, ew.q, ew.v, W_stop, p, since, err, out_t, out_q,
+                         out_v, out_stats, extra, out_extra):
+            _stop(out_last, counters, t_stop, ew.q, ew.v, W_stop, since, err, extra, h)
             return NON_FINITE, rows
         rows += 1
         since = 0.0
     while j < t_eval.shape[0] and (t_eval[j] - t_stop) * direction <= 0.0:
         method.interpolate(ws, t_eval[j], ws.q_int, ws.v_int)
-        if not _save_row(kern, rows, t_eval[j], ws.q_int, ws.v_int, p, since, err, out_t,
+        W = _work_at(method, kern, ws, t_eval[j])
+        if not _save_row(kern, rows, t_eval[j], ws.q_int, ws.v_int, W, p, since, err, out_t,
                          out_q, out_v, out_stats, extra, out_extra):
-            _stop(out_last, counters, t_eval[j], ws.q_int, ws.v_int, since, err, extra, h)
+            _stop(out_last, counters, t_eval[j], ws.q_int, ws.v_int, W, since, err, extra, h)
             return NON_FINITE, rows
         rows += 1
         since = 0.0
         j += 1
-    _stop(out_last, counters, t_stop, ew.q, ew.v, since, err, extra, h)
+    _stop(out_last, counters, t_stop, ew.q, ew.v, W_stop, since, err, extra, h)
     return OK, rows
 
 
@@ -270,16 +292,18 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     if n != kern.N_COORDS or v0.shape[0] != n:      # (the steps loop to N_COORDS: options.py)
         raise ValueError("run_<method>: q0 and v0 need N_COORDS entries (the model's "
                          "coordinates)")
-    if (out_extra.shape[1] != n_saved or out_last.shape[0] != layout.work_at(n, n_saved)
-            or size < 2):
+    if (out_extra.shape[1] != n_saved
+            or out_last.shape[0] - layout.work_at(n, n_saved) not in (0, 1) or size < 2):
         raise ValueError("run_<method>: out_extra needs n_saved columns, out_last 2 n + 3 + "
-                         "n_saved entries and the outputs at least 2 rows")
+                         "n_saved entries (one more for W) and the outputs at least 2 rows")
     q = q0.copy()
     v = v0.copy()
     ws = method.workspace(kern, n)
     extra = np.zeros(n_saved)
     for k in range(n_saved):
         extra[k] = out_extra[0, k]
+    # W, the work since t0, continues from row 0 of out_stats (a run in chunks)
+    ws.w[0] = out_stats[0, STAT_WORK] if kern.WORK else 0.0
     status = check_state(q, v, settings.blowup_bound)
     if status == OK:
         status = method.prepare(kern, q, v, t0, p, settings, ws)
@@ -287,10 +311,11 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     if status == OK:             # a switching right-hand side classifies the start state
         status = method.apply_switch(kern, ws, q, v, t0, p, settings, extra)
     write_last(out_last, t0, q, v, 0.0, 0.0, extra)
+    write_work(out_last, n, n_saved, ws.w[0])
     if status != OK:
         return status, 0, 0
-    if not _save_row(kern, 0, t0, q, v, p, 0.0, 0.0, out_t, out_q, out_v, out_stats, extra,
-                     out_extra):
+    if not _save_row(kern, 0, t0, q, v, ws.w[0], p, 0.0, 0.0, out_t, out_q, out_v, out_stats,
+                     extra, out_extra):
         return NON_FINITE, 0, 0
     status, h = _first_step(method, kern, q, v, t0, t_end, p, settings, ws, counters)
     if status != OK:
@@ -305,7 +330,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
     attempts, rejected, nonfinite_retry = 0, False, False
     while t != t_end:
         if attempts >= settings.max_steps or 0.1 * abs(h) <= abs(t) * UROUND:
-            _stop(out_last, counters, t, q, v, since, err_last, extra, h)
+            _stop(out_last, counters, t, q, v, ws.w[0], since, err_last, extra, h)
             if attempts >= settings.max_steps:
                 return TOO_MANY_STEPS, rows, n_events
             return (NON_FINITE if nonfinite_retry else STEP_TOO_SMALL), rows, n_events
@@ -315,7 +340,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
         if not rejected:          # first attempt of a step: does its output fit?
             fits, h_room = _room(t_eval, j, t, h, rows, size, method.ROWS_PER_STEP)
             if not fits:
-                _stop(out_last, counters, t, q, v, since, err_last, extra, h)
+                _stop(out_last, counters, t, q, v, ws.w[0], since, err_last, extra, h)
                 return OK, rows, n_events
             last = last and h_room == h
             h = h_room
@@ -323,7 +348,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
         attempts += 1
         counters[3] += method.STAGE_EVALS
         if status != OK:
-            _stop(out_last, counters, t, q, v, since, err_last, extra, h)
+            _stop(out_last, counters, t, q, v, ws.w[0], since, err_last, extra, h)
             return status, rows, n_events
         if not err <= 1.0:
             counters[2] += 1
@@ -337,7 +362,8 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
         if status == OK:
             status = check_state(ws.q_new, ws.v_new, settings.blowup_bound)
         if status != OK:
-            _stop(out_last, counters, t_new, ws.q_new, ws.v_new, since, err, extra, h)
+            _stop(out_last, counters, t_new, ws.q_new, ws.v_new, ws.w_new[0], since, err,
+                  extra, h)
             return status, rows, n_events
         counters[1] += 1
         since += 1.0
@@ -347,7 +373,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
         status, switched, t_new = method.switch_point(kern, ws, q, v, t, h, t_new, p, extra,
                                                       counters)
         if status != OK:
-            _stop(out_last, counters, t, q, v, since, err, extra, h)
+            _stop(out_last, counters, t, q, v, ws.w[0], since, err, extra, h)
             return status, rows, n_events
         if n_event_fns > 0:
             if events.crossed(kern, ew, ws.q_new, ws.v_new, t_new, p):
@@ -355,7 +381,7 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
                     status = method.dense(kern, q, v, t, h, p, ws)
                     counters[3] += method.DENSE_EVALS
                 if status != OK:
-                    _stop(out_last, counters, t, q, v, since, err, extra, h)
+                    _stop(out_last, counters, t, q, v, ws.w[0], since, err, extra, h)
                     return status, rows, n_events
                 n_events, stopped = events.locate(method, ws, kern, ew, p, t, t_new,
                                                   out_events, n_events)
@@ -378,14 +404,14 @@ def run_adaptive(method, kern, n_saved, n_event_fns, q0, v0, t0, t_end, p, setti
             status = method.apply_switch(kern, ws, q, v, t, p, settings, extra)
             counters[3] += 1
             if status != OK:
-                _stop(out_last, counters, t, q, v, since, err, extra, h)
+                _stop(out_last, counters, t, q, v, ws.w[0], since, err, extra, h)
                 return status, rows, n_events
             if t_eval.shape[0] == 0 and rows < size:
-                if not _save_row(kern, rows, t, q, v, p, since, err, out_t, out_q, out_v,
-                                 out_stats, extra, out_extra):
-                    _stop(out_last, counters, t, q, v, since, err, extra, h)
+                if not _save_row(kern, rows, t, q, v, ws.w[0], p, since, err, out_t, out_q,
+                                 out_v, out_stats, extra, out_extra):
+                    _stop(out_last, counters, t, q, v, ws.w[0], since, err, extra, h)
                     return NON_FINITE, rows, n_events
                 rows += 1
                 since = 0.0
-    _stop(out_last, counters, t, q, v, since, err_last, extra, h)
+    _stop(out_last, counters, t, q, v, ws.w[0], since, err_last, extra, h)
     return OK, rows, n_events

@@ -17,6 +17,13 @@ explicit_rk's tableau-driven core. The coefficients are the published ones (Hair
 also in scipy.integrate's dop853_coefficients.py), indexed as there: K[0..11] the stages,
 K[12] = f(t + h, y_new), K[13..15] the dense-output stages.
 
+The work W (steppers/core/work.py: E - E0 - W = 0 along a motion) on a model with kern.WORK:
+the ODE is augmented with W' = P(q, v, t), the generated ``power`` kernel at every stage (the
+stage states recomputed from the stages, P_j into pk), so W is stepped by the same tableau
+(order 8), its error estimate joins the error norm (N = 2n + 1 components, W the last) and its
+dense output is the same interpolant (P at the three dense stages). W does not feed back into
+q, v. On a model without WORK none of it runs (no power call, N = 2n).
+
 The adaptive loop (adaptive.run_adaptive) calls the functions below; their contract is in its
 module docstring. Not symplectic, not symmetric: energy drifts with the error tolerance.
 
@@ -168,8 +175,12 @@ class Settings(NamedTuple):
 #: a(q, v, t) from the end of the previous step), stage position qs, the trial state q_new,
 #: v_new, an interpolated state q_int, v_int, H; the dense output of the last accepted step:
 #: coefficients dense_q, dense_v (7, n), its start q_old, v_old and span = [t_old, h].
+#: The work W as a one-component half of the state (module docstring): the stage powers pk
+#: (16, 1) (row 0 carries P(q, v, t) like ka), W at the current state w, at the trial state
+#: w_new, at the dense output's start w_old (1,), its coefficients dense_w (7, 1); pw
+#: (2n + 2,) the power kernel's output.
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v "
-                                    "q_old v_old span")
+                                    "q_old v_old span pk w w_new w_old dense_w pw")
 
 
 @njit
@@ -177,7 +188,16 @@ def workspace(kern, n):
     """Allocated once per run by adaptive.run_adaptive."""
     return Workspace(np.zeros((N_DENSE, n)), np.zeros((N_DENSE, n)), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)),
-                     np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2))
+                     np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2),
+                     *work_fields(n))
+
+
+@njit
+def work_fields(n):
+    """The work's fields of the workspace, in its order: pk (16, 1), w, w_new, w_old (1,),
+    dense_w (7, 1), pw (2n + 2,) (what dop853_impacts' workspace holds too)."""
+    return (np.zeros((N_DENSE, 1)), np.zeros(1), np.zeros(1), np.zeros(1), np.zeros((7, 1)),
+            np.zeros(2 * n + 2))
 
 
 @njit(**FAST)
@@ -189,8 +209,25 @@ def stage_acceleration(kern, ctx, q, v, t, a):
 
 @njit(**FAST)
 def prepare(kern, q, v, t, p, settings, ws):
-    """The first stage of the first step, ka[0] = a(q, v, t); OK or SINGULAR_MASS."""
+    """The first stage of the first step, ka[0] = a(q, v, t) (and pk[0]: start_work); OK or
+    SINGULAR_MASS."""
+    start_work(kern, q, v, t, p, ws)
     return accel(kern, q, v, t, p, ws.H, ws.ka[0])
+
+
+@njit(inline="always")
+def _power(kern, ws, q, v, t, p):
+    """P(q, v, t) (generated power kernel; its derivatives, also written, are not used)."""
+    kern.power(q, v, t, p, ws.pw)
+    return ws.pw[0]
+
+
+@njit(**FAST)
+def start_work(kern, q, v, t, p, ws):
+    """The work's first stage pk[0] = P(q, v, t) at the state a step starts from (a model
+    with kern.WORK; nothing otherwise)."""
+    if kern.WORK:
+        ws.pk[0, 0] = _power(kern, ws, q, v, t, p)
 
 
 @njit(**FAST)
@@ -253,17 +290,18 @@ def _error_sums(K, i, y_old, y_new, atol, rtol):
 
 @njit(**FAST)
 def attempt(kern, q, v, t, h, p, settings, ws):
-    """One trial step of size h from (q, v) at t (ka[0] = a(q, v, t)) into ws.q_new, ws.v_new.
-    Returns (status, err): err the scaled error norm (accept when err <= 1; NaN when the trial
-    went non-finite); status OK or the stage acceleration's failure. STAGE_EVALS evaluations."""
-    return attempt_on(_THIS, kern, (p, ws.H), q, v, t, h, settings, ws)
+    """One trial step of size h from (q, v) at t (ka[0] = a(q, v, t)) into ws.q_new, ws.v_new
+    (and W into ws.w_new on a model with WORK). Returns (status, err): err the scaled error
+    norm (accept when err <= 1; NaN when the trial went non-finite); status OK or the stage
+    acceleration's failure. STAGE_EVALS evaluations (and as many power kernel calls)."""
+    return attempt_on(_THIS, kern, (p, ws.H), p, q, v, t, h, settings, ws)
 
 
 @njit(**FAST)
-def attempt_on(source, kern, ctx, q, v, t, h, settings, ws):
+def attempt_on(source, kern, ctx, p, q, v, t, h, settings, ws):
     """attempt with the accelerations of ``source.stage_acceleration(kern, ctx, ...)``
     (explicit_rk's contract): what a method stepping another right-hand side with this
-    tableau (dop853_impacts) calls."""
+    tableau (dop853_impacts) calls. p: the parameters (the power kernel's)."""
     status = rk_step(source, kern, ctx, A, B, C, q, v, t, h, ws.kv, ws.ka, ws.qs,
                      ws.q_new, ws.v_new, True)
     if status != OK:
@@ -276,24 +314,64 @@ def attempt_on(source, kern, ctx, q, v, t, h, settings, ws):
         b5, b3 = _error_sums(ws.ka, i, v, ws.v_new, settings.atol, settings.rtol)
         s5 += a5 + b5
         s3 += a3 + b3
+    components = 2 * n
+    if kern.WORK:
+        _work_stages(kern, q, v, t, h, p, ws)
+        w5, w3 = _error_sums(ws.pk, 0, ws.w, ws.w_new, settings.atol, settings.rtol)
+        s5 += w5
+        s3 += w3
+        components += 1
     deno = s5 + 0.01 * s3
     if deno <= 0.0:
         deno = 1.0
-    return OK, abs(h) * s5 / math.sqrt(2 * n * deno)
+    return OK, abs(h) * s5 / math.sqrt(components * deno)
+
+
+@njit(**FAST)
+def _work_stages(kern, q, v, t, h, p, ws):
+    """The stage powers pk[1..11] at the stage states of the trial step (recomputed from its
+    stages kv, ka as rk_step made them) and W at its end, ws.w_new = w + h sum_j b_j P_j."""
+    n = kern.N_COORDS
+    for i in range(1, N_STAGES):
+        stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, n)
+        ws.pk[i, 0] = _power(kern, ws, ws.qs, ws.kv[i], t + C[i] * h, p)
+    ws.w_new[0] = ws.w[0] + stage_integral(ws.pk, h)
+
+
+@njit(**FAST)
+def stage_integral(K, h):
+    """h sum_j b_j K[j, 0]: the integral over a step of size h of a scalar rate whose stage
+    values are K (16, 1) (K[0..11]), as the tableau steps it (order 8)."""
+    s = 0.0
+    for j in range(N_STAGES):
+        s += B[j] * K[j, 0]
+    return h * s
+
+
+@njit(**FAST)
+def dense_integral(K, h, x, F, ends):
+    """The integral of that rate from the step's start to x h, 0 <= x <= 1, from the dense
+    output (K[12..15] too: the FSAL and dense stages); F (7, 1), ends (2,) scratch."""
+    ends[0] = 0.0
+    ends[1] = stage_integral(K, h)
+    _coefficients(K, ends[0:1], ends[1:2], h, F)
+    return _interpolant(F, ends[0:1], 0, x)
 
 
 @njit(**FAST)
 def accept(kern, t_new, p, ws):
-    """After an accepted trial: the FSAL stage K[12] = f(t_new, y_new) (kv[12], ka[12]).
-    ACCEPT_EVALS evaluations; OK or SINGULAR_MASS."""
-    return accept_on(_THIS, kern, (p, ws.H), t_new, ws)
+    """After an accepted trial: the FSAL stage K[12] = f(t_new, y_new) (kv[12], ka[12]; pk[12]
+    with WORK). ACCEPT_EVALS evaluations; OK or SINGULAR_MASS."""
+    return accept_on(_THIS, kern, (p, ws.H), p, t_new, ws)
 
 
 @njit(**FAST)
-def accept_on(source, kern, ctx, t_new, ws):
+def accept_on(source, kern, ctx, p, t_new, ws):
     """accept with the accelerations of ``source`` (see attempt_on)."""
     for i in range(ws.v_new.shape[0]):
         ws.kv[N_STAGES, i] = ws.v_new[i]
+    if kern.WORK:
+        ws.pk[N_STAGES, 0] = _power(kern, ws, ws.q_new, ws.v_new, t_new, p)
     return source.stage_acceleration(kern, ctx, ws.q_new, ws.v_new, t_new, ws.ka[N_STAGES])
 
 
@@ -316,21 +394,27 @@ def _coefficients(K, y_old, y_new, h, F):
 @njit(**FAST)
 def dense(kern, q, v, t, h, p, ws):
     """Build the 7th-order interpolant of the accepted step (q, v) at t -> (q_new, v_new) at
-    t + h: the stages K[13..15], then the coefficients, the start state and span into ws. Call
-    after accept, before advance. DENSE_EVALS evaluations; OK or SINGULAR_MASS."""
-    return dense_on(_THIS, kern, (p, ws.H), q, v, t, h, ws)
+    t + h: the stages K[13..15], then the coefficients, the start state and span into ws (and
+    W's with WORK). Call after accept, before advance. DENSE_EVALS evaluations; OK or
+    SINGULAR_MASS."""
+    return dense_on(_THIS, kern, (p, ws.H), p, q, v, t, h, ws)
 
 
 @njit(**FAST)
-def dense_on(source, kern, ctx, q, v, t, h, ws):
+def dense_on(source, kern, ctx, p, q, v, t, h, ws):
     """dense with the accelerations of ``source`` (see attempt_on)."""
     for i in range(N_STAGES + 1, N_DENSE):
         stage_state(A, i, q, v, h, ws.kv, ws.ka, ws.qs, kern.N_COORDS)
         status = source.stage_acceleration(kern, ctx, ws.qs, ws.kv[i], t + C[i] * h, ws.ka[i])
         if status != OK:
             return status
+        if kern.WORK:
+            ws.pk[i, 0] = _power(kern, ws, ws.qs, ws.kv[i], t + C[i] * h, p)
     _coefficients(ws.kv, q, ws.q_new, h, ws.dense_q)
     _coefficients(ws.ka, v, ws.v_new, h, ws.dense_v)
+    if kern.WORK:
+        _coefficients(ws.pk, ws.w, ws.w_new, h, ws.dense_w)
+        ws.w_old[0] = ws.w[0]
     for i in range(q.shape[0]):
         ws.q_old[i] = q[i]
         ws.v_old[i] = v[i]
@@ -344,29 +428,42 @@ def interpolate(ws, t, q_out, v_out):
     """The dense output of the last step ``dense`` was built for, at t in [t_old, t_old + h]:
     q_out, v_out (n,). Accurate to order 7 in h (the step values themselves are order 8)."""
     x = (t - ws.span[0]) / ws.span[1]
+    for i in range(ws.q_old.shape[0]):
+        q_out[i] = _interpolant(ws.dense_q, ws.q_old, i, x)
+        v_out[i] = _interpolant(ws.dense_v, ws.v_old, i, x)
+
+
+@njit(inline="always")
+def _interpolant(F, y0, i, x):
+    """Component i of the dense output y0 + x (F0 + (1 - x) (F1 + x (F2 + ...))) at the step
+    fraction x (F (7, N) the coefficients, y0 (N,) the step's start)."""
     y = 1.0 - x
-    for half in range(2):
-        F = ws.dense_q if half == 0 else ws.dense_v
-        y0 = ws.q_old if half == 0 else ws.v_old
-        out = q_out if half == 0 else v_out
-        for i in range(y0.shape[0]):
-            r = F[6, i] * x
-            r = (r + F[5, i]) * y
-            r = (r + F[4, i]) * x
-            r = (r + F[3, i]) * y
-            r = (r + F[2, i]) * x
-            r = (r + F[1, i]) * y
-            r = (r + F[0, i]) * x
-            out[i] = y0[i] + r
+    r = F[6, i] * x
+    r = (r + F[5, i]) * y
+    r = (r + F[4, i]) * x
+    r = (r + F[3, i]) * y
+    r = (r + F[2, i]) * x
+    r = (r + F[1, i]) * y
+    r = (r + F[0, i]) * x
+    return y0[i] + r
+
+
+@njit(**FAST)
+def interpolate_work(ws, t):
+    """W at t from the dense output ``dense`` built (a model with WORK; order 7 like q, v)."""
+    return _interpolant(ws.dense_w, ws.w_old, 0, (t - ws.span[0]) / ws.span[1])
 
 
 @njit(**FAST)
 def advance(q, v, ws):
-    """Make the accepted trial the current state: q, v <- q_new, v_new; ka[0] <- ka[12]."""
+    """Make the accepted trial the current state: q, v <- q_new, v_new; ka[0] <- ka[12]; the
+    same for the work: w <- w_new, pk[0] <- pk[12]."""
     for i in range(q.shape[0]):
         q[i] = ws.q_new[i]
         v[i] = ws.v_new[i]
         ws.ka[0, i] = ws.ka[N_STAGES, i]
+    ws.w[0] = ws.w_new[0]
+    ws.pk[0, 0] = ws.pk[N_STAGES, 0]
 
 
 #: Rows one accepted step may output in every-step mode (adaptive.run_adaptive's room check).
@@ -397,4 +494,4 @@ SPEC = Spec(
     settings=Settings,
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False)},
-    kernels=("forward_dynamics",))
+    kernels=("forward_dynamics", "power"))

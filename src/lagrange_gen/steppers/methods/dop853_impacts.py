@@ -39,12 +39,13 @@ Reported (SPEC.saved, c = kern.N_CONTACTS), cumulative since t0 except the modes
 (1) the impacts so far, ``normal_impulse_sum``, ``tangent_impulse_sum`` (c) the impulses of
 the impacts and projections summed per contact, ``contact_mode`` (c) FREE 0, STICK 1,
 SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, ``contact_work`` (1) the work of the impulses,
-r . (u- + u+) / 2, plus that of the persistent contacts' forces, lambda . (W v) integrated by
-the trapezoid rule over each step (exact for a constant force on a slip velocity linear in t:
-the block on a ramp). E - E0 - contact_work is then the balance for conservative forces. Row 0
+r . (u- + u+) / 2, plus that of the persistent contacts' forces, their power lambda . (W v)
+integrated like W (dop853.py): its values at the stages, the tableau's sum over a step and the
+dense output's integral over a step that ends at a switch (order 8, 7). E - E0 - contact_work is then the balance for conservative forces;
+forces that do work (kern.WORK) add W, which dop853's functions step with the state (W' = P at
+the stages, see dop853.py) and which a switch leaves as it is: E - E0 - W - contact_work. Row 0
 is the state after the start's classification (an impact at t0 is in the impulse sums); the
-work counts from it. In
-every-step mode a switch writes two rows at its time: before and after (diff the sums for an
+work counts from it. In every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
 
 A run continued in chunks reclassifies the contacts at each chunk's start; the Zeno guard's
@@ -100,7 +101,7 @@ class Settings(NamedTuple):
     max_sweeps: int = 1000          # cap on the Gauss-Seidel sweeps of one contact problem
 
 
-#: dop853's fields (its functions read them by name), then, c contacts: M (n, n) the mass
+#: dop853's fields (its functions read them by name, the work's included), then, c contacts: M (n, n) the mass
 #: matrix (LU-factored), f (n,) rhs, s (n,) scratch, piv (n,) pivots, acc (n,) scratch
 #: acceleration; g (c,), WN, WT (c, n), coef (c, 2) = (e, mu), rate (2c,) = Wdot v; r (2c,)
 #: forces or impulses, uf (2c,) free local velocities/accelerations, zero (c,) zeros, un (c,)
@@ -109,13 +110,16 @@ class Settings(NamedTuple):
 #: coef_impact (c, 2); last_impact (c,) times; Y (2c, n), D (2c, 2c) (contact_problem);
 #: switch values at the step's start and end and at trial times sw_prev, sw_new (2c,) with
 #: the events workspace sw (refine's); power (2,) = [at the last evaluation, at the step's
-#: start]; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
+#: start]; contact_stages (16, 1) that power at the stages of the step, stage_at (1,) the
+#: stage the next stage_acceleration evaluates, quad_F (7, 1), quad_ends (2,) scratch of its
+#: dense integral; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
 #: switching functions, and 1 while the start state is not classified yet; left_at (c,) the time a free contact was last touching (-inf: not
 #: since the step it cleared gap_tol).
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
-                                    "v_old span M f s piv acc g WN WT coef rate r uf zero un "
+                                    "v_old span pk w w_new w_old dense_w pw M f s piv acc g WN WT coef rate r uf zero un "
                                     "mode law impact_law persistent touching coef_impact "
-                                    "last_impact Y D sw power solver left_at")
+                                    "last_impact Y D sw power contact_stages stage_at quad_F "
+                                    "quad_ends solver left_at")
 
 
 @njit
@@ -128,12 +132,13 @@ def workspace(kern, n):
     return Workspace(np.zeros((nd, n)), np.zeros((nd, n)), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)),
                      np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2),
-                     np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
+                     *dop853.work_fields(n), np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
                      np.zeros(n), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
                      np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
                      np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
                      np.zeros(2 * c, np.int64), np.zeros(c), np.zeros(c), np.zeros((c, 2)),
                      np.full(c, -np.inf), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)), sw,
+                     np.zeros(2), np.zeros((nd, 1)), np.zeros(1, np.int64), np.zeros((7, 1)),
                      np.zeros(2), np.zeros(4), np.full(c, -np.inf))
 
 
@@ -200,9 +205,15 @@ def contact_acceleration(kern, ws, q, v, t, p, a):
 
 @njit(**FAST)
 def stage_acceleration(kern, ctx, q, v, t, a):
-    """explicit_rk's callback: contact_acceleration; ctx = (p, ws)."""
+    """explicit_rk's callback: contact_acceleration; ctx = (p, ws). Records the persistent
+    forces' power there as stage ws.stage_at of the step (attempt, accept, dense set it)."""
     p, ws = ctx
-    return contact_acceleration(kern, ws, q, v, t, p, a)
+    status = contact_acceleration(kern, ws, q, v, t, p, a)
+    k = ws.stage_at[0]
+    if k < dop853.N_DENSE:
+        ws.contact_stages[k, 0] = ws.power[0]
+        ws.stage_at[0] = k + 1
+    return status
 
 
 @njit(**FAST)
@@ -250,6 +261,7 @@ def prepare(kern, q, v, t, p, settings, ws):
     for a in range(kern.N_CONTACTS):
         ws.mode[a] = FREE
         ws.persistent[a] = 0.0
+    dop853.start_work(kern, q, v, t, p, ws)
     return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
 
 
@@ -263,22 +275,26 @@ def initial_step(kern, q, v, t, direction, p, settings, ws):
 @njit(**FAST)
 def attempt(kern, q, v, t, h, p, settings, ws):
     """dop853's trial step on the contact acceleration (dop853.attempt_on)."""
-    return dop853.attempt_on(_THIS, kern, (p, ws), q, v, t, h, settings, ws)
+    ws.stage_at[0] = 1
+    return dop853.attempt_on(_THIS, kern, (p, ws), p, q, v, t, h, settings, ws)
 
 
 @njit(**FAST)
 def accept(kern, t_new, p, ws):
     """dop853.accept_on: the FSAL stage on the contact acceleration."""
-    return dop853.accept_on(_THIS, kern, (p, ws), t_new, ws)
+    ws.stage_at[0] = dop853.N_STAGES
+    return dop853.accept_on(_THIS, kern, (p, ws), p, t_new, ws)
 
 
 @njit(**FAST)
 def dense(kern, q, v, t, h, p, ws):
     """dop853.dense_on: the dense output on the contact acceleration."""
-    return dop853.dense_on(_THIS, kern, (p, ws), q, v, t, h, ws)
+    ws.stage_at[0] = dop853.N_STAGES + 1
+    return dop853.dense_on(_THIS, kern, (p, ws), p, q, v, t, h, ws)
 
 
 interpolate = dop853.interpolate
+interpolate_work = dop853.interpolate_work
 advance = dop853.advance
 
 
@@ -292,10 +308,11 @@ def _work_at(c):
 def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
     """After an accepted step from (q, v) at t to (ws.q_new, ws.v_new) at t_new: the switching
     functions there; on a crossing, the dense output, the earliest crossing time t* (refined)
-    and the state there into ws.q_new, ws.v_new. Adds the persistent forces' work over
-    [t, t_end of the step] to extra. Returns (status, switched, step end)."""
+    and the state there into ws.q_new, ws.v_new (and W into ws.w_new). Adds the persistent
+    forces' work over [t, t_end of the step] to extra (from their power at the stages). Returns (status, switched, step end)."""
     c = kern.N_CONTACTS
     sw = ws.sw
+    ws.contact_stages[0, 0] = ws.power[1]
     status = event_values(kern, ws, ws.q_new, ws.v_new, t_new, p, sw.g_new)
     if status != OK:
         return status, False, t_new
@@ -304,7 +321,7 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
         if events.crossing(sw.g_prev[k], sw.g_new[k], -1) != 0:
             crossed = True
     if not crossed:
-        extra[_work_at(c)] += 0.5 * (t_new - t) * (ws.power[1] + ws.power[0])
+        extra[_work_at(c)] += dop853.stage_integral(ws.contact_stages, h)
         ws.power[1] = ws.power[0]
         for k in range(2 * c):
             sw.g_prev[k] = sw.g_new[k]
@@ -327,7 +344,10 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
     status, t_star = _past_crossing(kern, ws, p, t, t_new, first, t_star)
     if status != OK:
         return status, False, t_new
-    extra[_work_at(c)] += 0.5 * (t_star - t) * (ws.power[1] + ws.power[0])
+    if kern.WORK:                    # the step ends at t_star: W there from the dense output
+        ws.w_new[0] = dop853.interpolate_work(ws, t_star)
+    extra[_work_at(c)] += dop853.dense_integral(ws.contact_stages, h, (t_star - t) / h,
+                                                 ws.quad_F, ws.quad_ends)
     return status, True, t_star
 
 
@@ -488,6 +508,7 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     ws.power[1] = ws.power[0]
     if status != OK:
         return status
+    dop853.start_work(kern, q, v, t, p, ws)      # P at the velocities after the impulses
     return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
 
 
@@ -507,4 +528,4 @@ SPEC = Spec(
             "zeno_interval": (0.0, True, False), "gap_tol": (0.0, True, False),
             "rest_velocity": (0.0, True, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
-    kernels=("contacts", "contact_rates", "dynamics", "forward_dynamics"))
+    kernels=("contacts", "contact_rates", "dynamics", "forward_dynamics", "power"))
