@@ -122,9 +122,10 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
         k = min(size, task.n_steps - done)
         rows = slice(row, row + k // task.save_every + 1)
         # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
-        # Newton statistics, which belong to the steps before it.
+        # Newton statistics and saved fields, which belong to the steps before it (the method's
+        # prepare may write the saved fields of its initial state there, e.g. multipliers).
         kept = out["stats"][row].copy()
-        kept_extra = out["extra"][row].copy() if tier == "interpreted" else None
+        kept_extra = out["extra"][row].copy()
         found = min(out["n_events"], out["events"].shape[0])
         began = time.perf_counter()
         result = run(
@@ -145,6 +146,7 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
         out["n_events"] += n_events
         if row > 0:
             out["stats"][row, STAT_ITERS:] = kept[STAT_ITERS:]
+            out["extra"][row] = kept_extra
         if code != st.OK:
             raise_for_status(code, m, task.method, done + steps + 1, task.n_steps, last,
                              task.max_iter, h, task.p)
