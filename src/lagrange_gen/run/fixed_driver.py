@@ -221,7 +221,8 @@ def _compile_after_interpreted(task, args, label, done):
     seconds for the next choice (first_run.record_compile_seconds). Returns (glue, seconds,
     the tier now running); task.ran says what ran."""
     cpu, count, first = time.process_time(), compiles(), args()
-    run, seconds = warm_up(lambda: task.glue(first), first, label)
+    run, seconds = warm_up(lambda: task.glue(first), first,
+                           f"{label} after {done} interpreted steps")
     if task.ran == "portable" and compiles() > count:
         first_run.record_compile_seconds(task.method, time.process_time() - cpu)
     remember_glue(task, run)
