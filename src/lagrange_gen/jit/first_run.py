@@ -118,7 +118,7 @@ def _stale(lock: Path) -> bool:
         pid = int(lock.read_text().strip() or 0)
     except (OSError, ValueError):
         return False           # being written right now: not stale
-    if pid <= 0:
+    if pid <= 0 or os.name == "nt":      # (Windows' os.kill would end the process): age only
         return False
     try:
         os.kill(pid, 0)
@@ -208,7 +208,7 @@ def main(argv) -> int:
     try:
         try:
             os.nice(10)
-        except OSError:
+        except (AttributeError, OSError):      # no os.nice (Windows), or not allowed
             pass
         compile_for_next_time(method, name, path)
     finally:
