@@ -110,7 +110,8 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
     """The chunk loop of integrate_fixed (args(): the arguments of a warm-up call); returns
     (steps done, last row, seconds spent compiling between chunks, compile seconds). An
     interpreted run (task.ran "interpreted") goes on compiled once it is worth it
-    (_after_interpreted_chunk), or when Python cannot run a chunk (then it runs again compiled)."""
+    (_worth_compiling) or once the cache holds its glue (the background compile finished), or
+    when Python cannot run a chunk (then that chunk runs again compiled)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     done, row, switch = 0, 0, 0.0
     tier = task.ran
