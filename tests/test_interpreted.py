@@ -58,6 +58,7 @@ def first_use(monkeypatch):
     monkeypatch.setattr(fixed_driver, "_INTERPRETED_S", {})
     monkeypatch.setattr(first_run, "expected_compile_seconds", lambda method: 1e9)
     monkeypatch.setenv(first_run.BACKGROUND_ENV, "0")
+    monkeypatch.setenv(first_run.INTERPRETED_ENV, "1")
 
 
 def _assert_close(a, b, rtol=1e-12):
@@ -139,6 +140,12 @@ def test_a_twin_calls_twins_and_keeps_the_code(generated):
     twin_table = interpreted.twin(table)
     assert type(twin_table) is type(table)
     assert twin_table.forward_dynamics.__code__ is table.forward_dynamics.dispatcher.py_func.__code__
+
+
+def test_the_interpreted_tier_can_be_turned_off(generated, first_use, monkeypatch):
+    monkeypatch.setenv(first_run.INTERPRETED_ENV, "0")
+    run = simulate(generated("double_pendulum"), "verlet", [0.3, 0.2], None, t_end=0.01, h=1e-3)
+    assert run.jit == "portable"
 
 
 def test_a_short_run_never_compiles_in_the_foreground(generated, first_use, monkeypatch):
@@ -248,7 +255,7 @@ def test_the_background_compile_fills_the_cache_for_the_next_process(tmp_path):
     without compiling, and it records its seconds and releases its lock."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"),
                LAGRANGE_GEN_PORTABLE_DIR=str(tmp_path / "portable"),
-               **{first_run.BACKGROUND_ENV: "0"})
+               **{first_run.BACKGROUND_ENV: "0", first_run.INTERPRETED_ENV: "1"})
     gen = tmp_path / "gen"
     path = generate_model(MODELS_DIR / "damped_oscillator.py", gen, methods=["explicit_euler"]).path
     child = ("import sys, json\n"

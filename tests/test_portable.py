@@ -103,8 +103,6 @@ def test_one_compile_serves_every_model(generated):
 
 def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypatch):
     mod = generated("double_pendulum")
-    # the portable glue compiled before (else the run would start interpreted: test_interpreted)
-    monkeypatch.setattr(portable, "portable_cached", lambda module, method: True)
     monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
     monkeypatch.setattr(fixed_run, "SPECIALIZE_AFTER_S", 0.0)
     monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
@@ -117,8 +115,6 @@ def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypa
 
 
 def test_auto_keeps_portable_on_a_short_run(generated, monkeypatch):
-    # the portable glue compiled before (else the run would start interpreted: test_interpreted)
-    monkeypatch.setattr(portable, "portable_cached", lambda module, method: True)
     monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
     monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
     monkeypatch.setattr(fixed_run, "_READY", {})     # no choice remembered from another test

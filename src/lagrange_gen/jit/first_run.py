@@ -15,7 +15,7 @@ the argument types simulate passes, and records its CPU seconds. One process per
 library version at a time: a lock file beside the portable glue (a stale lock, older than
 LOCK_STALE_S or of a process that is gone, is taken over). The next process then finds the glue
 in numba's cache (the warm path, unchanged). $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off
-(tests and CI do).
+(tests and CI do); $LAGRANGE_GEN_INTERPRETED=0 turns the interpreted tier off.
 """
 
 from __future__ import annotations
@@ -31,6 +31,13 @@ from pathlib import Path
 #: Environment variable that turns the background compile off ("0", "off", "no" or "false").
 BACKGROUND_ENV = "LAGRANGE_GEN_BACKGROUND_COMPILE"
 
+#: Environment variable that turns the interpreted tier off: a first run compiles in the
+#: foreground, as before it existed (the test suite does, so that which code ran does not depend
+#: on the order in which tests fill numba's cache; tests/test_interpreted.py turns it on).
+INTERPRETED_ENV = "LAGRANGE_GEN_INTERPRETED"
+
+_OFF = ("0", "off", "no", "false")
+
 #: CPU seconds a compile of a method's portable glue is expected to take before one was measured
 #: on this machine: the first use of the lighter methods (rk4) takes 4 to 5 s on a loaded
 #: two-core machine, the implicit ones 10 to 25 s.
@@ -45,7 +52,12 @@ ESTIMATES_FILE = "compile_seconds.json"
 
 def background_enabled() -> bool:
     """Whether a background compile may start ($LAGRANGE_GEN_BACKGROUND_COMPILE)."""
-    return os.environ.get(BACKGROUND_ENV, "1").strip().lower() not in ("0", "off", "no", "false")
+    return os.environ.get(BACKGROUND_ENV, "1").strip().lower() not in _OFF
+
+
+def interpreted_enabled() -> bool:
+    """Whether a first run may start interpreted ($LAGRANGE_GEN_INTERPRETED)."""
+    return os.environ.get(INTERPRETED_ENV, "1").strip().lower() not in _OFF
 
 
 def _estimates_path() -> Path:

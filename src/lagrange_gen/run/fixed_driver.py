@@ -190,7 +190,7 @@ def _interpreted_glue(task, args):
     has neither the specialized glue nor the portable glue of the method in memory or in its
     cache (a first use after an install, or after the library changed): compiling one takes
     seconds to tens of seconds, a short run interpreted a fraction of a second."""
-    if task.jit != "auto" or portable.unsupported() is not None:
+    if task.jit != "auto" or not first_run.interpreted_enabled() or portable.unsupported():
         return None
     if portable.specialized_ready(task.run, args) or portable.portable_cached(task.module,
                                                                              task.method):
