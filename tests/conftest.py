@@ -1,6 +1,7 @@
 """Shared fixtures: every model in models/ is generated once per session into a temp dir."""
 
 import json
+import os
 
 import pytest
 
@@ -9,6 +10,12 @@ from lagrange_gen.codegen import generate_model
 from lagrange_gen.derive import derive
 from lagrange_gen.run.loader import import_generated
 from lg_test_support import MODELS_DIR
+
+# A first run of a method compiles in the foreground and leaves no compile process behind
+# (lagrange_gen.jit.first_run): which code a test runs must not depend on the order in which
+# tests fill numba's cache. tests/test_interpreted.py turns both on where it tests them.
+os.environ.setdefault("LAGRANGE_GEN_BACKGROUND_COMPILE", "0")
+os.environ.setdefault("LAGRANGE_GEN_INTERPRETED", "0")
 
 def pytest_addoption(parser):
     """Options of the differential harness (tests/harness/conftest.py says what they do); here,

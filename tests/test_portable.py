@@ -161,8 +161,12 @@ def test_specialized_ready_remembers_a_miss_until_the_cache_index_changes(tmp_pa
     monkeypatch.setattr(portable, "_index_state", lambda cache: ("index", stamp[0]))
     for _ in range(3):
         assert not portable.specialized_ready(run, args)
-    assert len(probes) == 1
+    assert probes == []                      # no index file: no entry, numba is not asked
     stamp[0] = (1, 2)                        # the index was written
+    for _ in range(3):
+        assert not portable.specialized_ready(run, args)
+    assert len(probes) == 1
+    stamp[0] = (1, 3)                        # and written again
     assert not portable.specialized_ready(run, args)
     assert len(probes) == 2
     run(*args)                               # compiled (and saved) in this process

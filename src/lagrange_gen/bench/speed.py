@@ -253,8 +253,11 @@ def _cold_child(models_dir, stem, options, method, q0, out_dir, cache, jit="auto
     """Run _COLD_CHILD in a new process with NUMBA_CACHE_DIR=cache (numba's cache of the
     portable glue included: it lives there too) and LAGRANGE_GEN_PORTABLE_DIR=cache-portable
     (the portable glue's sources), and simulate(jit=jit); its timings (dict)."""
+    from ..jit.first_run import BACKGROUND_ENV
     from ..jit.portable import DIR_ENV
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), **{DIR_ENV: f"{cache}-portable"})
+    # no background compile (jit.first_run): it would load the machine under the next rows
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache),
+               **{DIR_ENV: f"{cache}-portable", BACKGROUND_ENV: "0"})
     done = subprocess.run([sys.executable, "-c", _COLD_CHILD, str(Path(models_dir) / f"{stem}.py"),
                            str(out_dir), method, json.dumps(options), json.dumps(q0), jit],
                           env=env, capture_output=True, text=True)
@@ -283,7 +286,9 @@ def measure_cold(models_dir, work):
         cold = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"gen{i}", cache)
         warm_cache = Path(work) / f"libcache{i}"
         warm_stem, warm_q0 = WARMUP_STEM.get(method, WARMUP_DEFAULT)
-        _cold_child(models_dir, warm_stem, {}, method, warm_q0, Path(work) / f"wgen{i}", warm_cache)
+        # (jit="portable": compiles the portable stepper, which "auto" would only interpret)
+        _cold_child(models_dir, warm_stem, {}, method, warm_q0, Path(work) / f"wgen{i}", warm_cache,
+                    jit="portable")
         lib = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"lgen{i}", warm_cache)
         own = _cold_child(models_dir, stem, options, method, q0, Path(work) / f"sgen{i}",
                           Path(work) / f"scache{i}", jit="specialized")

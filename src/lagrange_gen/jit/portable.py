@@ -223,25 +223,64 @@ def remove_unused_versions(current: Path) -> list:
     return removed
 
 
+def n_saved(module, method):
+    """The method's n_saved on ``module``'s model (SPEC.n_saved)."""
+    from ..steppers.core.registry import spec
+    return spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,
+                                getattr(module, "N_CONTACTS", 0),
+                                getattr(module, "N_NONHOLONOMIC", 0))
+
+
 def _bound(module, method, function):
     """``function`` of the portable glue of ``method`` with ``module``'s kernel table and the
     method's n_saved on that model (SPEC.n_saved) passed in front of the glue arguments."""
-    from ..steppers.core.registry import spec
     run, table = getattr(_glue_module(method), function), kernel_table(module, method)
-    n_saved = spec(method).n_saved(module.N_COORDS, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                                   getattr(module, "N_CONTACTS", 0),
-                                   getattr(module, "N_NONHOLONOMIC", 0))
+    saved = n_saved(module, method)
 
     def bound(*args):
-        return run(table, n_saved, *args)
+        return run(table, saved, *args)
 
     return bound
+
+
+def _run_name(module, method):
+    return f"run_{method}_events" if module.N_EVENTS else f"run_{method}"
 
 
 def runner(module, method):
     """A callable with the arguments of ``module.run_<method>`` (codegen.glue.GLUE_ARGS or
     ADAPTIVE_GLUE_ARGS) that runs the portable glue on ``module``'s kernels."""
-    return _bound(module, method, f"run_{method}_events" if module.N_EVENTS else f"run_{method}")
+    return _bound(module, method, _run_name(module, method))
+
+
+def glue_path(method) -> Path:
+    """The file of the portable glue of ``method`` for this library version (written if
+    missing)."""
+    return Path(_glue_module(method).__file__)
+
+
+def portable_cached(module, method) -> bool:
+    """Whether the portable glue that runs ``method`` on ``module`` is compiled in this process
+    or has entries in numba's cache for this library version (any entry: its kernel table's type
+    is the same for every model but the constants', so an entry is taken as a hit; a wrong guess
+    costs the compile it would have cost anyway)."""
+    glue = getattr(_glue_module(method), _run_name(module, method))
+    if glue.overloads:
+        return True
+    table_class(method)          # the index refers to the table's class: defined before it is read
+    try:
+        return bool(glue._cache._cache_file._load_index())
+    except Exception:      # numba's cache internals moved, or no cache: not known to be cached
+        return False
+
+
+def interpreted_runner(module, method):
+    """runner's interpreted twin (jit.interpreted): the portable glue's Python code on the
+    Python code of ``module``'s kernels, nothing compiled; it returns None instead of (status,
+    steps, n_events) where Python cannot go on (interpreted.PYTHON_ONLY_FAILURE)."""
+    from .interpreted import runner as python_runner
+    glue = getattr(_glue_module(method), _run_name(module, method))
+    return python_runner(glue, module, n_saved(module, method))
 
 
 @functools.lru_cache(maxsize=None)
@@ -350,6 +389,10 @@ def specialized_ready(dispatcher, args) -> bool:
         if cache is None:
             return False
         index = _index_state(cache)
+        if index is not None and index[1] is None:
+            # no index file, so no entry: numba's lookup would first set up its target (a
+            # second of imports, scipy's included) only to miss
+            return False
         if index is not None and _MISSES.get((index[0], sig), _UNSEEN) == index[1]:
             return False
         result = cache.load_overload(sig, dispatcher.targetctx)

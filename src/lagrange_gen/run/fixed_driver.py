@@ -15,7 +15,8 @@ import time
 import numpy as np
 
 from .failures import raise_for_status
-from ..jit.compile_notice import first_use_notice
+from ..jit import first_run, portable
+from ..jit.compile_notice import compiles, first_use_notice
 from ..steppers.core import status as st
 from ..steppers.core.layout import N_STATS, STAT_ITERS, events_size, last_size, read_last
 
@@ -30,6 +31,14 @@ CHUNK_STEPS = 200_000
 #: and its compile costs 10 to 20 s: below a minute of remaining work it cannot pay for itself,
 #: and on large models it may not pay at all (then it costs one compile in a run of minutes).
 SPECIALIZE_AFTER_S = 60.0
+
+#: Steps of a run's first interpreted chunk (jit/interpreted.py), whose time projects the run's
+#: interpreted time; later interpreted chunks double, up to CHUNK_STEPS.
+PROBE_STEPS = 20
+
+#: {method: seconds its runs spent interpreted in this process}: a program of many short runs
+#: compiles once their sum would pass the compile (_worth_compiling).
+_INTERPRETED_S: dict = {}
 
 #: Rows of located events kept per run (steppers/core/events.py); more are counted, not stored.
 EVENT_ROWS = 10_000
@@ -63,7 +72,9 @@ def integrate_fixed(task, q, v, out, progress):
     out["n_events"]. The glue is task.glue's choice (specialized or portable); a portable run
     under jit="auto" switches to the specialized glue between chunks once its projected
     remaining time passes SPECIALIZE_AFTER_S (task.ran records it). Returns (compile seconds,
-    integration seconds). Raises the exception of a failure status (failures.raise_for_status)."""
+    integration seconds). Under jit="auto" a first run of a method whose glue numba has compiled
+    nowhere yet starts interpreted (_interpreted_glue). Raises the exception of a failure
+    status (failures.raise_for_status)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     last = np.zeros(last_size(n, out["extra"].shape[1], with_work=True))
 
@@ -76,8 +87,10 @@ def integrate_fixed(task, q, v, out, progress):
     compile_time = 0.0
     if run is None:
         first = args()
-        run, compile_time = warm_up(lambda: task.glue(first), first, label)
-        remember_glue(task, run)
+        run = _interpreted_glue(task, first)
+        if run is None:
+            run, compile_time = warm_up(lambda: task.glue(first), first, label)
+            remember_glue(task, run)
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
@@ -95,23 +108,46 @@ def integrate_fixed(task, q, v, out, progress):
 
 def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_time):
     """The chunk loop of integrate_fixed (args(): the arguments of a warm-up call); returns
-    (steps done, last row, seconds spent switching to the specialized glue, compile seconds)."""
+    (steps done, last row, seconds spent compiling between chunks, compile seconds). An
+    interpreted run (task.ran "interpreted") goes on compiled once it is worth it
+    (_worth_compiling) or once the cache holds its glue (the background compile finished), or
+    when Python cannot run a chunk (then that chunk runs again compiled)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     done, row, switch = 0, 0, 0.0
+    tier = task.ran
+    # where the current tier began: (seconds since start, less switching; steps done)
+    since = (0.0, 0)
+    background = False
     while True:
-        k = min(chunk, task.n_steps - done)
+        size = _interpreted_chunk(done, task.save_every) if tier == "interpreted" else chunk
+        k = min(size, task.n_steps - done)
         rows = slice(row, row + k // task.save_every + 1)
         # Row `row` is the previous chunk's last save and this chunk's initial state: keep its
-        # Newton statistics, which belong to the steps before it.
+        # Newton statistics and saved fields, which belong to the steps before it (the method's
+        # prepare may write the saved fields of its initial state there, e.g. multipliers).
         kept = out["stats"][row].copy()
+        kept_extra = out["extra"][row].copy()
         found = min(out["n_events"], out["events"].shape[0])
-        code, steps, n_events = run(
+        began = time.perf_counter()
+        result = run(
             q, v, t0 + done * h, h, k, task.save_every, task.p, task.settings, out["t"][rows],
             out["q"][rows], out["v"][rows], out["stats"][rows], out["extra"][rows], last,
             out["events"][found:])
+        if tier == "interpreted":
+            _INTERPRETED_S[task.method] = (_INTERPRETED_S.get(task.method, 0.0)
+                                           + time.perf_counter() - began)
+            if result is None:      # Python cannot run these steps (jit.interpreted): compiled
+                out["stats"][row], out["extra"][row] = kept, kept_extra
+                run, seconds, tier = _compile_after_interpreted(task, args, label, done)
+                compile_time += seconds
+                switch += seconds
+                since = (time.perf_counter() - start - switch, done)
+                continue
+        code, steps, n_events = result
         out["n_events"] += n_events
         if row > 0:
             out["stats"][row, STAT_ITERS:] = kept[STAT_ITERS:]
+            out["extra"][row] = kept_extra
         if code != st.OK:
             raise_for_status(code, m, task.method, done + steps + 1, task.n_steps, last,
                              task.max_iter, h, task.p)
@@ -125,15 +161,75 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
         row += k // task.save_every
         if bar:
             bar.update(done)
+        elapsed = time.perf_counter() - start - switch - since[0]
+        if tier == "interpreted":
+            if done < task.n_steps and (portable.portable_cached(m, task.method) or _worth_compiling(
+                    task.method, elapsed, done - since[1], task.n_steps - done)):
+                run, seconds, tier = _compile_after_interpreted(task, args, label, done)
+                compile_time += seconds
+                switch += seconds
+                since = (time.perf_counter() - start - switch, done)
+            elif not background:
+                background = True
+                first_run.start_background_compile(m, task.method)
         if done >= task.n_steps:
             break
-        if task.ran == "portable" and task.jit == "auto" and _worth_specializing(
-                time.perf_counter() - start - switch, done, task.n_steps):
+        if tier == "portable" and task.jit == "auto" and _worth_specializing(
+                elapsed, done - since[1], task.n_steps - since[1]):
             run, seconds = warm_up(lambda: task.run, args(), label + ", specialized for this long run")
             compile_time += seconds
             switch += seconds
-            task.ran = f"portable, then specialized from step {done}"
+            task.ran = f"{task.ran}, then specialized from step {done}"
+            tier = "specialized"
     return done, row, switch, compile_time
+
+
+def _interpreted_glue(task, args):
+    """The interpreted runner (portable.interpreted_runner) when a run of task's kind should
+    start interpreted, recorded in task.ran; else None. It should under jit="auto" when numba
+    has neither the specialized glue nor the portable glue of the method in memory or in its
+    cache (a first use after an install, or after the library changed): compiling one takes
+    seconds to tens of seconds, a short run interpreted a fraction of a second."""
+    if task.jit != "auto" or not first_run.interpreted_enabled() or portable.unsupported():
+        return None
+    if portable.specialized_ready(task.run, args) or portable.portable_cached(task.module,
+                                                                             task.method):
+        return None
+    task.ran = "interpreted"
+    return portable.interpreted_runner(task.module, task.method)
+
+
+def _interpreted_chunk(done, save_every):
+    """Steps of the next interpreted chunk: PROBE_STEPS first, then as many as are done, up to
+    CHUNK_STEPS (a multiple of save_every)."""
+    steps = min(max(PROBE_STEPS, done), CHUNK_STEPS)
+    return max(1, steps // save_every) * save_every
+
+
+def _worth_compiling(method, elapsed, done, remaining):
+    """Whether an interpreted run that took ``elapsed`` seconds for ``done`` steps should
+    compile now: the interpreted seconds of the method in this process (its earlier runs and
+    this one) plus this run's projected remaining ones pass the compile expected
+    (first_run.expected_compile_seconds)."""
+    projected = elapsed * remaining / done if done > 0 else 0.0
+    return (_INTERPRETED_S.get(method, 0.0) + projected
+            > first_run.expected_compile_seconds(method))
+
+
+def _compile_after_interpreted(task, args, label, done):
+    """Compile (or load from numba's cache) the glue an interpreted run goes on with at step
+    ``done`` as a first call would (task.glue); a compile of the portable glue records its CPU
+    seconds for the next choice (first_run.record_compile_seconds). Returns (glue, seconds,
+    the tier now running); task.ran says what ran."""
+    cpu, count, first = time.process_time(), compiles(), args()
+    run, seconds = warm_up(lambda: task.glue(first), first,
+                           f"{label} after {done} interpreted steps")
+    if task.ran == "portable" and compiles() > count:
+        first_run.record_compile_seconds(task.method, time.process_time() - cpu)
+    remember_glue(task, run)
+    tier = task.ran
+    task.ran = f"interpreted, then {tier} from step {done}"
+    return run, seconds, tier
 
 
 #: {task.ready_key(): (what ran, the portable glue or None, the specialized glue's overload

@@ -125,7 +125,9 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         model compiles only its kernels; 1.4x to 2.2x the specialized step time on the cart
         pendulum, within 10 % on the 16-link chain; the same results bit for bit). "auto" (default): specialized when numba's cache already
         holds it, else portable, switching to specialized between chunks of a fixed-step run
-        whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S). Runs
+        whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S); a
+        fixed-step run whose method numba has compiled nowhere yet starts "interpreted" (the
+        same code as Python, jit/interpreted.py) and compiles only when that would pay. Runs
         with a control= hook are always specialized. None: the environment variable
         LAGRANGE_GEN_JIT, else "auto". Trajectory.jit says what ran.
     control_params: parameters of the controller (a 1-D sequence of numbers c, e.g. gains),

@@ -40,8 +40,9 @@ class Trajectory:
     n_steps: int
     wall_time: float = 0.0       # integration only, seconds
     compile_time: float = 0.0    # compiling or loading run_<method> from numba's cache, seconds
-    # the compiled loop that ran (simulate(jit=), lagrange_gen.jit.portable): "specialized",
-    # "portable", or "portable, then specialized from step k"
+    # the loop that ran (simulate(jit=), lagrange_gen.jit.portable): "specialized",
+    # "portable", "portable, then specialized from step k", or on a method's first use
+    # "interpreted" (its Python, jit/interpreted.py), "interpreted, then portable from step k"
     jit: str = ""
     saved: dict = field(default_factory=dict)   # {field name: (S, width)}: the method's SPEC.saved
     element_names: tuple = ()

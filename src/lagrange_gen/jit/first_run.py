@@ -1,0 +1,232 @@
+"""The first run of a method after an install: what a compile is expected to cost, and the
+compile done in a background process for the next one.
+
+A run that starts in the interpreted tier (jit/interpreted.py, chosen by run/fixed_driver.py)
+compiles nothing in the foreground unless its remaining interpreted time would pass the compile
+it saves; ``expected_compile_seconds`` is that compile: the CPU seconds of the last compile of the
+method's portable glue (with a model's kernels) recorded in the portable directory
+(``record_compile_seconds``), else DEFAULT_COMPILE_S.
+
+Meanwhile ``start_background_compile`` fills numba's cache for the next process: a detached
+process at low priority, ``python -m lagrange_gen.jit.first_run <method> <module name> <module
+file> <lock>``, imports the generated module under the same name (numba's cache refers to it by
+name), compiles its kernels for the portable glue and the portable glue with a zero-step call of
+the argument types simulate passes, and records its CPU seconds. One process per method and
+library version at a time: a lock file beside the portable glue (a stale lock, older than
+LOCK_STALE_S or of a process that is gone, is taken over). The next process then finds the glue
+in numba's cache (the warm path, unchanged). $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off
+(tests and CI do); $LAGRANGE_GEN_INTERPRETED=0 turns the interpreted tier off.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+#: Environment variable that turns the background compile off ("0", "off", "no" or "false").
+BACKGROUND_ENV = "LAGRANGE_GEN_BACKGROUND_COMPILE"
+
+#: Environment variable that turns the interpreted tier off: a first run compiles in the
+#: foreground, as before it existed (the test suite does, so that which code ran does not depend
+#: on the order in which tests fill numba's cache; tests/test_interpreted.py turns it on).
+INTERPRETED_ENV = "LAGRANGE_GEN_INTERPRETED"
+
+_OFF = ("0", "off", "no", "false")
+
+#: CPU seconds a compile of a method's portable glue is expected to take before one was measured
+#: on this machine: the first use of the lighter methods (rk4) takes 4 to 5 s on a loaded
+#: two-core machine, the implicit ones 10 to 25 s.
+DEFAULT_COMPILE_S = 10.0
+
+#: A lock file older than this (seconds) is taken to belong to a compile that died.
+LOCK_STALE_S = 900.0
+
+#: The file of the recorded compile seconds, in the portable directory.
+ESTIMATES_FILE = "compile_seconds.json"
+
+
+def background_enabled() -> bool:
+    """Whether a background compile may start ($LAGRANGE_GEN_BACKGROUND_COMPILE)."""
+    return os.environ.get(BACKGROUND_ENV, "1").strip().lower() not in _OFF
+
+
+def interpreted_enabled() -> bool:
+    """Whether a first run may start interpreted ($LAGRANGE_GEN_INTERPRETED)."""
+    return os.environ.get(INTERPRETED_ENV, "1").strip().lower() not in _OFF
+
+
+def _estimates_path() -> Path:
+    from .portable import portable_dir
+    return portable_dir() / ESTIMATES_FILE
+
+
+def expected_compile_seconds(method) -> float:
+    """CPU seconds the compile of ``method``'s portable glue is expected to take."""
+    try:
+        value = json.loads(_estimates_path().read_text()).get(method)
+        return float(value) if value and float(value) > 0 else DEFAULT_COMPILE_S
+    except (OSError, ValueError, AttributeError, TypeError):
+        return DEFAULT_COMPILE_S
+
+
+def record_compile_seconds(method, seconds) -> None:
+    """Record that a compile of ``method``'s portable glue took ``seconds`` (CPU); written
+    atomically, a failure to write is ignored (the default stands)."""
+    path = _estimates_path()
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            known = json.loads(path.read_text())
+            if not isinstance(known, dict):
+                known = {}
+        except (OSError, ValueError):
+            known = {}
+        known[method] = round(float(seconds), 3)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".compile_seconds.", suffix=".tmp")
+        with os.fdopen(fd, "w") as f:
+            json.dump(known, f, sort_keys=True)
+        os.replace(tmp, path)
+    except OSError:
+        pass
+
+
+def lock_path(method) -> Path:
+    """The lock file of a background compile of ``method`` (beside its portable glue)."""
+    from .portable import glue_path
+    path = glue_path(method)
+    return path.with_name(f".{path.stem}.compiling")
+
+
+def take_lock(lock: Path) -> bool:
+    """Create ``lock`` (False when another live compile holds it; a stale one is taken over)."""
+    for _ in range(2):
+        try:
+            fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+        except FileExistsError:
+            if not _stale(lock):
+                return False
+            try:
+                lock.unlink()
+            except OSError:
+                return False
+            continue
+        except OSError:         # a directory we may not write: no background compile
+            return False
+        os.write(fd, str(os.getpid()).encode())
+        os.close(fd)
+        return True
+    return False
+
+
+def _stale(lock: Path) -> bool:
+    try:
+        if time.time() - lock.stat().st_mtime > LOCK_STALE_S:
+            return True
+        pid = int(lock.read_text().strip() or 0)
+    except (OSError, ValueError):
+        return False           # being written right now: not stale
+    if pid <= 0 or os.name == "nt":      # (Windows' os.kill would end the process): age only
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:            # alive, another user's
+        return False
+    return False
+
+
+def release_lock(lock: Path) -> None:
+    try:
+        lock.unlink()
+    except OSError:
+        pass
+
+
+def start_background_compile(module, method, stream=None):
+    """Start the detached compile of ``method``'s portable glue and ``module``'s kernels for the
+    next process (module docstring) unless it is turned off or another holds the lock; one line
+    on ``stream`` (default stderr) says so. Returns the process (subprocess.Popen) or None."""
+    if not background_enabled():
+        return None
+    lock = lock_path(method)
+    if not take_lock(lock):
+        return None
+    package_parent = str(Path(__file__).resolve().parents[2])
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [package_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
+    try:
+        process = subprocess.Popen(
+            [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            start_new_session=True, env=env, close_fds=True)
+    except OSError:
+        release_lock(lock)
+        return None
+    try:
+        lock.write_text(str(process.pid))
+    except OSError:
+        pass
+    stream = stream or sys.stderr
+    stream.write(f"lagrange-gen: compiling run_{method} in the background for the next run "
+                 f"(process {process.pid}; {BACKGROUND_ENV}=0 turns this off)\n")
+    stream.flush()
+    return process
+
+
+def zero_step_args(module, method):
+    """The portable glue's arguments of a zero-step run of ``method`` on ``module`` of the types
+    simulate passes (run/fixed_driver.py's warm-up): fresh writable float64 arrays, the
+    method's default settings record."""
+    import numpy as np
+    from ..steppers.core.layout import N_STATS, events_size, last_size
+    from ..steppers.core.registry import spec
+    from .portable import n_saved
+    n, saved = module.N_COORDS, n_saved(module, method)
+    p = np.array(module.DEFAULT_PARAMS, dtype=np.float64)
+    return (np.zeros(n), np.zeros(n), 0.0, 1e-3, 0, 1, p, spec(method).settings(),
+            np.empty(1), np.empty((1, n)), np.empty((1, n)), np.empty((1, N_STATS)),
+            np.zeros((1, saved)), np.zeros(last_size(n, saved, with_work=True)),
+            np.zeros((0, events_size(n))))
+
+
+def compile_for_next_time(method, name, path) -> float:
+    """In the background process: import the generated module at ``path`` as ``name``, compile
+    its kernels and the portable glue of ``method`` (nothing when numba's cache has it), record
+    the CPU seconds. Returns them (0 when nothing was compiled)."""
+    import importlib.util
+    from .portable import portable_cached, runner
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    if portable_cached(module, method):
+        return 0.0
+    start = time.process_time()
+    runner(module, method)(*zero_step_args(module, method))
+    seconds = time.process_time() - start
+    record_compile_seconds(method, seconds)
+    return seconds
+
+
+def main(argv) -> int:
+    method, name, path, lock = argv
+    try:
+        try:
+            os.nice(10)
+        except (AttributeError, OSError):      # no os.nice (Windows), or not allowed
+            pass
+        compile_for_next_time(method, name, path)
+    finally:
+        release_lock(Path(lock))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
