@@ -87,6 +87,10 @@ KINDS = {
     # a unilateral contact: members that hit the floor within the run and one that does not
     "moreau_jean": (str(ROOT / "generated" / "bouncing_ball.py"), [[1e-3], [2e-3], [1.0]],
                     [[-1.0], [-0.5], [0.0]]),
+    # contacts with a holonomic constraint: a pendulum on a rod hitting the wall x = 0.5 within
+    # the run (it starts 1e-3 from it) and one that does not
+    "spook_contacts": (str(ROOT / "generated" / "pendulum_wall_cartesian.py"),
+                       [[0.499, -0.866601], [0.0, -1.0]], [[0.866601, 0.499], [0.0, 0.0]]),
     # velocity constraints
     "nonholonomic_rk4": (str(ROOT / "generated" / "chaplygin_sleigh.py"), None, None),
 }

@@ -38,12 +38,6 @@ CONTACT_SAVED = (("active_contacts", 1), ("normal_impulse", "c"), ("tangent_impu
 
 
 @njit(inline="always")
-def n_tangent_rows(kern):
-    """Rows of the generated W_T: one tangent per contact."""
-    return kern.N_CONTACTS
-
-
-@njit(inline="always")
 def min_gap(g):
     """The smallest entry of g (c,) (inf for no contacts)."""
     m = np.inf

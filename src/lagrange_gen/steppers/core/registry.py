@@ -39,7 +39,7 @@ ADAPTIVE_METHODS = tuple(m for m in METHODS if INFO[m].adaptive)
 #: and dop853 (adaptive: no fixed-step ensemble runs it).
 GPU_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
                "rattle", "constrained_midpoint", "constrained_implicit_euler", "spook", "index1",
-               "nonsmooth_euler", "moreau_jean", "nonholonomic_rk4")
+               "nonsmooth_euler", "moreau_jean", "spook_contacts", "nonholonomic_rk4")
 
 #: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
 ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}

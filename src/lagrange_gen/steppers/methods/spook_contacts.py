@@ -53,7 +53,7 @@ from ...jit.cache import njit
 from ..core.options import FAST, inline_step
 from ..core.constrained import constraint_rate
 from ..core.contact_kkt import (CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
-                                impulse_work, min_gap, n_tangent_rows, pad_rows,
+                                impulse_work, min_gap, pad_rows,
                                 record_constraints, record_contacts, row_dot, solve_contacts)
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
@@ -84,7 +84,7 @@ class SpookContactSettings(NamedTuple):
 def workspace(kern, n):
     """Allocated once per run by run_loop.run_loop."""
     m, c = kern.N_CONSTRAINTS, kern.N_CONTACTS
-    N, T = n + m, n_tangent_rows(kern)
+    N, T = n + m, c                   # T: the rows of W_T, one tangent per contact
     R = c + T
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),
                      np.zeros(n), np.zeros((n, n)), np.zeros(m), np.zeros(m),
