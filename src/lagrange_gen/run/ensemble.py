@@ -281,7 +281,8 @@ def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved, n_params=0)
 
 def _consistent_starts(module, q, v, p, t0, config, extra):
     """Each member's consistent (q0, v0), its multipliers and residuals in row 0 of ``extra``
-    (its last entries: a contact method saves its contact fields before them); one warning counting the members that were moved (instead of one per member)."""
+    (its last entries: a contact method saves its contact fields before them); one warning
+    counting the members that were moved (instead of one per member)."""
     from .consistent import consistent_initial_state
     tol = getattr(config, "newton_tol", 1e-12)
     q, v, moved = q.copy(), v.copy(), 0

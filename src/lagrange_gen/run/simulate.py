@@ -171,7 +171,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     constrained = spec.saves_constraints(module.N_CONSTRAINTS)
     if keep and not constrained:
         raise SimulationError(f"{module.NAME}: keep= ({', '.join(keep)}) chooses the velocities "
-                              "kept when v0 is projected onto J v = 0; this model has no constraints")
+                              "kept when v0 is projected onto J v = 0; this model has no "
+                              "constraints")
     if spec.constraints:
         q, v, initial = _constrained_start(module, q, v, p, t0,
                                            getattr(config, "newton_tol", 1e-12), keep)

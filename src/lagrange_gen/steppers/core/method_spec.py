@@ -19,8 +19,8 @@ method names. A spec says:
   the code, codegen.needs);
 * ``saved``: the named fields the method saves per output row besides (t, q, v, energy, Newton
   iterations and residual), in the order of its ``extra`` buffer, each with a width given as a
-  count name (``"m"`` constraints, ``"m1"`` 1 with constraints and 0 without, ``"ne"`` elements, ``"c"`` contacts, ``"r"`` nonholonomic
-  constraints, ``"n"`` coordinates) or an int;
+  count name (``"m"`` constraints, ``"m1"`` 1 with constraints and 0 without, ``"ne"``
+  elements, ``"c"`` contacts, ``"r"`` nonholonomic constraints, ``"n"`` coordinates) or an int;
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
   adaptive signature (codegen/glue.py).
 
