@@ -1,5 +1,5 @@
 """`lagrange-gen bench contact --quick` through the CLI on a model directory holding the bouncing
-ball and the rocking block: the report names both methods and both cases, says whether Siconos
+ball and the rocking block: the report names the three methods and both cases, says whether Siconos
 ran, and draws its figure; the event-driven runs' errors against the closed forms are small
 (the bouncing ball's parabolas are exact between located impacts). No timing asserts."""
 
@@ -31,6 +31,10 @@ def test_bench_contact_quick_writes_its_report(tmp_path, gen_dir, monkeypatch):
     assert float(rows[0]) <= 1e-9                 # the ball: exact parabolas, located impacts
     assert float(rows[3]) <= 1e-6                 # the block at rtol 1e-8
     assert len(re.findall(r"\| moreau_jean \|", text)) == 4
+    # spook_contacts at the same steps: each run's error below the ball's drop height and the
+    # block's energy fraction (an order-1 method at h = t_end / 100 and / 50)
+    spook = [float(x) for x in re.findall(r"\| spook_contacts \| \S+ \| \S+ \| (\S+) \|", text)]
+    assert len(spook) == 4 and max(spook[:2]) < 1.0 and max(spook[2:]) < 0.5
     figure = tmp_path / "reports" / "contact_precision.png"
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert float(np.ptp(mpimg.imread(figure)[..., :3])) > 0.0       # not a blank image

@@ -50,7 +50,11 @@ def test_not_a_contact_is_refused():
 
 
 def test_only_the_contact_methods_apply_to_contacts_and_not_elsewhere():
-    assert registry.applicable_methods(0, 0, 1) == ("moreau_jean", "dop853_impacts")
+    assert registry.applicable_methods(0, 0, 1) == ("moreau_jean", "spook_contacts",
+                                                    "dop853_impacts")
+    # with holonomic constraints too: the two whose step takes them as rows
+    assert registry.applicable_methods(1, 0, 1) == ("moreau_jean", "spook_contacts")
+    assert "nonsmooth elements" in registry.inapplicable("moreau_jean", 0, 1, 1)
     assert "moreau_jean" not in registry.applicable_methods(0, 0, 0)
     assert "dop853_impacts" not in registry.applicable_methods(0, 0, 0)
     assert "unilateral contacts" in registry.inapplicable("verlet", 0, 0, 2)

@@ -5,6 +5,7 @@ simulator (tests/gpu/conftest.py) the member function runs compiled for the CPU,
 agree to the last bit; on a GPU they differ by round-off (fused multiply-adds), which the
 tolerances allow. A few members and steps each: the time is compile time."""
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -87,6 +88,11 @@ KINDS = {
     # a unilateral contact: members that hit the floor within the run and one that does not
     "moreau_jean": (str(ROOT / "generated" / "bouncing_ball.py"), [[1e-3], [2e-3], [1.0]],
                     [[-1.0], [-0.5], [0.0]]),
+    # contacts with a holonomic constraint: a pendulum on a rod hitting the wall x = 0.5 within
+    # the run (it starts 1e-3 from it) and one that does not
+    "spook_contacts": (str(ROOT / "generated" / "pendulum_wall_cartesian.py"),
+                       [[0.499, -math.sqrt(1 - 0.499**2)], [0.0, -1.0]],
+                       [[math.sqrt(1 - 0.499**2), 0.499], [0.0, 0.0]]),
     # velocity constraints
     "nonholonomic_rk4": (str(ROOT / "generated" / "chaplygin_sleigh.py"), None, None),
 }

@@ -121,8 +121,9 @@ SUITES = {
                 _stepapi),
     "compile": ("first compile with each numba speedup on and off (LAGRANGE_GEN_SPEEDUPS)",
                 _compile),
-    "contact": ("work-precision of moreau_jean and dop853_impacts on the bouncing ball and the "
-                "rocking block against closed forms (Siconos when installed)", _contact),
+    "contact": ("work-precision of moreau_jean, spook_contacts and dop853_impacts on the bouncing "
+                "ball and the rocking block against closed forms (Siconos when installed)",
+                _contact),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

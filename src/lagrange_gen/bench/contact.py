@@ -12,7 +12,8 @@ Two cases, each with an error measured against a closed form:
   (E(t) - m g c) / (E0 - m g c) = r^k after k impacts; the error is that ratio's distance
   from r^3.
 
-Methods: moreau_jean (h = t_end / (n0 2^k)) and dop853_impacts (rtol sweep, atol = rtol / 100).
+Methods: the fixed-step moreau_jean and spook_contacts (h = t_end / (n0 2^k) each) and
+dop853_impacts (rtol sweep, atol = rtol / 100).
 Siconos (Moreau-Jean time stepping, the reference peer) runs when the package ``siconos`` is
 importable; the report says so when it is not. Time: simulate's integration wall time (the glue
 compiled before the clock starts), the fastest of ``repeats``.
@@ -31,6 +32,9 @@ from . import common
 from ..analysis import runs
 
 G = 9.81
+
+#: The fixed-step contact methods the suite sweeps in h (their markers in the figure).
+FIXED_STEP = (("moreau_jean", "o"), ("spook_contacts", "^"))
 
 
 @dataclass(frozen=True)
@@ -101,7 +105,7 @@ CASES = (
 
 @dataclass(frozen=True)
 class Settings:
-    n0: int             # moreau_jean's steps at k = 0
+    n0: int             # the fixed-step methods' steps at k = 0
     k_max: int
     rtols: tuple
     repeats: int
@@ -116,7 +120,7 @@ QUICK = Settings(n0=50, k_max=1, rtols=(1e-4, 1e-8), repeats=1, budget=1.0)
 @dataclass
 class Point:
     method: str
-    param: float        # h (moreau_jean) or rtol (dop853_impacts)
+    param: float        # h (fixed-step methods) or rtol (dop853_impacts)
     wall: float
     error: float = math.nan
     failed: str = ""
@@ -125,10 +129,11 @@ class Point:
 def _runs(case, settings):
     """[(method, param, simulate keywords)] of the sweeps, in order."""
     out = []
-    for k in range(settings.k_max + 1):
-        n = settings.n0 * 2 ** k
-        h = case.t_end / n
-        out.append(("moreau_jean", h, dict(h=h, save_every=n)))
+    for method, _ in FIXED_STEP:
+        for k in range(settings.k_max + 1):
+            n = settings.n0 * 2 ** k
+            h = case.t_end / n
+            out.append((method, h, dict(h=h, save_every=n)))
     for rtol in settings.rtols:
         out.append(("dop853_impacts", rtol, dict(h=None, rtol=rtol, atol=rtol / 100)))
     return out
@@ -171,7 +176,7 @@ def figure(results, path):
     fig, axes = common.new_figure(1, len(results), figsize=(5.5 * len(results), 4.2))
     axes = np.atleast_1d(axes)
     for ax, (case, points) in zip(axes, results):
-        for method, marker in (("moreau_jean", "o"), ("dop853_impacts", "s")):
+        for method, marker in (*FIXED_STEP, ("dop853_impacts", "s")):
             pts = [pt for pt in points if pt.method == method and not pt.failed]
             if pts:
                 ax.loglog([max(pt.wall, 1e-7) for pt in pts],
@@ -205,10 +210,11 @@ def run_contact(models_dir="models", gen_dir="generated", reports_dir="reports",
     {"results": [(case, [Point])], "report": path}."""
     settings = QUICK if quick else FULL
     cases = [c for c in CASES if runs.model_available(models_dir, c.stem)]
-    total = len(cases) * (settings.k_max + 1 + len(settings.rtols))
+    total = len(cases) * (len(FIXED_STEP) * (settings.k_max + 1) + len(settings.rtols))
     bar = common.Progress(total, "contact", enabled=progress)
     lines = ["# Contact and impacts: work-precision", "",
-             "moreau_jean (order 1, fixed step) against dop853_impacts (event-driven, "
+             "moreau_jean and spook_contacts (order 1, fixed step) against dop853_impacts "
+             "(event-driven, "
              "adaptive), each run's error against a closed form; time is simulate's "
              "integration wall time (fastest of "
              f"{settings.repeats}){' (--quick settings)' if quick else ''}.", "",
@@ -218,11 +224,12 @@ def run_contact(models_dir="models", gen_dir="generated", reports_dir="reports",
         mod = runs.load_module(models_dir, case.stem, gen_dir)
         points = sweep(mod, case, settings, bar)
         results.append((case, points))
-        order = fitted_order(points)
         lines += [f"## {case.title}", "", f"Error: {case.measures}.", ""]
-        if order is not None:
-            lines += [f"moreau_jean's fitted order (slope of log error against log h): "
-                      f"{order:.2f}.", ""]
+        for method, _ in FIXED_STEP:
+            order = fitted_order(points, method)
+            if order is not None:
+                lines += [f"{method}'s fitted order (slope of log error against log h): "
+                          f"{order:.2f}.", ""]
         lines += [*_table(points), ""]
     bar.finish()
     missing = [c.stem for c in CASES if c not in cases]

@@ -273,7 +273,7 @@ def check_method(module, method):
                                 getattr(module, "N_NONHOLONOMIC", 0))
     if not why:
         return
-    if m and not registry.spec(method).constraints:
+    if m and not registry.spec(method).constraints and not registry.spec(method).contacts:
         names = "; ".join(constraint_label(module, i) for i in range(m))
         about = "; ".join(f"{s.name}: order {s.order}, {s.summary}"
                           for s in map(registry.spec, registry.CONSTRAINED_METHODS))

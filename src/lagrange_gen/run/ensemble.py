@@ -177,7 +177,7 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     for i in range(M) if getattr(module, "N_CONTACTS", 0) else ():
         run_checks.check_contact_coefficients(module, p[i], q[i])
     out = allocate_outputs(M, rows, n, n_saved)
-    if spec.constraints:
+    if spec.saves_constraints(module.N_CONSTRAINTS):
         q, v = _consistent_starts(module, q, v, p, t0, config, out["extra"])
     if on_gpu:
         from ..gpu.launch import run_on_gpu
@@ -280,8 +280,9 @@ def check_ensemble_memory(model, M, n_steps, save_every, n, n_saved, n_params=0)
 
 
 def _consistent_starts(module, q, v, p, t0, config, extra):
-    """Each member's consistent (q0, v0), its multipliers and residuals in row 0 of ``extra``;
-    one warning counting the members that were moved (instead of one per member)."""
+    """Each member's consistent (q0, v0), its multipliers and residuals in row 0 of ``extra``
+    (its last entries: a contact method saves its contact fields before them); one warning
+    counting the members that were moved (instead of one per member)."""
     from .consistent import consistent_initial_state
     tol = getattr(config, "newton_tol", 1e-12)
     q, v, moved = q.copy(), v.copy(), 0
@@ -291,7 +292,8 @@ def _consistent_starts(module, q, v, p, t0, config, extra):
             state = consistent_initial_state(module, q[i], v[i], p[i], t0, tol)
         moved += bool(caught)
         q[i], v[i] = state.q, state.v
-        extra[i, 0] = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
+        start = np.concatenate((state.lam, [state.phi_norm, state.jv_norm]))
+        extra[i, 0, extra.shape[2] - start.shape[0]:] = start
     if moved:
         warnings.warn(f"{module.NAME}: the initial state of {moved} of {q.shape[0]} members was "
                       f"projected onto the constraints (lagrange_gen.run.consistent)", stacklevel=3)

@@ -102,7 +102,8 @@ def _build(task, rows, out, steps, h, wall, compile_time):
                       work=rows["stats"][:, STAT_WORK].copy() if _has_work(m) else None,
                       settings=_settings(task.settings),
                       element_names=tuple(m.ELEMENTS) if spec.elements else (),
-                      constraint_names=tuple(m.CONSTRAINTS) if spec.constraints else (),
+                      constraint_names=(tuple(m.CONSTRAINTS)
+                                        if spec.saves_constraints(m.N_CONSTRAINTS) else ()),
                       events=_events(m, out), source=_source(m))
 
 

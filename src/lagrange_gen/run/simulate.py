@@ -170,14 +170,19 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
                            getattr(module, "N_CONTACTS", 0), getattr(module, "N_NONHOLONOMIC", 0))
     initial = np.zeros(0)
-    if keep and not spec.constraints:
+    constrained = spec.saves_constraints(module.N_CONSTRAINTS)
+    if keep and not constrained:
         raise SimulationError(f"{module.NAME}: keep= ({', '.join(keep)}) chooses the velocities "
-                              "kept when v0 is projected onto J v = 0; this model has no constraints")
+                              "kept when v0 is projected onto J v = 0; this model has no "
+                              "constraints")
     if spec.constraints:
         q, v, initial = _constrained_start(module, q, v, p, t0,
                                            getattr(config, "newton_tol", 1e-12), keep)
     elif spec.contacts:          # (its prepare fills row 0; the contact work starts at 0)
         initial = np.zeros(n_saved)
+        if constrained:          # the constrained fields come last (contact_kkt.CONTACT_SAVED)
+            q, v, start = _constrained_start(module, q, v, p, t0, 1e-12, keep)
+            initial[n_saved - start.shape[0]:] = start
     elif spec.nonholonomic:      # q0 onto Phi = 0, v0 onto A v + b = 0; prepare fills row 0
         from .consistent import nonholonomic_start
         q, v = nonholonomic_start(module, q, v, p, t0, stacklevel=3)
@@ -211,7 +216,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     traj = fixed_step_trajectory(task, out, wall, compile_time)
     if overshoot:
         traj.warnings.insert(0, overshoot)
-    if spec.constraints:
+    if constrained:
         violated = run_checks.constraint_violation(module.NAME, method, traj.t, traj.q,
                                                    traj.saved.get("constraint_error"))
         if violated:

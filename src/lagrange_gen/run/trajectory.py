@@ -69,13 +69,13 @@ class Trajectory:
     def constraint_error(self):
         """(S,): max_i |Phi_i(q)| at each saved state; None for a run without constraints."""
         phi = self.saved.get("constraint_error")
-        return None if phi is None else phi[:, 0]
+        return None if phi is None or not phi.shape[1] else phi[:, 0]
 
     @property
     def velocity_constraint_error(self):
         """(S,): max_i |(J(q) v)_i| at each saved state; None for a run without constraints."""
         jv = self.saved.get("velocity_constraint_error")
-        return None if jv is None else jv[:, 0]
+        return None if jv is None or not jv.shape[1] else jv[:, 0]
 
     @property
     def element_state(self) -> np.ndarray:

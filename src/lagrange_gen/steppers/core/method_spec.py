@@ -19,8 +19,8 @@ method names. A spec says:
   the code, codegen.needs);
 * ``saved``: the named fields the method saves per output row besides (t, q, v, energy, Newton
   iterations and residual), in the order of its ``extra`` buffer, each with a width given as a
-  count name (``"m"`` constraints, ``"ne"`` elements, ``"c"`` contacts, ``"r"`` nonholonomic
-  constraints, ``"n"`` coordinates) or an int;
+  count name (``"m"`` constraints, ``"m1"`` 1 with constraints and 0 without, ``"ne"``
+  elements, ``"c"`` contacts, ``"r"`` nonholonomic constraints, ``"n"`` coordinates) or an int;
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
   adaptive signature (codegen/glue.py).
 
@@ -111,7 +111,8 @@ class Spec:
     stands_in_for: tuple = ()
     contacts: bool = False
     nonholonomic: bool = False
-    #: A nonholonomic method that also treats holonomic constraints beside the velocity ones.
+    #: A nonholonomic or contact method that also treats holonomic constraints beside the
+    #: velocity constraints or the contacts.
     holonomic_too: bool = False
     saved: tuple = ()
     limits: dict = field(default_factory=dict)
@@ -134,7 +135,7 @@ class Spec:
     def saved_layout(self, n: int, m: int, ne: int, nc: int = 0, nr: int = 0) -> tuple:
         """((name, start, width), ...) of the saved fields in the extra buffer (nc contacts,
         nr nonholonomic constraints)."""
-        counts = {"n": n, "m": m, "ne": ne, "c": nc, "r": nr}
+        counts = {"n": n, "m": m, "m1": min(m, 1), "ne": ne, "c": nc, "r": nr}
         layout, start = [], 0
         for name, width in self.saved:
             w = counts[width] if isinstance(width, str) else int(width)
@@ -145,6 +146,12 @@ class Spec:
     def n_saved(self, n: int, m: int, ne: int, nc: int = 0, nr: int = 0) -> int:
         """Width of the extra buffer (sum of the saved fields' widths)."""
         return sum(w for _, _, w in self.saved_layout(n, m, ne, nc, nr))
+
+    def saves_constraints(self, m: int) -> bool:
+        """Whether a run of a model with m holonomic constraints saves the constrained methods'
+        fields (multipliers, constraint_error, velocity_constraint_error) and so starts from a
+        consistent state: a constrained method, or a contact method on a constrained model."""
+        return self.constraints or bool(m and self.contacts and self.holonomic_too)
 
     def setting_names(self) -> tuple:
         return tuple(self.settings._fields)

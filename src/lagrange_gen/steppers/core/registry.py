@@ -15,7 +15,7 @@ import importlib
 METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
            "dop853", "composition", "composition6", "nonsmooth_euler", "rattle",
            "constrained_midpoint", "constrained_implicit_euler", "spook", "index1", "moreau_jean",
-           "dop853_impacts", "nonholonomic_rk4", "nonholonomic_midpoint")
+           "spook_contacts", "dop853_impacts", "nonholonomic_rk4", "nonholonomic_midpoint")
 
 #: {method: its Spec}.
 INFO = {m: importlib.import_module(f"lagrange_gen.steppers.methods.{m}").SPEC for m in METHODS}
@@ -39,7 +39,7 @@ ADAPTIVE_METHODS = tuple(m for m in METHODS if INFO[m].adaptive)
 #: and dop853 (adaptive: no fixed-step ensemble runs it).
 GPU_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "implicit_euler", "rk4",
                "rattle", "constrained_midpoint", "constrained_implicit_euler", "spook", "index1",
-               "nonsmooth_euler", "moreau_jean", "nonholonomic_rk4")
+               "nonsmooth_euler", "moreau_jean", "spook_contacts", "nonholonomic_rk4")
 
 #: The method simulate() runs instead of the one asked for on a model with nonsmooth elements.
 ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}
@@ -75,13 +75,17 @@ def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: i
                 f"{', '.join(both)})")
     if n_constraints and n_elements:
         return "constraints together with nonsmooth elements are not supported by any method"
-    if n_contacts and (n_constraints or n_elements):
-        return ("contacts together with constraints or nonsmooth elements are not supported by "
-                "any method yet")
+    if n_contacts and n_elements:
+        return "contacts together with nonsmooth elements are not supported by any method yet"
     if bool(n_contacts) != flags.contacts:
-        contact_methods = ", ".join(m for m in METHODS if INFO[m].contacts)
+        contact_methods = ", ".join(m for m in METHODS if INFO[m].contacts
+                                    and (INFO[m].holonomic_too or not n_constraints))
         return (f"it ignores the model's unilateral contacts (use {contact_methods})" if n_contacts
                 else "it is for models with unilateral contacts and this model has none")
+    if n_contacts:
+        both = [m for m in METHODS if INFO[m].contacts and INFO[m].holonomic_too]
+        return ("" if not n_constraints or flags.holonomic_too else
+                f"it does not treat holonomic constraints beside contacts (use {', '.join(both)})")
     if bool(n_constraints) != flags.constraints:
         return ("it ignores the model's constraints" if n_constraints
                 else "it is for models with constraints and this model has none")

@@ -30,16 +30,27 @@ until the largest change of a sweep is at most contact_tol max|r| or max_sweeps 
 (CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
 impulse that zeroes u_T: no creep.
 
+Holonomic constraints Phi(q) = 0 (m rows, J = dPhi/dq) join the step as rigid equality rows of
+the same linear system, K [v+ - v; nu] = [h f + h^2 theta K v + W r; target] with
+K = [[A, -J^T], [J, 0]] and the target J v+ + dPhi/dt = -Phi(q) / h: the velocity constraint
+with the drift Phi of the step's start removed over the step (the linearized Phi(q+) then
+follows x+ = (1 - theta) x + (1 - theta) y, y+ = -x for x = Phi, y = h J v: spectral radius
+sqrt(1 - theta) < 1, so |Phi| stays O(h^2), reported as constraint_error). The contacts then
+act on the constrained motion: D = W K^-1 W^T (core/contact_kkt.py), and the constraint
+impulses follow the contact impulses exactly. The multipliers saved are lam = nu / h.
+
 Order 1 (impacts located to within a step). theta = 1/2 (default) is energy-neutral in free
 flight; the work of the contact impulses per step is r . (u- + u+) / 2 with u- = W v, u+ = W v+
 (the kinetic energy change an impulse causes), and for forces that do not depend on q and v
 (the bouncing ball, the block on a ramp) E - E0 - W_contact = 0 to rounding at theta = 1/2.
 Positions may go below the gap by O(h |u_N|) at an impact (the impulse acts on velocities);
-``min_gap`` reports it. No Newton: one LU of A per step.
+``min_gap`` reports it. No Newton: one LU of K per step.
 
-``extra`` (SPEC.saved), c = kern.N_CONTACTS: active contacts (1), normal impulses p_N (c),
-tangential impulses p_T (c), the smallest gap at the end of the step (1), the cumulated work
-of the contact impulses (1). The step returns (status, sweeps, last sweep's largest change).
+``extra`` (SPEC.saved, core/contact_kkt.CONTACT_SAVED), c = kern.N_CONTACTS: active contacts
+(1), normal impulses p_N (c), tangential impulses p_T (c), the smallest gap at the end of the
+step (1), the cumulated work of the contact impulses (1); with holonomic constraints the
+multipliers (m), max|Phi| and max|J v + dPhi/dt| at the end of the step. The step returns
+(status, sweeps, last sweep's largest change).
 """
 
 from collections import namedtuple
@@ -49,19 +60,25 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core.options import FAST, inline_step
-from ..core.contact_problem import delassus, gauss_seidel, local_velocity
+from ..core.constrained import constraint_rate
+from ..core.contact_kkt import (CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
+                                impulse_work, min_gap, pad_rows,
+                                record_constraints, record_contacts, row_dot, solve_contacts)
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.solve import failed_solve_status
 from ..core.status import CONTACT_NOT_CONVERGED, OK
 
-#: Scratch of one run (n coordinates, c contacts). (n,): rhs f, the free velocity vf, solver
-#: scratch s and pivots piv; (n, n): H, the iteration matrix A (LU-factored in place), d rhs/dq
-#: Jq, d rhs/dv Jqd; (c,): gaps g, normal velocities before the step un; W_N, W_T (c, n);
-#: coef (c, 2) = (e, mu); (2c,): impulses r = (p_N, p_T), free local velocities uf, active flag
-#: of each contact (first c entries); law (2c,) every contact UNILATERAL / COULOMB
-#: (core/contact_problem.py); Y (2c, n) the rows A^-1 W^T; D (2c, 2c) the Delassus matrix.
-Workspace = namedtuple("Workspace", "f vf s piv H A Jq Jqd g un WN WT coef r uf active law Y D")
+#: Scratch of one run (n coordinates, m constraints, c contacts, N = n + m, R = n_rows). x the
+#: unknown (v+ - v, nu), then (v+, nu) (N,); solver scratch s and pivots piv (N,); the
+#: iteration matrix K (N, N) (LU-factored in place); (n,): rhs f; (n, n): H, d rhs/dq Jq,
+#: d rhs/dv Jqd; phi, gam (m,), G (m, n); (c,): gaps g, normal velocities before the step un,
+#: active flag of each contact; W_N (c, n), W_T (R - c, n) and their copies padded to N columns
+#: WNp, WTp; coef (c, 2) = (e, mu); (R,): impulses r = (p_N, p_T), free local velocities uf,
+#: law (every contact UNILATERAL / COULOMB, core/contact_problem.py); Y (R, N) the rows
+#: K^-1 [W^T; 0]; D (R, R) the Delassus matrix.
+Workspace = namedtuple("Workspace",
+                       "x s piv K f H Jq Jqd phi gam G g un active WN WT WNp WTp coef r uf law Y D")
 
 
 class MoreauJeanSettings(NamedTuple):
@@ -76,97 +93,90 @@ class MoreauJeanSettings(NamedTuple):
 @njit
 def workspace(kern, n):
     """Allocated once per run by run_loop.run_loop."""
-    c = kern.N_CONTACTS
-    return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
-                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros(c), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
-                     np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
-                     np.zeros(2 * c, np.int64), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)))
-
-
-@njit(inline="always")
-def _min_gap(g):
-    """The smallest entry of g (c,) (inf for no contacts)."""
-    m = np.inf
-    for i in range(g.shape[0]):
-        m = min(m, g[i])
-    return m
+    m, c = kern.N_CONSTRAINTS, kern.N_CONTACTS
+    N, T = n + m, c                   # T: the rows of W_T, one tangent per contact
+    R = c + T
+    return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),
+                     np.zeros(n), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
+                     np.zeros(m), np.zeros(m), np.zeros((m, n)), np.zeros(c), np.zeros(c),
+                     np.zeros(c), np.zeros((c, n)), np.zeros((T, n)), np.zeros((c, N)),
+                     np.zeros((T, N)), np.zeros((c, 2)), np.zeros(R), np.zeros(R),
+                     np.zeros(R, np.int64), np.zeros((R, N)), np.zeros((R, R)))
 
 
 @njit(**FAST)
 def prepare(kern, q, v, mom, t, p, settings, ws, extra):
     """Row 0 of the saved fields: no active contact, no impulse, the initial smallest gap; the
-    contact work continues from what extra holds (0 at the start of a run)."""
-    c = kern.N_CONTACTS
+    contact work continues from what extra holds (0 at the start of a run); the constrained
+    fields keep the consistent start simulate put there."""
     kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
-    for i in range(2 * c + 1):
+    R = ws.r.shape[0]
+    for i in range(R + 1):
         extra[i] = 0.0
-    extra[2 * c + 1] = _min_gap(ws.g)
+    extra[R + 1] = min_gap(ws.g)
     return OK
 
 
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Gauss-Seidel sweeps, last change)."""
-    n, c = kern.N_COORDS, kern.N_CONTACTS
+    n, m, c = kern.N_COORDS, kern.N_CONSTRAINTS, kern.N_CONTACTS
+    N, R = n + m, ws.r.shape[0]
     theta = settings.theta
-    f, vf, A, r, uf, active, WN, WT = ws.f, ws.vf, ws.A, ws.r, ws.uf, ws.active, ws.WN, ws.WT
-    kern.dynamics(q, v, t + theta * h, p, ws.H, f)
+    x, K, G, phi, gam, WN, WT = ws.x, ws.K, ws.G, ws.phi, ws.gam, ws.WN, ws.WT
+    kern.dynamics(q, v, t + theta * h, p, ws.H, ws.f)
     kern.rhs_jacobian(q, v, t + theta * h, p, ws.Jq, ws.Jqd)
     for i in range(n):
-        s = h * f[i]
+        s = h * ws.f[i]
         for j in range(n):
             s += h * h * theta * ws.Jq[i, j] * v[j]
-            A[i, j] = ws.H[i, j] - h * theta * ws.Jqd[i, j] - h * h * theta * theta * ws.Jq[i, j]
-        vf[i] = s
-    if not lu_inplace(A, ws.piv):
-        return failed_solve_status(A), 0, 0.0
-    lu_solve_inplace(A, ws.piv, vf, ws.s)
+            K[i, j] = ws.H[i, j] - h * theta * ws.Jqd[i, j] - h * h * theta * theta * ws.Jq[i, j]
+        x[i] = s
+    kern.constraints(q, v, t, p, phi, G, gam)
+    constraint_rate(kern, q, t, p, gam)                # gam: dPhi/dt
+    assemble_constraint_rows(K, n, G, 0.0)
+    for k in range(m):                                 # G (v+ - v) = -Phi / h - dPhi/dt - G v
+        s = -phi[k] / h - gam[k]
+        for j in range(n):
+            s -= G[k, j] * v[j]
+        x[n + k] = s
+    if not lu_inplace(K, ws.piv):
+        return failed_solve_status(K), 0, 0.0
+    lu_solve_inplace(K, ws.piv, x, ws.s)
     for i in range(n):
-        vf[i] += v[i]
+        x[i] += v[i]                                   # x = (v_free, nu_free)
     kern.contacts(q, t, p, ws.g, WN, WT, ws.coef)
+    pad_rows(n, WN, WT, ws.WNp, ws.WTp)
     n_active = 0
     for a in range(c):
-        un, ufn, uft = 0.0, 0.0, 0.0
-        for i in range(n):
-            un += WN[a, i] * v[i]
-            ufn += WN[a, i] * vf[i]
-            uft += WT[a, i] * vf[i]
+        un = row_dot(a, c, WN, WT, v, n)
+        ufn = row_dot(a, c, WN, WT, x, n)
         ws.un[a] = un
-        uf[a], uf[c + a] = ufn, uft
+        ws.uf[a] = ufn
         # the gap the step reaches without contact impulses (first order in h)
-        active[a] = 1.0 if ws.g[a] + h * ((1.0 - theta) * un + theta * ufn) <= 0.0 else 0.0
-        n_active += int(active[a])
-        r[a], r[c + a] = 0.0, 0.0
+        ws.active[a] = 1.0 if ws.g[a] + h * ((1.0 - theta) * un + theta * ufn) <= 0.0 else 0.0
+        n_active += int(ws.active[a])
+    for k in range(c, R):
+        ws.uf[k] = row_dot(k, c, WN, WT, x, n)
+    for k in range(R):
+        ws.r[k] = 0.0
     sweeps, change = 0, 0.0
     if n_active > 0:
-        delassus(c, n, active, WN, WT, A, ws.piv, ws.s, ws.Y, ws.D)
-        converged, sweeps, change = gauss_seidel(c, settings.contact_tol, settings.max_sweeps,
-                                                 active, ws.law, ws.coef, ws.un, uf, ws.D, r)
+        converged, sweeps, change = solve_contacts(
+            c, N, settings.contact_tol, settings.max_sweeps, ws.active, ws.law, ws.coef, ws.un,
+            ws.uf, ws.WNp, ws.WTp, K, ws.piv, ws.s, ws.Y, ws.D, 0.0, ws.r)
         if not converged:
             return CONTACT_NOT_CONVERGED, sweeps, change
-    work = 0.0
-    for a in range(c):                   # r . (u- + u+) / 2, u+ = u_free + D r
-        if active[a] == 0.0:
-            continue
-        ut_minus = 0.0
-        for i in range(n):
-            ut_minus += WT[a, i] * v[i]
-        work += r[a] * 0.5 * (ws.un[a] + local_velocity(a, c, uf, ws.D, r))
-        work += r[c + a] * 0.5 * (ut_minus + local_velocity(c + a, c, uf, ws.D, r))
+        apply_impulses(c, ws.active, ws.Y, ws.r, x)
+    work = impulse_work(c, n, WN, WT, v, x, ws.r)
     for i in range(n):
-        vi = vf[i]
-        for k in range(2 * c):
-            if active[k % c] != 0.0:
-                vi += ws.Y[k, i] * r[k]
-        q[i] += h * ((1.0 - theta) * v[i] + theta * vi)
-        v[i] = vi
+        q[i] += h * ((1.0 - theta) * v[i] + theta * x[i])
+        v[i] = x[i]
     kern.contacts(q, t + h, p, ws.g, WN, WT, ws.coef)
-    extra[0] = n_active
-    for k in range(2 * c):
-        extra[1 + k] = r[k]
-    extra[2 * c + 1] = _min_gap(ws.g)
-    extra[2 * c + 2] += work
+    record_contacts(extra, n_active, ws.r, ws.g, work)
+    kern.constraints(q, v, t + h, p, phi, G, gam)
+    constraint_rate(kern, q, t + h, p, gam)
+    record_constraints(extra, R + 3, x, n, 1.0 / h, phi, G, v, gam)
     return OK, sweeps, change
 
 
@@ -175,10 +185,9 @@ SPEC = Spec(
     symmetric=False,
     summary="Moreau-Jean time stepping: impacts (Newton) and Coulomb friction as impulses, "
             "projected Gauss-Seidel",
-    contacts=True,
-    saved=(("active_contacts", 1), ("normal_impulse", "c"), ("tangent_impulse", "c"),
-           ("min_gap", 1), ("contact_work", 1)),
+    contacts=True, holonomic_too=True, constraint_drift="bounded",
+    saved=CONTACT_SAVED,
     limits={"theta": (0.0, False, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
     settings=MoreauJeanSettings,
-    kernels=("contacts", "dynamics", "rhs_jacobian"))
+    kernels=("constraint_rate", "constraints", "contacts", "dynamics", "rhs_jacobian"))
