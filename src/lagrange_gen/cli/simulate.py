@@ -187,8 +187,11 @@ def _summary(traj):
     contact_work = traj.saved.get("contact_work")
     if contact_work is not None:     # impacts and friction: E changes by the impulses' work
         balance = float(abs(traj.energy_error - contact_work[:, 0]).max())
-        print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
-              f"contact impulses, final W = {contact_work[-1, 0]:.6g})")
+        # event-driven runs hold persistent contacts by forces, whose work W also counts
+        what = ("the contact impulses and of the persistent contacts' forces"
+                if "impacts" in traj.saved else "the contact impulses")
+        print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of "
+              f"{what}, final W = {contact_work[-1, 0]:.6g})")
         impacts = traj.impacts
         if "impacts" in traj.saved:      # event-driven: the located impacts
             shown = ", ".join(f"t = {row['t']:.9g} (contact {row['contact']}, p_N = "

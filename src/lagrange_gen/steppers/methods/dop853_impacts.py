@@ -51,9 +51,9 @@ Reported (SPEC.saved, c = kern.N_CONTACTS), cumulative since t0 except the modes
 the impacts and projections summed per contact (``tangent2_impulse_sum`` (c) the second
 tangent's), ``contact_mode`` (c) FREE 0, STICK 1, SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, SLIDE 4,
 ``contact_work`` (1) the work of the impulses, r . (W v- + W v+) / 2, plus that of the
-persistent contacts' forces, lambda . (W v) integrated by
-the trapezoid rule over each step (exact for a constant force on a slip velocity linear in t:
-the block on a ramp). E - E0 - contact_work is then the balance for conservative forces. Row 0
+persistent contacts' forces, lambda . (W v) integrated by Gauss-Lobatto's 5-point rule over
+each step on the dense output (exact to degree 7 in t: the block on a ramp exactly, a curving
+3D slide to the dense output's accuracy). E - E0 - contact_work is then the balance for conservative forces. Row 0
 is the state after the start's classification (an impact at t0 is in the impulse sums); the
 work counts from it. In
 every-step mode a switch writes two rows at its time: before and after (diff the sums for an
@@ -387,8 +387,6 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
         if events.crossing(sw.g_prev[k], sw.g_new[k], -1) != 0:
             crossed = True
     if not crossed:
-        extra[_work_at(c)] += 0.5 * (t_new - t) * (ws.power[1] + ws.power[0])
-        ws.power[1] = ws.power[0]
         for k in range(2 * c):
             sw.g_prev[k] = sw.g_new[k]
         for a in range(c):           # a slide's reference: its slip direction at the new start
@@ -401,7 +399,9 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
             if ws.left_at[a] > -np.inf and ws.g[a] > ws.solver[2]:
                 ws.left_at[a] = -np.inf
                 sw.g_prev[a] = ws.g[a]
-        return OK, False, t_new
+        status = _add_persistent_work(kern, ws, q, v, t, h, t_new, p, extra, counters, False)
+        ws.power[1] = ws.power[0]
+        return status, False, t_new
     status = dense(kern, q, v, t, h, p, ws)
     counters[3] += DENSE_EVALS
     if status != OK:
@@ -416,8 +416,47 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
     status, t_star = _past_crossing(kern, ws, p, t, t_new, first, t_star)
     if status != OK:
         return status, False, t_new
-    extra[_work_at(c)] += 0.5 * (t_star - t) * (ws.power[1] + ws.power[0])
+    status = _add_persistent_work(kern, ws, q, v, t, h, t_star, p, extra, counters, True)
     return status, True, t_star
+
+
+#: Gauss-Lobatto's 5 nodes on [-1, 1] (the interior ones; the ends are +-1) and weights: exact
+#: for polynomials of degree 7.
+LOBATTO_NODES = (-0.6546536707079771, 0.0, 0.6546536707079771)
+LOBATTO_WEIGHTS = (0.5444444444444444, 0.7111111111111111, 0.5444444444444444)
+LOBATTO_END_WEIGHT = 0.1
+
+
+@njit(inline="always")
+def _add_persistent_work(kern, ws, q, v, t, h, t_end, p, extra, counters, dense_built):
+    """The persistent forces' work over [t, t_end] of the step from (q, v) at t (size h) into
+    extra: the power lambda . (W v) at the ends (ws.power[1] at t, ws.power[0] at t_end) and, when
+    it is not zero there, at Lobatto's interior nodes on the dense output (a sliding contact on a
+    curving path, or one on a moving surface, has a power that is not linear in t: the
+    trapezoid rule would leave an O(h^3) error per step). ws.power[0] stays the power at
+    t_end. Returns status."""
+    c = kern.N_CONTACTS
+    start, end = ws.power[1], ws.power[0]
+    half = 0.5 * (t_end - t)
+    if start == 0.0 and end == 0.0:
+        return OK
+    status = OK
+    if not dense_built:
+        status = dense(kern, q, v, t, h, p, ws)
+        counters[3] += DENSE_EVALS
+        if status != OK:
+            return status
+    inner = 0.0
+    for k in range(3):
+        tk = t + half * (1.0 + LOBATTO_NODES[k])
+        dop853.interpolate(ws, tk, ws.q_int, ws.v_int)
+        status = contact_acceleration(kern, ws, ws.q_int, ws.v_int, tk, p, ws.acc)
+        if status != OK:
+            break
+        inner += LOBATTO_WEIGHTS[k] * ws.power[0]
+    ws.power[0] = end
+    extra[_work_at(c)] += half * (LOBATTO_END_WEIGHT * (start + end) + inner)
+    return status
 
 
 @njit(inline="always")
