@@ -52,9 +52,10 @@ class Model:
         linear in the velocities (or an sp.Eq): rolling without slipping, knife edges
         (model/nonholonomic.py); stepped by the methods for nonholonomic models.
     elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
-    contacts : unilateral contacts Contact(gap=g(q), restitution=e, friction=mu, slip=u_T):
-        g >= 0 with impacts (Newton's law) and Coulomb friction on the slip velocity u_T
-        (model/contacts.py); stepped by moreau_jean.
+    contacts : unilateral contacts Contact(gap=g(q, t), restitution=e, friction=mu, slip=u_T
+        or (u_T1, u_T2)): g >= 0 with impacts (Newton's law) and Coulomb friction on the slip
+        velocity (2D) or the pair of them (3D cone) (model/contacts.py); stepped by moreau_jean
+        and dop853_impacts.
     events : {name: g} with g(q, qdot, t) an expression, or Event(g, terminal=, direction=):
         simulate locates the zero crossings of each g and records them (steppers/core/events.py).
     prescribed : {Coordinate: expression of t and parameters}: coordinates whose motion is

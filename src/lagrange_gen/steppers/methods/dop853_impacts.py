@@ -59,8 +59,10 @@ work counts from it. In
 every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
 
-A run continued in chunks reclassifies the contacts at each chunk's start; the Zeno guard's
-memory of the last impact time does not cross chunks.
+``last_impact`` (c) is each contact's latest impact time (-inf before its first): the Zeno
+guard's memory. A run continued in chunks (run/adaptive_driver.py) reclassifies the contacts
+at each chunk's start and takes that memory back from the saved fields, so the guard acts the
+same whatever the chunk boundaries.
 
 Over 300 lines: the switching functions, the classification at a switch (impact, modes,
 projection) and the work accounting read and write one workspace and one ``extra`` layout, so
@@ -371,6 +373,12 @@ def _work_at(c):
     return 1 + 4 * c
 
 
+@njit(inline="always")
+def _last_impact_at(c):
+    """Index of last_impact (c) in extra."""
+    return 2 + 4 * c
+
+
 @njit(**FAST)
 def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
     """After an accepted step from (q, v) at t to (ws.q_new, ws.v_new) at t_new: the switching
@@ -507,6 +515,7 @@ def _impact(kern, ws, v, t, settings, extra):
     for a in range(c):
         if ws.touching[a] != 0.0 and ws.r[a] > 0.0:
             ws.last_impact[a] = t
+            extra[_last_impact_at(c) + a] = t
     extra[IMPACTS] += 1.0
     return OK
 
@@ -585,6 +594,11 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     status."""
     n, c = kern.N_COORDS, kern.N_CONTACTS
     work_before = extra[_work_at(c)]
+    if ws.solver[3] != 0.0:        # a call's start: the Zeno guard's memory from extra
+        for a in range(c):
+            if extra[IMPACTS] == 0.0:      # none yet (extra starts at zeros)
+                extra[_last_impact_at(c) + a] = -np.inf
+            ws.last_impact[a] = extra[_last_impact_at(c) + a]
     if not _mass_and_rhs(kern, ws, q, v, t, p):
         return SINGULAR_MASS
     _contacts_at(kern, ws, q, t, p)
@@ -642,7 +656,8 @@ SPEC = Spec(
             "persistent contacts and stick-slip switches, Zeno guard",
     settings=Settings,
     saved=(("impacts", 1), ("normal_impulse_sum", "c"), ("tangent_impulse_sum", "c"),
-           ("tangent2_impulse_sum", "c"), ("contact_mode", "c"), ("contact_work", 1)),
+           ("tangent2_impulse_sum", "c"), ("contact_mode", "c"), ("contact_work", 1),
+           ("last_impact", "c")),
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False),
             "zeno_interval": (0.0, True, False), "gap_tol": (0.0, True, False),
