@@ -1,7 +1,9 @@
 """`lagrange-gen bench contact --quick` through the CLI on a model directory holding the bouncing
-ball and the rocking block: the report names the three methods and both cases, says whether Siconos
-ran, and draws its figure; the event-driven runs' errors against the closed forms are small
-(the bouncing ball's parabolas are exact between located impacts). No timing asserts."""
+ball, the rocking block and the puck on a table: the report names the three methods and the three
+cases, says whether Siconos ran, and draws its figure; the event-driven runs' errors against the
+closed forms are small (the bouncing ball's parabolas and the puck's straight deceleration are
+exact between located switches). No timing asserts, so the runs take the portable loops (one
+compile per method, not one per model and method)."""
 
 import re
 import shutil
@@ -11,30 +13,35 @@ import numpy as np
 
 from lg_test_support import MODELS_DIR
 from lagrange_gen.cli.main import main
+from lagrange_gen.jit.portable import JIT_ENV
 
 
 def test_bench_contact_quick_writes_its_report(tmp_path, gen_dir, monkeypatch):
     models = tmp_path / "models"
     models.mkdir()
-    for stem in ("bouncing_ball", "rocking_block"):
+    for stem in ("bouncing_ball", "rocking_block", "puck_on_table"):
         shutil.copy(MODELS_DIR / f"{stem}.py", models)
     (tmp_path / "generated").symlink_to(gen_dir)
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(JIT_ENV, "portable")
     assert main(["bench", "contact", "--quick", "--no-progress", "--models", "models",
                  "--reports", "reports"]) == 0
     text = (tmp_path / "reports" / "contact.md").read_text()
     assert text.startswith("# Contact and impacts: work-precision")
-    assert "## Bouncing ball" in text and "## Rocking block" in text
+    assert "## Bouncing ball" in text and "## Rocking block" in text and "## Puck" in text
     assert "Siconos" in text
     rows = re.findall(r"\| dop853_impacts \| \S+ \| \S+ \| (\S+) \|", text)
-    assert len(rows) == 4
+    assert len(rows) == 6
     assert float(rows[0]) <= 1e-9                 # the ball: exact parabolas, located impacts
     assert float(rows[3]) <= 1e-6                 # the block at rtol 1e-8
-    assert len(re.findall(r"\| moreau_jean \|", text)) == 4
-    # spook_contacts at the same steps: each run's error below the ball's drop height and the
-    # block's energy fraction (an order-1 method at h = t_end / 100 and / 50)
+    assert max(float(rows[4]), float(rows[5])) <= 1e-9      # the puck: a located stop
+    assert len(re.findall(r"\| moreau_jean \|", text)) == 6
+    # spook_contacts at the same steps (an order-1 method at h = t_end / 100 and / 50): each
+    # run's error below the ball's drop height, the block's energy fraction and a tenth of the
+    # puck's sliding distance (0.68 m)
     spook = [float(x) for x in re.findall(r"\| spook_contacts \| \S+ \| \S+ \| (\S+) \|", text)]
-    assert len(spook) == 4 and max(spook[:2]) < 1.0 and max(spook[2:]) < 0.5
+    assert len(spook) == 6 and max(spook[:2]) < 1.0 and max(spook[2:4]) < 0.5
+    assert max(spook[4:]) < 0.068
     figure = tmp_path / "reports" / "contact_precision.png"
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert float(np.ptp(mpimg.imread(figure)[..., :3])) > 0.0       # not a blank image

@@ -37,7 +37,7 @@ def test_summary_of_an_event_driven_bouncing_ball(generated, capsys):
     assert float(first.group(2)) == pytest.approx((2 / 9.81) ** 0.5, abs=1e-10)
     assert float(first.group(3)) == pytest.approx((1 + 0.8) * (2 * 9.81) ** 0.5, rel=1e-5)  # 6 digits
     balance = re.search(r"max \|E - E0 - W\| = (\S+) \(E0 = 9.81, W the work of the contact "
-                        r"impulses, final W = (\S+)\)", out)
+                        r"impulses and of the persistent contacts' forces, final W = (\S+)\)", out)
     assert balance, out
     assert float(balance.group(1)) <= 1e-11 * 9.81
     # at rest from the Zeno time (2.7 s) on: all of m g h0 went into the impacts

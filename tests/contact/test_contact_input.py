@@ -20,6 +20,14 @@ def test_a_good_contact_is_accepted():
     assert model.n_contacts == 1 and model.contacts[0].name == "contact_0"
 
 
+def test_rheonomic_gaps_and_slip_pairs_are_accepted():
+    """A moving surface (gap and slips depending on t) and a pair of slip velocities (3D)."""
+    model = _ball(gap=lambda y: y - sp.sin(t), friction=0.3,
+                  slip=lambda y: (y.d - sp.cos(t), 2 * y.d))
+    contact = model.contacts[0]
+    assert len(contact.slips) == 2 and contact.slip == contact.slips
+
+
 @pytest.mark.parametrize("contact, message", [
     (dict(restitution=-0.1), r"contact contact_0: restitution must be in \[0, 1\], got -0.1"),
     (dict(restitution=1.5), r"restitution must be in \[0, 1\], got 1.5"),
@@ -27,7 +35,13 @@ def test_a_good_contact_is_accepted():
     (dict(friction=0.3), r"friction 0.3 without a tangent: give slip="),
     (dict(gap=sp.Integer(2)), r"the gap 2 does not depend on any coordinate \(y\)"),
     (dict(gap=lambda y: y.d), r"the gap y_dot depends on velocities"),
-    (dict(gap=lambda y: y - t), r"depends on t; rheonomic gaps"),
+    (dict(gap=lambda y: sp.sin(t)), r"the gap sin\(t\) does not depend on any coordinate \(y\)"),
+    (dict(friction=0.3, slip=lambda y: (y.d,)), r"slip must be one slip velocity \(2D\) or a "
+                                                r"pair \(u1, u2\) \(3D\), got 1 of them"),
+    (dict(friction=0.3, slip=lambda y: (y.d, y.d, y.d)), r"or a pair \(u1, u2\) \(3D\), got 3"),
+    (dict(friction=0.3, slip=lambda y: (y.d, y * y.d**2)), r"the slip y\*y_dot\*\*2 is not linear"),
+    (dict(friction=0.3, slip=lambda y: (y.d, y)), r"the slip y does not depend on any velocity"),
+    (dict(friction=0.3, slip=()), r"got 0 of them"),
     (dict(friction=0.3, slip=lambda y: y.d**2), r"the slip y_dot\*\*2 is not linear"),
     (dict(friction=0.3, slip=lambda y: y), r"the slip y does not depend on any velocity"),
 ])

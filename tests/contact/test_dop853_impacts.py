@@ -170,3 +170,27 @@ def test_settings_are_checked(generated):
     with pytest.raises(SimulationError, match="zeno_interval"):
         simulate(generated("bouncing_ball"), method="dop853_impacts", q0=[H0], v0=[0.0],
                  t_end=1.0, zeno_interval=-1.0)
+
+
+def test_zeno_guard_survives_the_drivers_chunks(generated, monkeypatch):
+    """The driver calls the glue again when its row buffers fill (run/adaptive_driver.py): with
+    buffers of 4 rows the impacts near the accumulation time fall in different calls. The
+    guard's memory (the saved last_impact) crosses them: the ball still comes to rest within
+    the bracket of test_ball_comes_to_rest_at_the_accumulation_time, after the same impacts
+    as in one call. Without it each call would forget the last impact and the ball would
+    bounce on until rest_velocity stopped it, far more impacts later."""
+    from lagrange_gen.run import adaptive_driver
+    module = generated("bouncing_ball")
+    whole = simulate(module, method="dop853_impacts", q0=[H0], v0=[0.0], t_end=T_INF + 0.1,
+                     params={"g": G, "e": E}, zeno_interval=DELTA)
+    monkeypatch.setattr(adaptive_driver, "FIRST_ROWS", 4)
+    monkeypatch.setattr(adaptive_driver, "CHUNK_ROWS", 4)
+    chunked = simulate(module, method="dop853_impacts", q0=[H0], v0=[0.0], t_end=T_INF + 0.1,
+                       params={"g": G, "e": E}, zeno_interval=DELTA)
+    rows = _impact_rows(chunked)
+    assert chunked.saved["impacts"][-1, 0] == whole.saved["impacts"][-1, 0]
+    t_rest = chunked.t[rows[-1]]
+    assert T_INF - DELTA * E / (1 - E) <= t_rest <= T_INF - DELTA * E**2 / (1 - E)
+    assert t_rest == pytest.approx(whole.t[_impact_rows(whole)[-1]], abs=1e-12)
+    last = chunked.saved["last_impact"][-1, 0]
+    assert last == t_rest and whole.saved["last_impact"][0, 0] == -np.inf

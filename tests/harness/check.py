@@ -51,7 +51,7 @@ CONTRACT = {
     "elements_hessian": (("q", "we", "p"), (("out_mat", "nn"),), ("hess_w",)),
     "events": (_QQTP, (("out", "g"),), ("events",)),
     # only a model with unilateral contacts has it
-    "contacts": (("q", "t", "p"), (("gap", "c"), ("WN", "cn"), ("WT", "cn"), ("coef", "c2")),
+    "contacts": (("q", "t", "p"), (("gap", "c"), ("WN", "cn"), ("WT", "2cn"), ("coef", "c2")),
                  ("contact_gap", "contact_WN", "contact_WT", "contact_coef")),
     # only a model with velocity constraints has them (constraint_gamma_dq: with holonomic ones too)
     "nonholonomic": (_QQTP, (("A", "rn"), ("b", "r"), ("gamma", "r")), ("nh_A", "nh_b", "nh_gamma")),
@@ -61,7 +61,8 @@ CONTRACT = {
                         ("nh_dAw", "nh_dATmu", "nh_dc", "nh_dgamma_dq", "nh_dgamma_dqd")),
     "constraint_gamma_dq": (_QQTP, (("dgamma_dq", "mn"), ("dgamma_dqd", "mn")),
                             ("gamma_dq", "gamma_dqd")),
-    "contact_rates": (_QQTP, (("out", "2c"),), ("contact_rate",)),
+    "contact_rates": (_QQTP, (("out", "3c"),), ("contact_rate",)),
+    "contact_bias": (("q", "t", "p"), (("out", "3c"),), ("contact_bias",)),
     # the kernels of a module generated from bodies (README, Robots); qdd is the State's w
     "inverse_dynamics": (("q", "qd", "qdd", "t", "p"), (("tau", "n"),), ("tau_id",)),
     "gravity_forces": (("q", "t", "p"), (("out", "n"),), ("gravity",)),
@@ -70,7 +71,7 @@ CONTRACT = {
 #: the kernels only a module generated from bodies has (tests/harness/test_spatial_trees.py)
 BODY_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
 #: the kernels only a module of a model with unilateral contacts has
-CONTACT_KERNELS = ("contacts", "contact_rates")
+CONTACT_KERNELS = ("contacts", "contact_bias", "contact_rates")
 #: the kernels only a module of a model with velocity constraints has
 NONHOLONOMIC_KERNELS = ("nonholonomic", "nonholonomic_dq", "constraint_gamma_dq")
 
@@ -156,7 +157,8 @@ ACCUMULATING = {"transport", "transport_dq"}
 def _shape(key, n, m, ne, ng=0, nc=0, nr=0):
     return {"n": (n,), "nn": (n, n), "m": (m,), "mn": (m, n), "e": (ne,), "en": (ne, n),
             "e3": (ne, 3), "g": (ng,), "P": (2 * n + 2,), "c": (nc,), "cn": (nc, n),
-            "c2": (nc, 2), "2c": (2 * nc,), "r": (nr,), "rn": (nr, n)}[key]
+            "c2": (nc, 2), "2c": (2 * nc,), "2cn": (2 * nc, n), "3c": (3 * nc,), "r": (nr,),
+            "rn": (nr, n)}[key]
 
 
 def call_kernel(kern, name, state, sizes):

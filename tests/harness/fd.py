@@ -65,11 +65,18 @@ def check_derivatives(mod, kern, state, sizes, mode):
         WN = value("contacts", "contact_WN", state)
         fd = derivative(lambda q: value("contacts", "contact_gap", at_q(q)), state.q)
         out.append(_compare("contacts", "WN", WN, fd, mode))
-        if "contact_rates" in names:        # d/ds [W(q + s qd) qd] at s = 0
-            W_at = lambda q: np.vstack((value("contacts", "contact_WN", at_q(q)),     # noqa: E731
-                                        value("contacts", "contact_WT", at_q(q))))
-            along = derivative(lambda s: W_at(state.q + s[0] * state.qd) @ state.qd,
-                               np.zeros(1))[:, 0]
+        if "contact_bias" in names:         # its normal rows are dg/dt
+            gap_dt = derivative(lambda s: value("contacts", "contact_gap",
+                                                _with(state, t=state.t + s[0])), np.zeros(1))[:, 0]
+            out.append(_compare("contact_bias", "out", value("contact_bias", "contact_bias",
+                                                             state)[:len(gap_dt)], gap_dt, mode))
+        if "contact_rates" in names:        # d/ds [W(q + s qd, t + s) qd + b(q + s qd, t + s)]
+            def local_at(s):
+                moved = _with(state, q=state.q + s[0] * state.qd, t=state.t + s[0])
+                W = np.vstack((value("contacts", "contact_WN", moved),
+                               value("contacts", "contact_WT", moved)))
+                return W @ state.qd + value("contact_bias", "contact_bias", moved)
+            along = derivative(local_at, np.zeros(1))[:, 0]
             out.append(_compare("contact_rates", "out", value("contact_rates", "contact_rate",
                                                                state), along, mode))
     return [f for f in out if f]

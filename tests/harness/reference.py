@@ -39,7 +39,8 @@ def _jumps_settled(expr):
 _ELEMENT_KIND = {"saint_venant": 0, "dry_friction": 1}
 #: Column quantities returned as 1-D arrays, like the kernels' vector outputs.
 VECTORS = {"rhs", "momentum_rate", "forces", "dT_dqd", "Phi", "Phi_t", "gamma", "s", "events",
-           "power", "b", "tau_id", "gravity", "bias", "contact_gap", "contact_rate", "nh_b",
+           "power", "b", "tau_id", "gravity", "bias", "contact_gap", "contact_rate", "contact_bias",
+           "contact_slips", "nh_b",
            "nh_gamma"}
 
 
@@ -194,15 +195,30 @@ class Reference:
     def _contact_WN(self):
         return self.expr("contact_gap").jacobian(self.q)
 
+    def _contact_slips(self):
+        """The slip velocities (2c,): every contact's first, then every contact's second (0
+        where a contact has fewer)."""
+        pairs = []
+        for _, _, _, slip in self.drawn.contacts:
+            slips = () if slip is None else (slip if isinstance(slip, tuple) else (slip,))
+            pairs.append(tuple(slips) + (0,) * (2 - len(slips)))
+        return _vector([p[0] for p in pairs] + [p[1] for p in pairs])
+
     def _contact_WT(self):
-        """Rows d slip/d qd; zero for a frictionless contact without a slip velocity."""
-        slips = _vector([slip if slip is not None else 0 for _, _, _, slip in self.drawn.contacts])
-        return slips.jacobian(self.qd)
+        """Rows d slip/d qd (2c, n): tangent 1 of each contact, then tangent 2 (zero rows where
+        a contact has no such slip velocity)."""
+        return self.expr("contact_slips").jacobian(self.qd)
+
+    def _contact_bias(self):
+        """(dg/dt, the slips at qd = 0) (3c,): local velocities are W qd + these."""
+        slips = self.expr("contact_slips").subs({v: 0 for v in self.qd})
+        return self.expr("contact_gap").diff(t).col_join(slips)
 
     def _contact_rate(self):
-        """(dW_N/dt qd, dW_T/dt qd): d(W qd)/dq qd with W = [W_N; W_T]."""
-        local = self.expr("contact_WN").col_join(self.expr("contact_WT")) * self.qd
-        return local.jacobian(self.q) * self.qd
+        """d(W qd + bias)/dq qd + d(W qd + bias)/dt (3c,) with W = [W_N; W_T]."""
+        local = (self.expr("contact_WN").col_join(self.expr("contact_WT")) * self.qd
+                 + self.expr("contact_bias"))
+        return local.jacobian(self.q) * self.qd + local.diff(t)
 
     def _contact_coef(self):
         rows = [[restitution, friction] for _, restitution, friction, _ in self.drawn.contacts]

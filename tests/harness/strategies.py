@@ -255,25 +255,40 @@ def _elements(g):
 
 
 def _contacts(g):
-    """One or two unilateral contacts: a gap g(q) from the grammar minus a constant, restitution
-    k / (k + k') in (0, 1) or a number in [0, 1], and either no friction or friction k with a
-    slip velocity sum_i f_i(q) qd_i (f_i from the grammar, some zero)."""
+    """One or two unilateral contacts: a gap g(q) from the grammar minus a constant, plus, for a
+    moving surface, a constant times a function of t; restitution k / (k + k') in (0, 1) or a
+    number in [0, 1]; and either no friction or friction k with one slip velocity (2D) or a pair
+    (3D), each sum_i f_i(q) qd_i (f_i from the grammar, some zero) plus, for a moving surface,
+    a term times a function of t."""
     out = []
-    speeds = [c.d for c in g.coords]
     for _ in range(g.draw(st.integers(1, 2))):
         gap = g.term() - g.pick(COEFFS)
+        if g.draw(st.booleans()):
+            gap += g.pick(COEFFS) * g.pick(TIME)(g.pick(g.params))
         if g.draw(st.booleans()):
             a, b = g.pick(g.params), g.pick(g.params)
             restitution = a / (a + b)          # in (0, 1) for positive a, b (the same a twice)
         else:
             restitution = g.pick([sp.Integer(0), sp.Rational(1, 2), sp.Integer(1)])
         friction, slip = sp.S.Zero, None
-        if g.draw(st.booleans()):
+        tangents = g.draw(st.integers(0, 2))
+        if tangents:
             friction = g.param()
-            slip = sp.Add(*[g.factor() * v for v in speeds if g.draw(st.booleans())])
-            slip = slip if slip != 0 else g.pick(COEFFS) * speeds[0]
+            slips = tuple(_slip_velocity(g) for _ in range(tangents))
+            slip = slips[0] if tangents == 1 else slips
         out.append((gap, restitution, friction, slip))
     return out
+
+
+def _slip_velocity(g):
+    """sum_i f_i(q) qd_i (some f_i zero, one at least), plus a term times a function of t or
+    not."""
+    speeds = [c.d for c in g.coords]
+    slip = sp.Add(*[g.factor() * v for v in speeds if g.draw(st.booleans())])
+    slip = slip if slip != 0 else g.pick(COEFFS) * speeds[0]
+    if g.draw(st.booleans()):
+        slip += g.term() * g.pick(TIME)(g.pick(g.params))
+    return slip
 
 
 def _nonholonomic(g):

@@ -8,7 +8,7 @@ use the momentum rate, as verlet's and midpoint's do) get the composed dynamics 
 momentum_rate_jacobian,
 constant-H models the rhs kernel and the pre-factored forward dynamics,
 constrained models the constraint kernels, models with elements the element kernels, models
-with unilateral contacts the contacts kernel (gap, W_N, W_T, coefficients) and contact_rates,
+with unilateral contacts the contacts kernel (gap, W_N, W_T, coefficients), contact_bias and contact_rates,
 models with velocity constraints the nonholonomic kernels (A, b, gamma and their derivatives;
 with holonomic constraints too, d gamma/dq of those);
 test_every_kernel_kind_was_checked asserts it. Profiles: profiles.py.
@@ -107,7 +107,7 @@ def _expected_kinds():
         kinds.add(f"{name}[composed]")
     kinds |= {f"fd:{name}" for name in ("rhs_jacobian", "momentum_rate_jacobian", "mass_matvec_dq",
                                         "constraints", "constraint_dq", "elements", "elements_hessian",
-                                        "contacts", "contact_rates")}
+                                        "contacts", "contact_bias", "contact_rates")}
     return kinds
 
 

@@ -1,6 +1,6 @@
 """`lagrange-gen bench contact`: work-precision of the contact methods against closed forms.
 
-Two cases, each with an error measured against a closed form:
+Three cases, each with an error measured against a closed form:
 
 * bouncing ball (models/bouncing_ball.py, h0 = 1, e = 0.8, g = 9.81) at t_end = 3, in the
   flight after the 6th impact: max(|y - y_exact|, |v - v_exact|) at t_end, the exact motion
@@ -11,6 +11,10 @@ Two cases, each with an error measured against a closed form:
   r = (1 - 3/2 sin^2 alpha)^2 of the kinetic energy at phi = 0, so
   (E(t) - m g c) / (E0 - m g c) = r^k after k impacts; the error is that ratio's distance
   from r^3.
+
+* puck on a table (models/puck_on_table.py, the 3D friction cone: mu = 0.3, launched at 2 m/s
+  at 0.6 rad from the x axis) at t_end = 1, at rest since V0 / (mu g) = 0.68: the distance of
+  (x, y) from the stop point V0^2 / (2 mu g) along the launch direction.
 
 Methods: the fixed-step moreau_jean and spook_contacts (h = t_end / (n0 2^k) each) and
 dop853_impacts (rtol sweep, atol = rtol / 100).
@@ -93,6 +97,16 @@ def _rocking_error(traj):
     return abs(ratio - rocking_ratio(ROCK_IMPACTS))
 
 
+PUCK_SPEED, PUCK_ANGLE, PUCK_MU = 2.0, 0.6, 0.3
+
+
+def _puck_error(traj):
+    """Distance of the puck's final (x, y) from where Coulomb's disk stops it."""
+    reach = PUCK_SPEED**2 / (2 * PUCK_MU * G)
+    return math.hypot(traj.q[-1, 0] - reach * math.cos(PUCK_ANGLE),
+                      traj.q[-1, 1] - reach * math.sin(PUCK_ANGLE))
+
+
 CASES = (
     Case("bouncing_ball", "Bouncing ball (e = 0.8), t = 3 after 6 impacts", (1.0,), (0.0,), 3.0,
          (("g", G), ("e", 0.8)), _ball_error, "max(|y - y_exact|, |v - v_exact|) at t_end"),
@@ -100,6 +114,10 @@ CASES = (
          rocking_start(), (0.0, 0.0, 0.0), 1.5,
          (("g", G), ("b", B), ("c", C), ("e", 0.0), ("mu", 1.0), ("a_ground", 0.0)),
          _rocking_error, "|(E - m g c) / (E0 - m g c) - r^3| at t_end"),
+    Case("puck_on_table", "Puck on a table (3D friction cone, mu = 0.3), t = 1 after its stop",
+         (0.0, 0.0, 0.0), (PUCK_SPEED * math.cos(PUCK_ANGLE), PUCK_SPEED * math.sin(PUCK_ANGLE),
+                           0.0), 1.0, (("g", G), ("mu", PUCK_MU)), _puck_error,
+         "distance of (x, y) at t_end from the stop point V0^2 / (2 mu g) along v0"),
 )
 
 

@@ -187,10 +187,13 @@ def _summary(traj):
     contact_work = traj.saved.get("contact_work")
     if contact_work is not None:     # impacts and friction: E changes by the impulses' work
         work = contact_work[:, 0] + (traj.work if traj.work is not None else 0.0)
-        forces = " and of the forces" if traj.work is not None else ""
+        # event-driven runs hold persistent contacts by forces, whose work W also counts
+        what = ("the contact impulses and of the persistent contacts' forces"
+                if "impacts" in traj.saved else "the contact impulses")
+        forces = " and of the other forces" if traj.work is not None else ""
         balance = float(abs(traj.energy_error - work).max())
-        print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of the "
-              f"contact impulses{forces}, final W = {work[-1]:.6g})")
+        print(f"max |E - E0 - W| = {balance:.3e} (E0 = {traj.energy[0]:.9g}, W the work of "
+              f"{what}{forces}, final W = {work[-1]:.6g})")
         impacts = traj.impacts
         if "impacts" in traj.saved:      # event-driven: the located impacts
             shown = ", ".join(f"t = {row['t']:.9g} (contact {row['contact']}, p_N = "

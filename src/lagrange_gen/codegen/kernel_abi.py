@@ -53,9 +53,10 @@ ARGUMENTS = {
     "bias_forces": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                     ("out", ("n",))),
     "contacts": (("q", ("n",)), ("t", None), ("p", ("n_params",)), ("gap", ("c",)), ("WN", ("c", "n")),
-                 ("WT", ("c", "n")), ("coef", ("c", "two"))),
+                 ("WT", ("c2", "n")), ("coef", ("c", "two"))),
+    "contact_bias": (("q", ("n",)), ("t", None), ("p", ("n_params",)), ("out", ("c3",))),
     "contact_rates": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
-                      ("out", ("c2",))),
+                      ("out", ("c3",))),
     "nonholonomic": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                      ("A", ("r", "n")), ("b", ("r",)), ("gamma", ("r",))),
     "nonholonomic_dq": (("q", ("n",)), ("qd", ("n",)), ("w", ("n",)), ("mu", ("r",)), ("t", None),
@@ -76,14 +77,15 @@ ARGUMENTS = {
 def kernel_dimensions(namespace):
     """{dimension name: size} of a generated module from its constants (``namespace``: its
     globals): n, m, n_params, ne, n_events, n_inputs, n_outputs, power (2 n + 2: power, the
-    work rate and its parts), c (contacts), c2 (2 c: normal and tangent rows), r (nonholonomic constraints), two (the columns of a
+    work rate and its parts), c (contacts), c2 (2 c: the tangent rows), c3 (3 c: normal, tangent 1
+    and tangent 2 rows), r (nonholonomic constraints), two (the columns of a
     contact's coefficients) and three (the columns of an element's coefficients)."""
     n = namespace["N_COORDS"]
     return dict(n=n, m=namespace.get("N_CONSTRAINTS", 0), n_params=namespace["N_PARAMS"],
                 ne=namespace.get("N_ELEMENTS", 0), n_events=namespace.get("N_EVENTS", 0),
                 n_inputs=namespace.get("N_INPUTS", 0), n_outputs=namespace.get("N_OUTPUTS", 0),
                 c=namespace.get("N_CONTACTS", 0), r=namespace.get("N_NONHOLONOMIC", 0),
-                c2=2 * namespace.get("N_CONTACTS", 0), power=2 * n + 2, two=2, three=3)
+                c2=2 * namespace.get("N_CONTACTS", 0), c3=3 * namespace.get("N_CONTACTS", 0), power=2 * n + 2, two=2, three=3)
 
 
 def argument_shapes(kernel, dimensions):

@@ -29,7 +29,8 @@ def module_docstring(dyn, source_rel, methods, why=None, texts=()) -> str:
         lines += [f"    {i}: {e.name} ({e.kind}) on s = {sp.sstr(e.strain)}, coef = "
                   f"({', '.join(sp.sstr(c) for c in e.coefficients())})" for i, e in enumerate(m.elements)]
     if dyn.n_contacts:
-        lines.append("Contacts gap(q) >= 0 (index in gap / rows of WN, WT, coef):")
+        lines.append("Contacts gap(q, t) >= 0 (index in gap / rows of WN, coef; WT rows i and "
+                     "c + i):")
         lines += [f"    {i}: {c.name}: gap = {sp.sstr(c.gap)}, slip = {sp.sstr(c.slip)}, "
                   f"restitution = {sp.sstr(c.restitution)}, friction = {sp.sstr(c.friction)}"
                   for i, c in enumerate(m.contacts)]

@@ -176,19 +176,25 @@ def robot_kernels(dyn) -> dict:
 
 
 def contact_kernels(dyn) -> dict:
-    """The ``contacts`` and ``contact_rates`` kernels of a model with unilateral contacts ({}
-    without any)."""
+    """The ``contacts``, ``contact_bias`` and ``contact_rates`` kernels of a model with unilateral
+    contacts ({} without any); local rows (normal (c), tangent 1 (c), tangent 2 (c))."""
     if not dyn.n_contacts:
         return {}
     nat = dyn.native
     return {"contact_rates": lambda: KernelSpec(
         "contact_rates", ["q", "qd", "t", "p"], [Output("out", nat["contact_rate"])],
-        doc="(dW_N/dt qd, dW_T/dt qd) (2c,): the local accelerations are W qdd + these"),
+        doc="(3c,): the local accelerations are W qdd + these (dW/dt qd and a moving surface's "
+            "time derivatives)"),
+            "contact_bias": lambda: KernelSpec(
+        "contact_bias", ["q", "t", "p"], [Output("out", nat["contact_bias"])],
+        doc="(dg/dt, b_T1, b_T2) (3c,): the local velocities are W qd + these (a moving surface; "
+            "zero for fixed ones)"),
             "contacts": lambda: KernelSpec(
         "contacts", ["q", "t", "p"],
         [Output("gap", nat["contact_gap"]), Output("WN", nat["contact_WN"]),
          Output("WT", nat["contact_WT"]), Output("coef", nat["contact_coef"])],
-        doc="unilateral contacts: gaps g (c,), W_N = dg/dq (c, n), W_T = d slip/d qd (c, n), "
+        doc="unilateral contacts: gaps g (c,), W_N = dg/dq (c, n), W_T = d slip/d qd (2c, n: "
+            "tangent 1 rows, then tangent 2), "
             "coef (c, 2) = (restitution, friction)")}
 
 

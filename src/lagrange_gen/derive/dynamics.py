@@ -21,7 +21,7 @@ from .recursive import recursive_dynamics
 #: Fields readable as sympy objects (converted from the backend's native objects on first read).
 FIELDS = ("H", "h", "g", "Q", "rhs", "dTdq", "momentum_rate", "E", "Phi", "J", "gamma", "Phi_t", "b", "db", "power",
           "elem_s", "elem_grad", "elem_coef", "elem_hess_w",
-          "contact_gap", "contact_WN", "contact_WT", "contact_coef", "contact_rate", "nh_A", "nh_b", "nh_gamma")
+          "contact_gap", "contact_WN", "contact_WT", "contact_coef", "contact_bias", "contact_rate", "nh_A", "nh_b", "nh_gamma")
 
 
 class Dynamics:
@@ -34,8 +34,9 @@ class Dynamics:
     rhs = Q - h - g (smooth forces only: nonsmooth element forces are the steppers' business).
     Elements (ne of them): elem_s (ne, 1), elem_grad (ne, n), elem_coef (ne, 3),
     elem_hess_w (n, n). Contacts (c of them): contact_gap (c, 1), contact_WN = d gap/dq (c, n),
-    contact_WT = d slip/d qdot (c, n), contact_coef (c, 2) = (restitution, friction),
-    contact_rate (2c, 1) = (dW_N/dt qdot, dW_T/dt qdot).
+    contact_WT = d slip/d qdot (2c, n) (tangent 1 rows, then tangent 2), contact_coef (c, 2) =
+    (restitution, friction), contact_bias (3c, 1) (local velocities u = W qdot + bias: a moving
+    surface's terms), contact_rate (3c, 1) (du/dt = W qddot + contact_rate); derive/contacts.py.
     Nonholonomic constraints (r of them, A qdot + b = 0, forces A^T mu): nh_A (r, n), nh_b
     (r, 1), nh_gamma (r, 1) with A qddot = gamma along a motion (derive/nonholonomic.py).
     ``momentum_rate`` = dL/dq + Q_nc is dp/dt for the canonical momentum

@@ -44,4 +44,6 @@ def _freeze_element(element, sub):
     for key, value in vars(element).items():
         if isinstance(value, sp.Basic):
             setattr(out, key, value.xreplace(sub))
+        elif isinstance(value, tuple) and all(isinstance(v, sp.Basic) for v in value):
+            setattr(out, key, tuple(v.xreplace(sub) for v in value))
     return out

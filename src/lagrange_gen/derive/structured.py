@@ -114,7 +114,7 @@ def graph_model(model, expand_all=False):
     for c in getattr(model, "contacts", ()):
         c = copy.copy(c)
         c.gap = expand_intermediates(c.gap)
-        c.slip = None if c.slip is None else expand_intermediates(c.slip)
+        c.slips = tuple(expand_intermediates(u) for u in c.slips)
         out.contacts.append(c)
     out.outputs = {k: expand_intermediates(y) for k, y in model.outputs.items()}
     return out

@@ -52,9 +52,10 @@ class Model:
         linear in the velocities (or an sp.Eq): rolling without slipping, knife edges
         (model/nonholonomic.py); stepped by the methods for nonholonomic models.
     elements : nonsmooth elements (SaintVenant, DryFriction) acting on strains s(q).
-    contacts : unilateral contacts Contact(gap=g(q), restitution=e, friction=mu, slip=u_T):
-        g >= 0 with impacts (Newton's law) and Coulomb friction on the slip velocity u_T
-        (model/contacts.py); stepped by moreau_jean.
+    contacts : unilateral contacts Contact(gap=g(q, t), restitution=e, friction=mu, slip=u_T
+        or (u_T1, u_T2)): g >= 0 with impacts (Newton's law) and Coulomb friction on the slip
+        velocity (2D) or the pair of them (3D cone) (model/contacts.py); stepped by moreau_jean
+        and dop853_impacts.
     events : {name: g} with g(q, qdot, t) an expression, or Event(g, terminal=, direction=):
         simulate locates the zero crossings of each g and records them (steppers/core/events.py).
     prescribed : {Coordinate: expression of t and parameters}: coordinates whose motion is
@@ -136,7 +137,7 @@ class Model:
             e.expr = e.expr.xreplace(sub)
         for c in self.contacts:
             c.gap = c.gap.xreplace(sub)
-            c.slip = None if c.slip is None else c.slip.xreplace(sub)
+            c.slips = tuple(u.xreplace(sub) for u in c.slips)
         self.outputs = {k: y.xreplace(sub) for k, y in self.outputs.items()}
         self._prescribed_sub = sub
 
@@ -240,8 +241,8 @@ class Model:
         out = named_contacts(self.name, self._sequence(contacts, "contacts", "Contact"))
         for c in out:
             c.gap = self._scalar(c.gap, f"gap of contact {c.name}", replace)
-            if c.slip is not None:
-                c.slip = self._scalar(c.slip, f"slip of contact {c.name}", replace)
+            c.slips = tuple(self._scalar(u, f"slip of contact {c.name}", replace)
+                            for u in c.slips)
             c.restitution = self._scalar(c.restitution, f"restitution of contact {c.name}", {})
             c.friction = self._scalar(c.friction, f"friction of contact {c.name}", {})
         return out
@@ -270,8 +271,8 @@ class Model:
                 yield f"coefficient of element {e.name}", c
         for c in self.contacts:
             yield f"gap of contact {c.name}", c.gap
-            if c.slip is not None:
-                yield f"slip of contact {c.name}", c.slip
+            for u in c.slips:
+                yield f"slip of contact {c.name}", u
             for k in c.coefficients():
                 yield f"coefficient of contact {c.name}", k
 
@@ -323,7 +324,7 @@ class Model:
             e.expr = expand_intermediates(e.expr)
         for c in self.contacts:
             c.gap = expand_intermediates(c.gap)
-            c.slip = None if c.slip is None else expand_intermediates(c.slip)
+            c.slips = tuple(expand_intermediates(u) for u in c.slips)
         self.outputs = {k: expand_intermediates(y) for k, y in self.outputs.items()}
 
     def _inputs(self, given):

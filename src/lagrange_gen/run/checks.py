@@ -208,7 +208,7 @@ def contact_coefficients(module, p, q):
     """coef (c, 2) = (restitution, friction) of the generated ``contacts`` kernel at q (n,);
     they depend on parameters only (model/contacts.py checks that)."""
     nc, n = module.N_CONTACTS, module.N_COORDS
-    gap, WN, WT, coef = np.empty(nc), np.empty((nc, n)), np.empty((nc, n)), np.empty((nc, 2))
+    gap, WN, WT, coef = np.empty(nc), np.empty((nc, n)), np.empty((2 * nc, n)), np.empty((nc, 2))
     module.contacts(np.ascontiguousarray(q, dtype=np.float64), 0.0, np.ascontiguousarray(p, dtype=np.float64), gap, WN, WT,
                     coef)
     return coef

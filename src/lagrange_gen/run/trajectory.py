@@ -111,19 +111,22 @@ class Trajectory:
         """The impacts of an event-driven contact run (dop853_impacts, which saves the
         cumulative ``impacts`` and impulse sums and writes a row after each impact): one row per
         impact and contact that took an impulse, fields t, contact (index in the model's
-        CONTACTS), normal, tangent (the impulses). With t_eval the rows after impacts are not
+        CONTACTS), normal, tangent, tangent2 (the impulses; tangent2 along a 3D contact's second
+        tangent, else 0). With t_eval the rows after impacts are not
         written: then a row stands for the impacts since the previous one. Empty for other runs."""
         dtype = [("t", np.float64), ("contact", np.int64), ("normal", np.float64),
-                 ("tangent", np.float64)]
+                 ("tangent", np.float64), ("tangent2", np.float64)]
         count = self.saved.get("impacts")
         if count is None:
             return np.zeros(0, dtype=dtype)
         normal = np.diff(self.saved["normal_impulse_sum"], axis=0)
         tangent = np.diff(self.saved["tangent_impulse_sum"], axis=0)
+        second = self.saved.get("tangent2_impulse_sum")
+        tangent2 = np.zeros_like(tangent) if second is None else np.diff(second, axis=0)
         rows = []
         for k in np.flatnonzero(np.diff(count[:, 0]) > 0):
-            for c in np.flatnonzero((normal[k] != 0) | (tangent[k] != 0)):
-                rows.append((self.t[k + 1], c, normal[k, c], tangent[k, c]))
+            for c in np.flatnonzero((normal[k] != 0) | (tangent[k] != 0) | (tangent2[k] != 0)):
+                rows.append((self.t[k + 1], c, normal[k, c], tangent[k, c], tangent2[k, c]))
         return np.array(rows, dtype=dtype)
 
     def to_npz(self, path):

@@ -18,7 +18,7 @@ tangents per contact, rows t c + a); every loop here runs over n_rows and finds 
 row k as k % c, so it holds for any number of tangents per contact.
 
 The saved contact fields (moreau_jean's, spook_contacts' SPEC.saved, CONTACT_SAVED): active
-contacts (1), the impulses r (n_rows: normal, then tangent), the smallest gap at the end of the
+contacts (1), the impulses r (n_rows = 3c: normal, tangent 1, tangent 2), the smallest gap at the end of the
 step (1), the cumulated work of the contact impulses (1); then the constrained methods' fields
 (core/constrained.py) for a model with holonomic constraints: multipliers (m), max|Phi| and
 max|J v + dPhi/dt| (1 each, absent without constraints).
@@ -33,7 +33,7 @@ from .constrained import max_abs_jv
 #: The saved fields of a contact method (see the module docstring; width "m1": 1 with
 #: holonomic constraints, 0 without).
 CONTACT_SAVED = (("active_contacts", 1), ("normal_impulse", "c"), ("tangent_impulse", "c"),
-                 ("min_gap", 1), ("contact_work", 1), ("multipliers", "m"),
+                 ("tangent2_impulse", "c"), ("min_gap", 1), ("contact_work", 1), ("multipliers", "m"),
                  ("constraint_error", "m1"), ("velocity_constraint_error", "m1"))
 
 

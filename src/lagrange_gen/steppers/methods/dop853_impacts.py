@@ -1,33 +1,44 @@
 """Event-driven stepping of unilateral contacts: dop853 between switches, Newton's impact law at
 located impacts, persistent contacts held at the acceleration level, a Zeno guard.
 
-Each contact a is in one mode: FREE (its gap g_a(q) > 0 may close) or persistent (g_a = 0 held,
-the contact force lambda_N >= 0 watched), and a persistent one with friction STICKs (u_T = 0,
-|lambda_T| <= mu lambda_N) or SLIDEs (lambda_T = -mu lambda_N sign(u_T)). Between switches the
-motion is smooth: dop853's tableau, error control and dense output (dop853.attempt_on,
-accept_on, dense_on) on the acceleration
+Each contact a is in one mode: FREE (its gap g_a(q, t) > 0 may close) or persistent (g_a = 0
+held, the contact force lambda_N >= 0 watched), and a persistent one with friction STICKs
+(u_T = 0, |lambda_T| <= mu lambda_N) or slides: with one tangent SLIDE_POSITIVE /
+SLIDE_NEGATIVE (lambda_T = -mu lambda_N sign(u_T)); with two (the 3D cone) SLIDE, the force
+lambda_T = -mu lambda_N d along the current slip direction d = u_T / |u_T| of the pair
+(u_T1, u_T2), recomputed at every stage from the velocities (the path may curve). The local
+velocities are u = W v + b(q, t) (b: generated ``contact_bias``, a moving surface's velocity).
+Between switches the motion is smooth: dop853's tableau, error control and dense output
+(dop853.attempt_on, accept_on, dense_on) on the acceleration
 
-    M a = f + W^T lambda,   W a + Wdot v = 0 on the persistent rows (normal; tangent if sticking)
+    M a = f + W^T lambda,   W a + rate = 0 on the persistent rows (normal; tangent if sticking)
 
 with lambda from the contact problem at the acceleration level (core/contact_problem.py:
-BILATERAL normals, STICK or SLIDE tangents; Wdot v the generated ``contact_rates``).
+BILATERAL normals, STICK or SLIDE tangents; rate the generated ``contact_rates``, dW/dt v and a
+moving surface's time derivatives).
 
 Switches are zero crossings, located on the dense output by events.refine (Illinois), of one
 function per contact and direction (all falling through 0): FREE: the gap g_a; persistent:
-lambda_N (lift-off); STICK: mu lambda_N - |lambda_T| (slip starts); SLIDE: s u_T (the slip
-velocity reverses; s its sign). The step ends at the earliest one (adaptive.run_adaptive's
-switch_point / apply_switch hooks); the run goes on from there after ``classify``:
+lambda_N (lift-off); STICK: mu lambda_N - |lambda_T| (slip starts; |.| the pair's length in
+3D); SLIDE_*: s u_T (the slip velocity reverses; s its sign); SLIDE: s_ref . u_T with s_ref the
+slip direction at the step's start (|u_T| falls to zero where the slip stops; past it the
+force keeps the sign s_ref . u_T gives it, d = sign(s_ref . u_T) u_T / |u_T|, so that the
+motion stays smooth through the crossing and the root is a plain sign change). The step ends at
+the earliest one (adaptive.run_adaptive's switch_point / apply_switch hooks); the run goes on
+from there after ``classify``:
 
-1. Impact: the contacts touching (g <= gap_tol) and not separating (u_N <= rest_velocity)
-   take part; if one approaches (u_N < -rest_velocity), Newton's impact law with Coulomb
-   friction at the velocity level, u_N+ + e min(u_N-, 0) >= 0 _|_ p_N >= 0 (several
+1. Impact: the contacts touching (g <= gap_tol) and not separating (u_N <= rest_velocity,
+   u_N = W_N v + dg/dt the velocity relative to the surface) take part; if one approaches
+   (u_N < -rest_velocity), Newton's impact law with Coulomb friction (interval or disk) at the
+   velocity level, u_N+ + e min(u_N-, 0) >= 0 _|_ p_N >= 0 (several
    simultaneous contacts: one problem, the same projected Gauss-Seidel as moreau_jean), and
    v+ = v- + M^-1 W^T p.
    Zeno guard: a contact whose previous impact was less than zeno_interval ago gets e = 0 in
    this impact (an accumulation of impacts, t_k -> t_inf, ends there in a plastic one).
 2. Modes: a touching contact with |u_N| <= rest_velocity is persistent if its force at the
    acceleration level is positive (else FREE); with friction it sticks if |u_T| <= rest_velocity
-   and the sticking force fits the cone (else it slides, away from the sticking force). The
+   and the sticking force fits the cone (else it slides, away from the sticking force; a
+   moving one slides along u_T). The
    velocities are then projected onto the persistent rows (u_N = 0; u_T = 0 when sticking) by
    the same solver, so that rest stays rest.
 
@@ -37,19 +48,23 @@ level, so it drifts by the integration error (rtol, atol).
 
 Reported (SPEC.saved, c = kern.N_CONTACTS), cumulative since t0 except the modes: ``impacts``
 (1) the impacts so far, ``normal_impulse_sum``, ``tangent_impulse_sum`` (c) the impulses of
-the impacts and projections summed per contact, ``contact_mode`` (c) FREE 0, STICK 1,
-SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, ``contact_work`` (1) the work of the impulses,
-r . (u- + u+) / 2, plus that of the persistent contacts' forces, their power lambda . (W v)
-integrated like W (dop853.py): its values at the stages, the tableau's sum over a step and the
-dense output's integral over a step that ends at a switch (order 8, 7). E - E0 - contact_work is then the balance for conservative forces;
-forces that do work (kern.WORK) add W, which dop853's functions step with the state (W' = P at
-the stages, see dop853.py) and which a switch leaves as it is: E - E0 - W - contact_work. Row 0
+the impacts and projections summed per contact (``tangent2_impulse_sum`` (c) the second
+tangent's), ``contact_mode`` (c) FREE 0, STICK 1, SLIDE_POSITIVE 2, SLIDE_NEGATIVE 3, SLIDE 4,
+``contact_work`` (1) the work of the impulses, r . (W v- + W v+) / 2, plus that of the
+persistent contacts' forces, their power lambda . (W v) integrated like W (dop853.py): its
+values at the stages, the tableau's sum over a step and the dense output's integral over a step
+that ends at a switch (orders 8 and 7: a curving 3D slide or a moving surface to the method's
+accuracy). E - E0 - contact_work is then the balance for conservative forces; forces that do
+work (kern.WORK) add W, which dop853's functions step with the state (W' = P at the stages, see
+dop853.py) and which a switch leaves as it is: E - E0 - W - contact_work. Row 0
 is the state after the start's classification (an impact at t0 is in the impulse sums); the
 work counts from it. In every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
 
-A run continued in chunks reclassifies the contacts at each chunk's start; the Zeno guard's
-memory of the last impact time does not cross chunks.
+``last_impact`` (c) is each contact's latest impact time (-inf before its first): the Zeno
+guard's memory. A run continued in chunks (run/adaptive_driver.py) reclassifies the contacts
+at each chunk's start and takes that memory back from the saved fields, so the guard acts the
+same whatever the chunk boundaries.
 
 Over 300 lines: the switching functions, the classification at a switch (impact, modes,
 projection) and the work accounting read and write one workspace and one ``extra`` layout, so
@@ -64,8 +79,9 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import events
-from ..core.contact_problem import (BILATERAL, COULOMB, SLIDE_NEGATIVE, SLIDE_POSITIVE, STICK,
-                                    UNILATERAL, contact_row, delassus, gauss_seidel)
+from ..core.contact_problem import (BILATERAL, COULOMB, SLIDE, SLIDE_NEGATIVE, SLIDE_POSITIVE,
+                                    STICK, UNILATERAL, contact_row, delassus,
+                                    gauss_seidel_sliding)
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.options import FAST
@@ -82,7 +98,8 @@ DENSE_EVALS = dop853.DENSE_EVALS
 #: A switch writes the state before it and the state after it (every-step mode).
 ROWS_PER_STEP = 2
 
-#: Saved-field offsets in ``extra`` (c contacts): impacts, normal sums, tangent sums, modes, work.
+#: Saved-field offsets in ``extra`` (c contacts): impacts, normal sums, tangent 1 and tangent 2
+#: sums, modes, work.
 IMPACTS = 0
 
 
@@ -103,23 +120,27 @@ class Settings(NamedTuple):
 
 #: dop853's fields (its functions read them by name, the work's included), then, c contacts: M (n, n) the mass
 #: matrix (LU-factored), f (n,) rhs, s (n,) scratch, piv (n,) pivots, acc (n,) scratch
-#: acceleration; g (c,), WN, WT (c, n), coef (c, 2) = (e, mu), rate (2c,) = Wdot v; r (2c,)
-#: forces or impulses, uf (2c,) free local velocities/accelerations, zero (c,) zeros, un (c,)
+#: acceleration; g (c,), WN (c, n), WT (2c, n), coef (c, 2) = (e, mu), rate (3c,) (contact_rates),
+#: bias (3c,) (contact_bias); r (3c,) forces or impulses, uf (3c,) free local
+#: velocities/accelerations, zero (c,) zeros, un (c,)
 #: normal velocities before an impact; mode (c,) int; law (2c,) int (acceleration level),
 #: impact_law (2c,) zeros (UNILATERAL / COULOMB); persistent (c,) and touching (c,) 0/1 flags;
-#: coef_impact (c, 2); last_impact (c,) times; Y (2c, n), D (2c, 2c) (contact_problem);
+#: coef_impact (c, 2); last_impact (c,) times; Y (3c, n), D (3c, 3c) (contact_problem);
 #: switch values at the step's start and end and at trial times sw_prev, sw_new (2c,) with
 #: the events workspace sw (refine's); power (2,) = [at the last evaluation, at the step's
 #: start]; contact_stages (16, 1) that power at the stages of the step, stage_at (1,) the
 #: stage the next stage_acceleration evaluates, quad_F (7, 1), quad_ends (2,) scratch of its
-#: dense integral; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations and
-#: switching functions, and 1 while the start state is not classified yet; left_at (c,) the time a free contact was last touching (-inf: not
-#: since the step it cleared gap_tol).
+#: dense integral; solver (4,) = (contact_tol, max_sweeps, gap_tol) for the stage accelerations
+#: and switching functions, and 1 while the start state is not classified yet; left_at (c,) the
+#: time a free contact was last touching (-inf: not since the step it cleared gap_tol);
+#: bias (3c,) (contact_bias); slide_ref (2c,) the slip direction of a SLIDE contact at the
+#: step's start (pairs (slide_ref[a], slide_ref[c + a])), slide (2c,) the force's direction at
+#: the last evaluation.
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
                                     "v_old span pk w w_new w_old dense_w pw M f s piv acc g WN WT coef rate r uf zero un "
                                     "mode law impact_law persistent touching coef_impact "
                                     "last_impact Y D sw power contact_stages stage_at quad_F "
-                                    "quad_ends solver left_at")
+                                    "quad_ends solver left_at bias slide slide_ref")
 
 
 @njit
@@ -132,14 +153,16 @@ def workspace(kern, n):
     return Workspace(np.zeros((nd, n)), np.zeros((nd, n)), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)),
                      np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2),
-                     *dop853.work_fields(n), np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n, np.int64),
-                     np.zeros(n), np.zeros(c), np.zeros((c, n)), np.zeros((c, n)),
-                     np.zeros((c, 2)), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
+                     *dop853.work_fields(n), np.zeros((n, n)), np.zeros(n), np.zeros(n),
+                     np.zeros(n, np.int64),
+                     np.zeros(n), np.zeros(c), np.zeros((c, n)), np.zeros((2 * c, n)),
+                     np.zeros((c, 2)), np.zeros(3 * c), np.zeros(3 * c), np.zeros(3 * c),
                      np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
                      np.zeros(2 * c, np.int64), np.zeros(c), np.zeros(c), np.zeros((c, 2)),
-                     np.full(c, -np.inf), np.zeros((2 * c, n)), np.zeros((2 * c, 2 * c)), sw,
+                     np.full(c, -np.inf), np.zeros((3 * c, n)), np.zeros((3 * c, 3 * c)), sw,
                      np.zeros(2), np.zeros((nd, 1)), np.zeros(1, np.int64), np.zeros((7, 1)),
-                     np.zeros(2), np.zeros(4), np.full(c, -np.inf))
+                     np.zeros(2), np.zeros(4), np.full(c, -np.inf), np.zeros(3 * c),
+                     np.zeros(2 * c), np.zeros(2 * c))
 
 
 @njit(inline="always")
@@ -151,7 +174,7 @@ def _mass_and_rhs(kern, ws, q, v, t, p):
 
 @njit(inline="always")
 def _local(ws, k, c, x):
-    """W_k . x for row k of W (2c, n) (normal rows, then tangent rows)."""
+    """W_k . x for row k of W (3c, n) (normal rows, then tangent 1 and tangent 2 rows)."""
     w = contact_row(k, c, ws.WN, ws.WT)
     s = 0.0
     for i in range(x.shape[0]):
@@ -160,9 +183,67 @@ def _local(ws, k, c, x):
 
 
 @njit(inline="always")
+def _relative(ws, k, c, v):
+    """The local velocity of row k relative to the surface, W_k v + b_k (ws.bias at the
+    contacts' last evaluation)."""
+    return _local(ws, k, c, v) + ws.bias[k]
+
+
+@njit(inline="always")
+def _contacts_at(kern, ws, q, t, p):
+    """The contacts' gaps, Jacobians, coefficients and surface terms at (q, t) into ws."""
+    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    kern.contact_bias(q, t, p, ws.bias)
+
+
+@njit(inline="always")
+def _has_pair(ws, a, c):
+    """True when contact a has a second tangent (a non-zero tangent 2 row): the 3D cone."""
+    w = ws.WT[c + a]
+    for i in range(w.shape[0]):
+        if w[i] != 0.0:
+            return True
+    return False
+
+
+@njit(inline="always")
+def _slip(ws, a, c, v):
+    """(u_T1, u_T2) of contact a at velocity v, relative to the surface."""
+    return _relative(ws, c + a, c, v), _relative(ws, 2 * c + a, c, v)
+
+
+@njit(inline="always")
+def _slide_directions(ws, c, v):
+    """ws.slide: for each SLIDE contact the unit direction of its slip at v, oriented by
+    sign(s_ref . u_T) (module docstring); s_ref itself where the slip is zero."""
+    for a in range(c):
+        if ws.mode[a] != SLIDE:
+            continue
+        u1, u2 = _slip(ws, a, c, v)
+        r1, r2 = ws.slide_ref[a], ws.slide_ref[c + a]
+        along = r1 * u1 + r2 * u2
+        size = np.sqrt(u1 * u1 + u2 * u2)
+        if along == 0.0 or size == 0.0:
+            ws.slide[a], ws.slide[c + a] = r1, r2
+        else:
+            sign = 1.0 if along > 0.0 else -1.0
+            ws.slide[a], ws.slide[c + a] = sign * u1 / size, sign * u2 / size
+
+
+@njit(inline="always")
+def _set_slide_ref(ws, a, c, d1, d2):
+    """Contact a slides along (d1, d2) (normalized here; tangent 1 when it is zero)."""
+    size = np.sqrt(d1 * d1 + d2 * d2)
+    if size == 0.0:
+        d1, d2, size = 1.0, 0.0, 1.0
+    ws.slide_ref[a], ws.slide_ref[c + a] = d1 / size, d2 / size
+    ws.slide[a], ws.slide[c + a] = d1 / size, d2 / size
+
+
+@njit(inline="always")
 def _apply(ws, c, flags, r, x):
     """x (n,) += sum_k Y_k r_k over the rows of the contacts flagged."""
-    for k in range(2 * c):
+    for k in range(3 * c):
         if flags[k % c] != 0.0:
             for i in range(x.shape[0]):
                 x[i] += ws.Y[k, i] * r[k]
@@ -184,19 +265,21 @@ def contact_acceleration(kern, ws, q, v, t, p, a):
         n_persistent += int(ws.persistent[k])
     if n_persistent == 0:
         return OK
-    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    _contacts_at(kern, ws, q, t, p)
     kern.contact_rates(q, v, t, p, ws.rate)
     delassus(c, n, ws.persistent, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
-    for k in range(2 * c):
+    for k in range(3 * c):
         ws.r[k] = 0.0
         ws.uf[k] = _local(ws, k, c, a) + ws.rate[k] if ws.persistent[k % c] != 0.0 else 0.0
-    converged, _, _ = gauss_seidel(c, ws.solver[0], int(ws.solver[1]), ws.persistent, ws.law,
-                                   ws.coef, ws.zero, ws.uf, ws.D, ws.r)
+    _slide_directions(ws, c, v)
+    converged, _, _ = gauss_seidel_sliding(c, ws.solver[0], int(ws.solver[1]), ws.persistent,
+                                           ws.law, ws.coef, ws.zero, ws.uf, ws.D, ws.r,
+                                           ws.slide)
     if not converged:
         return CONTACT_NOT_CONVERGED
     _apply(ws, c, ws.persistent, ws.r, a)
     power = 0.0
-    for k in range(2 * c):
+    for k in range(3 * c):
         if ws.persistent[k % c] != 0.0:
             power += ws.r[k] * _local(ws, k, c, v)
     ws.power[0] = power
@@ -229,24 +312,28 @@ def event_values(kern, ws, q, v, t, p, out):
     sign change; g / (t - t_s) is positive until the landing, where it crosses 0 with g."""
     c = kern.N_CONTACTS
     status = contact_acceleration(kern, ws, q, v, t, p, ws.acc)
-    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    _contacts_at(kern, ws, q, t, p)
     for a in range(c):
         out[c + a] = 1.0
         if ws.mode[a] == FREE:
             out[a] = ws.g[a]
             if ws.left_at[a] == t:
-                out[a] = _local(ws, a, c, v)
+                out[a] = _relative(ws, a, c, v)
             elif ws.left_at[a] > -np.inf:
                 out[a] = ws.g[a] / (t - ws.left_at[a])
             continue
         out[a] = ws.r[a] if status == OK else 0.0
         if ws.coef[a, 1] > 0.0:
             if ws.mode[a] == STICK:
-                out[c + a] = ws.coef[a, 1] * ws.r[a] - abs(ws.r[c + a])
+                out[c + a] = ws.coef[a, 1] * ws.r[a] - np.sqrt(ws.r[c + a] ** 2
+                                                               + ws.r[2 * c + a] ** 2)
+            elif ws.mode[a] == SLIDE:
+                u1, u2 = _slip(ws, a, c, v)
+                out[c + a] = ws.slide_ref[a] * u1 + ws.slide_ref[c + a] * u2
             elif ws.mode[a] == SLIDE_POSITIVE:
-                out[c + a] = _local(ws, c + a, c, v)
+                out[c + a] = _relative(ws, c + a, c, v)
             else:
-                out[c + a] = -_local(ws, c + a, c, v)
+                out[c + a] = -_relative(ws, c + a, c, v)
     return status
 
 
@@ -301,7 +388,13 @@ advance = dop853.advance
 @njit(inline="always")
 def _work_at(c):
     """Index of contact_work in extra."""
-    return 1 + 3 * c
+    return 1 + 4 * c
+
+
+@njit(inline="always")
+def _last_impact_at(c):
+    """Index of last_impact (c) in extra."""
+    return 2 + 4 * c
 
 
 @njit(**FAST)
@@ -325,6 +418,12 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
         ws.power[1] = ws.power[0]
         for k in range(2 * c):
             sw.g_prev[k] = sw.g_new[k]
+        for a in range(c):           # a slide's reference: its slip direction at the new start
+            if ws.mode[a] == SLIDE:
+                u1, u2 = _slip(ws, a, c, ws.v_new)
+                if u1 * ws.slide_ref[a] + u2 * ws.slide_ref[c + a] > 0.0:
+                    _set_slide_ref(ws, a, c, u1, u2)
+                    sw.g_prev[c + a] = np.sqrt(u1 * u1 + u2 * u2)
         for a in range(c):           # clear of the surface: the plain gap from here on
             if ws.left_at[a] > -np.inf and ws.g[a] > ws.solver[2]:
                 ws.left_at[a] = -np.inf
@@ -384,20 +483,22 @@ def _impact(kern, ws, v, t, settings, extra):
     for a in range(c):
         ws.coef_impact[a, 0] = ws.coef[a, 0]
         ws.coef_impact[a, 1] = ws.coef[a, 1]
-        ws.un[a] = _local(ws, a, c, v)
+        ws.un[a] = _relative(ws, a, c, v)
         if ws.touching[a] != 0.0 and t - ws.last_impact[a] < settings.zeno_interval:
             ws.coef_impact[a, 0] = 0.0
-    for k in range(2 * c):
+    for k in range(3 * c):
         ws.r[k] = 0.0
-        ws.uf[k] = _local(ws, k, c, v) if ws.touching[k % c] != 0.0 else 0.0
-    converged, _, _ = gauss_seidel(c, settings.contact_tol, settings.max_sweeps, ws.touching,
-                                   ws.impact_law, ws.coef_impact, ws.un, ws.uf, ws.D, ws.r)
+        ws.uf[k] = _relative(ws, k, c, v) if ws.touching[k % c] != 0.0 else 0.0
+    converged, _, _ = gauss_seidel_sliding(c, settings.contact_tol, settings.max_sweeps,
+                                           ws.touching, ws.impact_law, ws.coef_impact, ws.un,
+                                           ws.uf, ws.D, ws.r, ws.slide)
     if not converged:
         return CONTACT_NOT_CONVERGED
     _record_impulses(kern, ws, ws.touching, v, extra)
     for a in range(c):
         if ws.touching[a] != 0.0 and ws.r[a] > 0.0:
             ws.last_impact[a] = t
+            extra[_last_impact_at(c) + a] = t
     extra[IMPACTS] += 1.0
     return OK
 
@@ -408,11 +509,11 @@ def _record_impulses(kern, ws, flags, v, extra):
     r . (u- + u+) / 2 into extra."""
     c = kern.N_CONTACTS
     work = 0.0
-    for k in range(2 * c):
+    for k in range(3 * c):
         if flags[k % c] != 0.0:
             work += 0.5 * ws.r[k] * _local(ws, k, c, v)
     _apply(ws, c, flags, ws.r, v)
-    for k in range(2 * c):
+    for k in range(3 * c):
         if flags[k % c] != 0.0:
             work += 0.5 * ws.r[k] * _local(ws, k, c, v)
             extra[1 + k] += ws.r[k]
@@ -426,16 +527,22 @@ def _set_modes(kern, ws, q, v, t, p, settings):
     status."""
     c = kern.N_CONTACTS
     for a in range(c):
-        rest = ws.touching[a] != 0.0 and abs(_local(ws, a, c, v)) <= settings.rest_velocity
+        rest = ws.touching[a] != 0.0 and abs(_relative(ws, a, c, v)) <= settings.rest_velocity
         ws.persistent[a] = 1.0 if rest else 0.0
         ws.mode[a] = FREE
         ws.law[a] = BILATERAL
         ws.law[c + a] = STICK
         if rest:
-            ut = _local(ws, c + a, c, v)
             ws.mode[a] = STICK
-            if ws.coef[a, 1] > 0.0 and abs(ut) > settings.rest_velocity:
-                ws.mode[a] = SLIDE_POSITIVE if ut > 0.0 else SLIDE_NEGATIVE
+            if _has_pair(ws, a, c):
+                u1, u2 = _slip(ws, a, c, v)
+                if ws.coef[a, 1] > 0.0 and np.sqrt(u1 * u1 + u2 * u2) > settings.rest_velocity:
+                    ws.mode[a] = SLIDE
+                    _set_slide_ref(ws, a, c, u1, u2)
+            else:
+                ut = _relative(ws, c + a, c, v)
+                if ws.coef[a, 1] > 0.0 and abs(ut) > settings.rest_velocity:
+                    ws.mode[a] = SLIDE_POSITIVE if ut > 0.0 else SLIDE_NEGATIVE
             ws.law[c + a] = ws.mode[a]
     status = OK
     for _ in range(2 * c + 1):          # each pass frees or starts sliding one contact at least
@@ -448,9 +555,14 @@ def _set_modes(kern, ws, q, v, t, p, settings):
                 continue
             if ws.r[a] <= 0.0:
                 ws.persistent[a], ws.mode[a], changed = 0.0, FREE, True
-            elif ws.mode[a] == STICK and abs(ws.r[c + a]) > ws.coef[a, 1] * ws.r[a]:
+            elif ws.mode[a] == STICK and (np.sqrt(ws.r[c + a] ** 2 + ws.r[2 * c + a] ** 2)
+                                          > ws.coef[a, 1] * ws.r[a]):
                 # it slides away from the sticking force
-                ws.mode[a] = SLIDE_POSITIVE if ws.r[c + a] < 0.0 else SLIDE_NEGATIVE
+                if _has_pair(ws, a, c):
+                    ws.mode[a] = SLIDE
+                    _set_slide_ref(ws, a, c, -ws.r[c + a], -ws.r[2 * c + a])
+                else:
+                    ws.mode[a] = SLIDE_POSITIVE if ws.r[c + a] < 0.0 else SLIDE_NEGATIVE
                 ws.law[c + a], changed = ws.mode[a], True
         if not changed:
             break
@@ -465,12 +577,17 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     status."""
     n, c = kern.N_COORDS, kern.N_CONTACTS
     work_before = extra[_work_at(c)]
+    if ws.solver[3] != 0.0:        # a call's start: the Zeno guard's memory from extra
+        for a in range(c):
+            if extra[IMPACTS] == 0.0:      # none yet (extra starts at zeros)
+                extra[_last_impact_at(c) + a] = -np.inf
+            ws.last_impact[a] = extra[_last_impact_at(c) + a]
     if not _mass_and_rhs(kern, ws, q, v, t, p):
         return SINGULAR_MASS
-    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    _contacts_at(kern, ws, q, t, p)
     approaching = False
     for a in range(c):
-        un = _local(ws, a, c, v)
+        un = _relative(ws, a, c, v)
         touching = ws.g[a] <= settings.gap_tol and un <= settings.rest_velocity
         ws.touching[a] = 1.0 if touching else 0.0
         approaching = approaching or (touching and un < -settings.rest_velocity)
@@ -487,14 +604,15 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     if n_persistent > 0:     # rest stays rest: u_N = 0 (and u_T = 0 sticking) on the velocities
         if not _mass_and_rhs(kern, ws, q, v, t, p):
             return SINGULAR_MASS
-        kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+        _contacts_at(kern, ws, q, t, p)
         delassus(c, n, ws.persistent, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
-        for k in range(2 * c):
+        for k in range(3 * c):
             ws.r[k] = 0.0
-            ws.uf[k] = _local(ws, k, c, v) if ws.persistent[k % c] != 0.0 else 0.0
-        converged, _, _ = gauss_seidel(c, settings.contact_tol, settings.max_sweeps,
-                                       ws.persistent, ws.law, ws.coef, ws.zero, ws.uf, ws.D,
-                                       ws.r)
+            ws.uf[k] = _relative(ws, k, c, v) if ws.persistent[k % c] != 0.0 else 0.0
+        _slide_directions(ws, c, v)
+        converged, _, _ = gauss_seidel_sliding(c, settings.contact_tol, settings.max_sweeps,
+                                               ws.persistent, ws.law, ws.coef, ws.zero, ws.uf,
+                                               ws.D, ws.r, ws.slide)
         if not converged:
             return CONTACT_NOT_CONVERGED
         _record_impulses(kern, ws, ws.persistent, v, extra)
@@ -502,7 +620,7 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
         extra[_work_at(c)] = work_before
         ws.solver[3] = 0.0
     for a in range(c):
-        extra[1 + 2 * c + a] = ws.mode[a]
+        extra[1 + 3 * c + a] = ws.mode[a]
         ws.left_at[a] = t if ws.mode[a] == FREE and ws.g[a] <= settings.gap_tol else -np.inf
     status = event_values(kern, ws, q, v, t, p, ws.sw.g_prev)
     ws.power[1] = ws.power[0]
@@ -522,10 +640,12 @@ SPEC = Spec(
             "persistent contacts and stick-slip switches, Zeno guard",
     settings=Settings,
     saved=(("impacts", 1), ("normal_impulse_sum", "c"), ("tangent_impulse_sum", "c"),
-           ("contact_mode", "c"), ("contact_work", 1)),
+           ("tangent2_impulse_sum", "c"), ("contact_mode", "c"), ("contact_work", 1),
+           ("last_impact", "c")),
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False),
             "zeno_interval": (0.0, True, False), "gap_tol": (0.0, True, False),
             "rest_velocity": (0.0, True, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
-    kernels=("contacts", "contact_rates", "dynamics", "forward_dynamics", "power"))
+    kernels=("contacts", "contact_bias", "contact_rates", "dynamics", "forward_dynamics",
+             "power"))

@@ -8,25 +8,29 @@ C = d rhs/dv at the start of the step, the linearized theta method is
     A (v+ - v) = h f + h^2 theta K v + W r,        A = M - h theta C - h^2 theta^2 K
     q+ = q + h ((1 - theta) v + theta v+)
 
-with W = [W_N^T, W_T^T] (n, 2c) the contact Jacobians at q (generated ``contacts``: gaps g,
-W_N = dg/dq, W_T = d slip/d qdot) and r = (p_N, p_T) the impulses. For a model whose forces are
+with W = [W_N^T, W_T^T] (n, 3c) the contact Jacobians at q (generated ``contacts``: gaps g,
+W_N = dg/dq, W_T = d slip/d qdot, two tangent rows per contact) and r = (p_N, p_T1, p_T2) the
+impulses. The local velocities are u = W v + b(t) (b: generated ``contact_bias``, what a moving
+surface adds; u- takes it at t, u+ at t + h). For a model whose forces are
 constant (gravity) the smooth part is exact: v+ = v + h a, q+ = q + h v + h^2 a / 2 at
 theta = 1/2.
 
 Contacts in the step: those whose gap closes at the end of the step without contact impulses,
-to first order: g(q) + h W_N ((1 - theta) v + theta v_free) <= 0 (the index set; the free
+to first order: g(q) + h ((1 - theta) u_N- + theta u_N,free) <= 0 (the index set; the free
 velocity, not v alone, so that a contact at rest with g = +1e-19 after rounding stays in it
 instead of leaving for a step of free fall). On them, with u = W v+ = u_free + D r, u_free = W v_free,
 v_free = v + A^-1 (h f + h^2 theta K v) and the Delassus operator D = W A^-1 W^T:
 
-    Newton's impact law:  u_N + e min(u_N-, 0) >= 0  _|_  p_N >= 0   (u_N- = W_N v, restitution e;
-                          a contact already opening at the step's start gets u_N >= 0)
-    Coulomb (2D):         p_T in [-mu p_N, mu p_N], p_T = -mu p_N sign(u_T) when u_T != 0
+    Newton's impact law:  u_N + e min(u_N-, 0) >= 0  _|_  p_N >= 0   (u_N- = W_N v + b_N(t),
+                          restitution e; a contact already opening at the step's start gets
+                          u_N >= 0)
+    Coulomb:              |p_T| <= mu p_N, p_T = -mu p_N u_T / |u_T| when u_T != 0 (the disk of
+                          (p_T1, p_T2) in 3D, the interval with one tangent)
 
 solved by projected Gauss-Seidel (core/contact_problem.py, shared with dop853_impacts), contact
 by contact:
-p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then p_T <- clamp(p_T - u_T / D_TT, -mu p_N, mu p_N),
-until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
+p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then the tangent impulse projected onto
+the interval (2D) or the disk (3D), until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
 (CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
 impulse that zeroes u_T: no creep.
 
@@ -40,17 +44,17 @@ act on the constrained motion: D = W K^-1 W^T (core/contact_kkt.py), and the con
 impulses follow the contact impulses exactly. The multipliers saved are lam = nu / h.
 
 Order 1 (impacts located to within a step). theta = 1/2 (default) is energy-neutral in free
-flight; the work of the contact impulses per step is r . (u- + u+) / 2 with u- = W v, u+ = W v+
-(the kinetic energy change an impulse causes), and for forces that do not depend on q and v
+flight; the work of the contact impulses per step is r . (W v + W v+) / 2 (the kinetic energy
+change an impulse causes; the surface's own velocity b is not part of it), and for forces that do not depend on q and v
 (the bouncing ball, the block on a ramp) E - E0 - W_contact = 0 to rounding at theta = 1/2.
 Positions may go below the gap by O(h |u_N|) at an impact (the impulse acts on velocities);
 ``min_gap`` reports it. No Newton: one LU of K per step.
 
 ``extra`` (SPEC.saved, core/contact_kkt.CONTACT_SAVED), c = kern.N_CONTACTS: active contacts
-(1), normal impulses p_N (c), tangential impulses p_T (c), the smallest gap at the end of the
-step (1), the cumulated work of the contact impulses (1); with holonomic constraints the
-multipliers (m), max|Phi| and max|J v + dPhi/dt| at the end of the step. The step returns
-(status, sweeps, last sweep's largest change).
+(1), normal impulses p_N (c), tangential impulses p_T1 (c), p_T2 (c) (zero with one tangent),
+the smallest gap at the end of the step (1), the cumulated work of the contact impulses (1);
+with holonomic constraints the multipliers (m), max|Phi| and max|J v + dPhi/dt| at the end of
+the step. The step returns (status, sweeps, last sweep's largest change).
 """
 
 from collections import namedtuple
@@ -69,16 +73,18 @@ from ..core.method_spec import Spec
 from ..core.solve import failed_solve_status
 from ..core.status import CONTACT_NOT_CONVERGED, OK
 
-#: Scratch of one run (n coordinates, m constraints, c contacts, N = n + m, R = n_rows). x the
+#: Scratch of one run (n coordinates, m constraints, c contacts, N = n + m, R = 3c rows). x the
 #: unknown (v+ - v, nu), then (v+, nu) (N,); solver scratch s and pivots piv (N,); the
 #: iteration matrix K (N, N) (LU-factored in place); (n,): rhs f; (n, n): H, d rhs/dq Jq,
-#: d rhs/dv Jqd; phi, gam (m,), G (m, n); (c,): gaps g, normal velocities before the step un,
-#: active flag of each contact; W_N (c, n), W_T (R - c, n) and their copies padded to N columns
-#: WNp, WTp; coef (c, 2) = (e, mu); (R,): impulses r = (p_N, p_T), free local velocities uf,
-#: law (every contact UNILATERAL / COULOMB, core/contact_problem.py); Y (R, N) the rows
-#: K^-1 [W^T; 0]; D (R, R) the Delassus matrix.
+#: d rhs/dv Jqd; phi, gam (m,), G (m, n); (c,): gaps g, relative normal velocities before the
+#: step un, active flag of each contact; W_N (c, n), W_T (2c, n) and their copies padded to N
+#: columns WNp, WTp; coef (c, 2) = (e, mu); (R,): impulses r = (p_N, p_T1, p_T2), free local
+#: velocities uf, law (every contact UNILATERAL / COULOMB, core/contact_problem.py), the surface
+#: terms b at t (bias) and t + h (bias_end); Y (R, N) the rows K^-1 [W^T; 0]; D (R, R) the
+#: Delassus matrix.
 Workspace = namedtuple("Workspace",
-                       "x s piv K f H Jq Jqd phi gam G g un active WN WT WNp WTp coef r uf law Y D")
+                       "x s piv K f H Jq Jqd phi gam G g un active WN WT WNp WTp coef r uf law Y D "
+                       "bias bias_end")
 
 
 class MoreauJeanSettings(NamedTuple):
@@ -94,14 +100,15 @@ class MoreauJeanSettings(NamedTuple):
 def workspace(kern, n):
     """Allocated once per run by run_loop.run_loop."""
     m, c = kern.N_CONSTRAINTS, kern.N_CONTACTS
-    N, T = n + m, c                   # T: the rows of W_T, one tangent per contact
+    N, T = n + m, 2 * c               # T: the rows of W_T, two tangents per contact
     R = c + T
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),
                      np.zeros(n), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
                      np.zeros(m), np.zeros(m), np.zeros((m, n)), np.zeros(c), np.zeros(c),
                      np.zeros(c), np.zeros((c, n)), np.zeros((T, n)), np.zeros((c, N)),
                      np.zeros((T, N)), np.zeros((c, 2)), np.zeros(R), np.zeros(R),
-                     np.zeros(R, np.int64), np.zeros((R, N)), np.zeros((R, R)))
+                     np.zeros(R, np.int64), np.zeros((R, N)), np.zeros((R, R)), np.zeros(R),
+                     np.zeros(R))
 
 
 @njit(**FAST)
@@ -146,18 +153,20 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     for i in range(n):
         x[i] += v[i]                                   # x = (v_free, nu_free)
     kern.contacts(q, t, p, ws.g, WN, WT, ws.coef)
+    kern.contact_bias(q, t, p, ws.bias)
+    kern.contact_bias(q, t + h, p, ws.bias_end)
     pad_rows(n, WN, WT, ws.WNp, ws.WTp)
     n_active = 0
     for a in range(c):
-        un = row_dot(a, c, WN, WT, v, n)
-        ufn = row_dot(a, c, WN, WT, x, n)
+        un = row_dot(a, c, WN, WT, v, n) + ws.bias[a]
+        ufn = row_dot(a, c, WN, WT, x, n) + ws.bias_end[a]
         ws.un[a] = un
         ws.uf[a] = ufn
         # the gap the step reaches without contact impulses (first order in h)
         ws.active[a] = 1.0 if ws.g[a] + h * ((1.0 - theta) * un + theta * ufn) <= 0.0 else 0.0
         n_active += int(ws.active[a])
     for k in range(c, R):
-        ws.uf[k] = row_dot(k, c, WN, WT, x, n)
+        ws.uf[k] = row_dot(k, c, WN, WT, x, n) + ws.bias_end[k]
     for k in range(R):
         ws.r[k] = 0.0
     sweeps, change = 0, 0.0
@@ -190,4 +199,5 @@ SPEC = Spec(
     limits={"theta": (0.0, False, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
     settings=MoreauJeanSettings,
-    kernels=("constraint_rate", "constraints", "contacts", "dynamics", "rhs_jacobian"))
+    kernels=("constraint_rate", "constraints", "contact_bias", "contacts", "dynamics",
+             "rhs_jacobian"))

@@ -9,16 +9,19 @@ equality rows are spook's (its docstring):
     K [v+; nu] = [M v + h f; -(4/h) Upsilon Phi + Upsilon G v + (Upsilon - 1) dPhi/dt]
     K = [[M, -G^T], [G, Sigma I]],   Sigma = 4 epsilon / (h^2 (1 + 4 d)),   Upsilon = 1 / (1 + 4 d)
 
-and the contact impulses r = (p_N, p_T) add [W^T r; 0] to the right-hand side, q+ = q + h v+.
+and the contact impulses r = (p_N, p_T1, p_T2) add [W^T r; 0] to the right-hand side,
+q+ = q + h v+.
 The contacts in the step are those whose gap the step reaches without contact impulses is
-closed, g + h W_N v_free <= 0 (as in moreau_jean). On them, with u+ = W v+ (= u_free + D r,
-D = W K^-1 W^T the Delassus operator of the constrained motion, core/contact_kkt.py):
+closed, g + h u_N,free <= 0 (as in moreau_jean). On them, with u+ = W v+ + b(t + h)
+(= u_free + D r, D = W K^-1 W^T the Delassus operator of the constrained motion,
+core/contact_kkt.py; b the generated ``contact_bias``, what a moving surface adds):
 
     normal:   u_N+ + Sigma p_N + b  >= 0  _|_  p_N >= 0,
               b = min((4/h) Upsilon g - Upsilon u_N-,  e min(u_N-, 0))
-    friction: u_T+ + Sigma p_T = 0 where |p_T| < mu p_N, else p_T = -/+ mu p_N (Coulomb's box)
+    friction: u_T+ + Sigma p_T = 0 where |p_T| < mu p_N, else on the bound |p_T| = mu p_N
+              opposing the slip (the interval with one tangent, the disk with two)
 
-with u_N- = W_N v. The first term of b is spook's regularized, stabilized row of the gap (the
+with u_N- = W_N v + b_N(t). The first term of b is spook's regularized, stabilized row of the gap (the
 spring-damper limit: a penetration decays over about d steps instead of being removed in one,
 and with compliance epsilon > 0 the contact is a spring of stiffness 1/epsilon); the second is
 Newton's impact law on the approaching velocity (restitution e): the row takes whichever of
@@ -65,9 +68,11 @@ from ..core.status import CONTACT_NOT_CONVERGED, OK
 #: phi, gam (m,); G (m, n); g gaps (c,); WN (c, n), WT (R - c, n) and their padded copies WNp,
 #: WTp (N columns); coef (c, 2) = (e, mu); zero (c,) (Newton's law is folded into uf, so the
 #: solver's approach velocities are zeros); (R,): impulses r, free local velocities uf, law
-#: (every row UNILATERAL / COULOMB); active (c,); Y (R, N); D (R, R).
+#: (every row UNILATERAL / COULOMB), the surface terms b at t (bias) and t + h (bias_end);
+#: active (c,); Y (R, N); D (R, R).
 Workspace = namedtuple("Workspace",
-                       "x xs piv K f H phi gam G g WN WT WNp WTp coef zero r uf law active Y D")
+                       "x xs piv K f H phi gam G g WN WT WNp WTp coef zero r uf law active Y D "
+                       "bias bias_end")
 
 
 class SpookContactSettings(NamedTuple):
@@ -84,14 +89,14 @@ class SpookContactSettings(NamedTuple):
 def workspace(kern, n):
     """Allocated once per run by run_loop.run_loop."""
     m, c = kern.N_CONSTRAINTS, kern.N_CONTACTS
-    N, T = n + m, c                   # T: the rows of W_T, one tangent per contact
+    N, T = n + m, 2 * c               # T: the rows of W_T, two tangents per contact
     R = c + T
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),
                      np.zeros(n), np.zeros((n, n)), np.zeros(m), np.zeros(m),
                      np.zeros((m, n)), np.zeros(c), np.zeros((c, n)), np.zeros((T, n)),
                      np.zeros((c, N)), np.zeros((T, N)), np.zeros((c, 2)), np.zeros(c),
                      np.zeros(R), np.zeros(R), np.zeros(R, np.int64), np.zeros(c),
-                     np.zeros((R, N)), np.zeros((R, R)))
+                     np.zeros((R, N)), np.zeros((R, R)), np.zeros(R), np.zeros(R))
 
 
 @njit(**FAST)
@@ -134,17 +139,19 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         return failed_solve_status(K), 0, 0.0
     lu_solve_inplace(K, ws.piv, x, ws.xs)              # x = (v_free, nu_free)
     kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    kern.contact_bias(q, t, p, ws.bias)
+    kern.contact_bias(q, t + h, p, ws.bias_end)
     pad_rows(n, ws.WN, ws.WT, ws.WNp, ws.WTp)
     n_active = 0
     for a in range(c):
-        un = row_dot(a, c, ws.WN, ws.WT, v, n)
-        ufn = row_dot(a, c, ws.WN, ws.WT, x, n)
+        un = row_dot(a, c, ws.WN, ws.WT, v, n) + ws.bias[a]
+        ufn = row_dot(a, c, ws.WN, ws.WT, x, n) + ws.bias_end[a]
         ws.active[a] = 1.0 if ws.g[a] + h * ufn <= 0.0 else 0.0
         n_active += int(ws.active[a])
         stabilized = 4.0 / h * ups * ws.g[a] - ups * un
         ws.uf[a] = ufn + min(stabilized, ws.coef[a, 0] * min(un, 0.0))
     for k in range(c, R):
-        ws.uf[k] = row_dot(k, c, ws.WN, ws.WT, x, n)
+        ws.uf[k] = row_dot(k, c, ws.WN, ws.WT, x, n) + ws.bias_end[k]
     for k in range(R):
         ws.r[k] = 0.0
     sweeps, change = 0, 0.0
@@ -177,4 +184,4 @@ SPEC = Spec(
     limits={"compliance": (0.0, True, False), "relaxation": (0.0, False, False),
             "contact_tol": (0.0, False, False), "max_sweeps": (1, True, False)},
     settings=SpookContactSettings,
-    kernels=("constraint_rate", "constraints", "contacts", "dynamics"))
+    kernels=("constraint_rate", "constraints", "contact_bias", "contacts", "dynamics"))
