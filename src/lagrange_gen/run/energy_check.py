@@ -26,6 +26,7 @@ dependence with power as not; a model left undecided (every sample singular) get
 
 from __future__ import annotations
 
+import math
 import sys
 
 import numpy as np
@@ -47,8 +48,15 @@ def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
     """One line (str) or None. q, v (S, n), t (S,), energy (S,) of a finished unconstrained run,
     p (n_params,), h the step (an adaptive run: its mean step), advice what to change."""
     # max |E_k - E_0| = max(max E - E_0, E_0 - min E): rounding is monotone, so the same
-    # number as the largest rounded difference, from two reductions and no temporary array.
-    e0, high, low = float(energy[0]), float(energy.max()), float(energy.min())
+    # number as the largest rounded difference, without a temporary array; on a few rows in
+    # Python floats (a numpy reduction costs more than the comparisons it does).
+    if len(energy) <= FEW_ROWS:
+        values = energy.tolist()
+        if math.isnan(sum(values)):           # as numpy's max would: NaN, and no warning
+            return None
+        e0, high, low = values[0], max(values), min(values)
+    else:
+        e0, high, low = float(energy[0]), float(energy.max()), float(energy.min())
     err = max(high - e0, e0 - low)
     floor = 64 * sys.float_info.epsilon * max(abs(high), abs(low))
     if not err > floor:
