@@ -40,7 +40,9 @@ def fixed_step_trajectory(task, out, wall, compile_time):
     event stopped the run), energies, and the energy warning."""
     m, n, h, p = task.module, task.module.N_COORDS, task.h, task.p
     last, row = out["last"], out["rows"] - 1
-    out["t"][:row + 1] = task.t0 + h * task.save_every * np.arange(row + 1)
+    times = out["t"][:row + 1]          # t0 + k (h save_every), written in place
+    np.multiply(np.arange(row + 1), h * task.save_every, out=times)
+    times += task.t0
     steps = out["steps"]
     if steps % task.save_every or steps < task.n_steps:
         row += 1
