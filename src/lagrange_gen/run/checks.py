@@ -98,9 +98,9 @@ def vector(name, value, n, coords):
         raise SimulationError(f"{name} has {arr.shape[0]} entries but the model has {n} "
                               f"coordinates ({', '.join(coords)})")
     # A finite sum has finite terms (a NaN or an infinity makes the sum NaN or infinite): one
-    # reduction instead of two on the common finite vector; a sum that overflows is looked at
-    # entry by entry.
-    if not math.isfinite(arr.sum()) and not np.all(np.isfinite(arr)):
+    # sum instead of two numpy calls on the common finite vector; a sum that overflows is
+    # looked at entry by entry. In Python floats, which overflow without numpy's warning.
+    if not math.isfinite(sum(arr.tolist())) and not np.all(np.isfinite(arr)):
         raise SimulationError(f"{name} contains a non-finite value: {arr.tolist()}")
     return arr
 
