@@ -10,7 +10,9 @@ run/adaptive_driver.py; this module only checks inputs (run_checks: element coef
 time resolution, memory; the method's settings by its spec) and hands the finished run to
 run/run_result.py, which builds the Trajectory from the method's declared saved fields and warns
 when a conservative run lost its energy (run/energy_check.py). What a method is and which models it applies to is read from its spec
-(steppers/core/method_spec.py), never from its name.
+(steppers/core/method_spec.py), never from its name. What the module and the method alone fix
+(the method that runs, whether it applies, its saved fields, default settings and parameters)
+is worked out on the first call of the pair and kept (run/call_plan.py).
 """
 
 from __future__ import annotations
