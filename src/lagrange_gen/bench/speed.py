@@ -122,54 +122,60 @@ CALLS = (("midpoint, 1 step", "midpoint", {"t_end": 1e-3, "h": 1e-3}),
 def call_breakdown(mod, calls=2000):
     """Per CALLS row: median microseconds over ``calls`` warm calls of the whole lg.simulate
     call, of the stepping (Trajectory.wall_time: the jitted run and its chunk loop) and of the
-    stages around it, timed by wrapping the functions simulate calls (run/simulate.py's names,
-    restored afterwards): the driver (glue choice, buffers, the chunk loop), the Trajectory
-    (with the energy check), and resolving the model file's path for its source record."""
+    phases around it, timed by wrapping the functions simulate calls (run/simulate.py's and
+    run/run_result.py's names, restored afterwards): the output buffers (allocate), the driver
+    less the stepping (glue choice, the compile notice), the Trajectory less the energy check,
+    the energy check, the inputs and outputs (attach_inputs_outputs), and the checks and set-up
+    (the whole call less all of these: simulate's own checks, the method's plan, parameters).
+    Each phase is the median over the calls of its time in a call."""
     import statistics
     import time
+    from ..run import run_result
     from ..run import simulate as sim
-    stages = {"driver": ("integrate_fixed", "integrate_adaptive"),
-              "trajectory": ("fixed_step_trajectory", "adaptive_trajectory")}
-    times, saved = {stage: [] for stage in stages}, {}
+    wrapped = ((sim, "allocate", "buffers"), (sim, "integrate_fixed", "driver"),
+               (sim, "integrate_adaptive", "driver"), (sim, "fixed_step_trajectory", "trajectory"),
+               (sim, "adaptive_trajectory", "trajectory"), (run_result, "energy_warning", "energy"),
+               (sim, "attach_inputs_outputs", "io"))
+    spent, saved = {}, []
 
-    def timed(stage, fn):
+    def timed(phase, fn):
         def wrapper(*args, **kwargs):
             start = time.perf_counter()
             try:
                 return fn(*args, **kwargs)
             finally:
-                times[stage].append(time.perf_counter() - start)
+                spent[phase] = spent.get(phase, 0.0) + time.perf_counter() - start
         return wrapper
 
-    model_file = Path(mod.__file__).parent / mod.MODEL_PATH
     rows = []
     try:
-        for stage, names in stages.items():
-            for name in names:
-                saved[name] = getattr(sim, name)
-                setattr(sim, name, timed(stage, saved[name]))
+        for owner, name, phase in wrapped:
+            saved.append((owner, name, getattr(owner, name)))
+            setattr(owner, name, timed(phase, getattr(owner, name)))
         for label, method, kwargs in CALLS:
             sim.simulate(mod, method, CASE.q0, CASE.v0, **kwargs)          # compile or load
-            times.update(driver=[], trajectory=[])
-            whole, stepping = [], []
+            per_call = {k: [] for k in ("whole", "stepping", "beyond", "checks", "buffers",
+                                        "driver", "trajectory", "energy", "io")}
             for _ in range(calls):
+                spent.clear()
                 start = time.perf_counter()
                 traj = sim.simulate(mod, method, CASE.q0, CASE.v0, **kwargs)
-                whole.append(time.perf_counter() - start)
-                stepping.append(traj.wall_time)
-            resolve = []
-            for _ in range(min(calls, 500)):
-                start = time.perf_counter()
-                model_file.resolve()
-                resolve.append(time.perf_counter() - start)
-            med = {k: 1e6 * statistics.median(v) for k, v in
-                   dict(whole=whole, stepping=stepping, resolve=resolve, **times).items()}
-            rows.append({"label": label, "jit": traj.jit, **med,
-                         "beyond": med["whole"] - med["stepping"],
-                         "checks": med["whole"] - med["driver"] - med["trajectory"]})
+                whole = time.perf_counter() - start
+                phases = {k: spent.get(k, 0.0) for k in ("buffers", "driver", "trajectory",
+                                                         "energy", "io")}
+                phases["driver"] -= traj.wall_time
+                phases["trajectory"] -= phases["energy"]
+                around = sum(phases.values())
+                phases.update(whole=whole, stepping=traj.wall_time,
+                              beyond=whole - traj.wall_time,
+                              checks=whole - traj.wall_time - around)
+                for k, value in phases.items():
+                    per_call[k].append(value)
+            rows.append({"label": label, "jit": traj.jit,
+                         **{k: 1e6 * statistics.median(v) for k, v in per_call.items()}})
     finally:
-        for name, fn in saved.items():
-            setattr(sim, name, fn)
+        for owner, name, fn in reversed(saved):
+            setattr(owner, name, fn)
     return rows
 
 

@@ -146,16 +146,17 @@ def _call_details(calls, whole):
     lines = ["## The cost of one call (microseconds, medians of warm calls)", "",
              "The whole `lg.simulate(mod, method, q0, v0, ...)` call timed around it, against "
              "its stepping (Trajectory.wall_time: the jitted run and the chunk loop around it); "
-             "the stages are timed by wrapping the functions simulate calls (bench/speed.py "
-             "call_breakdown). Checks and set-up: the whole call less the driver and the "
-             "Trajectory. The model file's path is resolved for the Trajectory's source record "
-             "(part of the Trajectory column).", "",
+             "the phases are timed by wrapping the functions simulate calls (bench/speed.py "
+             "call_breakdown), each a median over the calls: the output buffers, the driver "
+             "less the stepping, the Trajectory less the energy check, the energy check, the "
+             "inputs and outputs; checks and set-up are the whole call less all of these.", "",
              "| call | glue | whole call | stepping | beyond the stepping | checks and set-up | "
-             "driver (incl. stepping) | Trajectory (incl. energy check) | resolving the "
-             "model file's path |", "|---|---|---|---|---|---|---|---|---|"]
+             "buffers | driver (less stepping) | Trajectory | energy check | inputs, outputs |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['label']} | {r['jit']} | {r['whole']:.0f} | {r['stepping']:.0f} | "
-              f"{r['beyond']:.0f} | {r['checks']:.0f} | {r['driver']:.0f} | "
-              f"{r['trajectory']:.0f} | {r['resolve']:.0f} |" for r in calls]
+              f"{r['beyond']:.0f} | {r['checks']:.0f} | {r['buffers']:.0f} | "
+              f"{r['driver']:.0f} | {r['trajectory']:.0f} | {r['energy']:.0f} | "
+              f"{r['io']:.0f} |" for r in calls]
     if whole is not None:
         lines += ["", f"dop853 at rtol {whole['rtol']:.0e} (final error {whole['final']:.2g}): "
                       f"whole call {whole['call'] * 1e3:.3f} ms, jitted run "

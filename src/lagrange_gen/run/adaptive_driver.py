@@ -55,7 +55,9 @@ def integrate_adaptive(task, q, v, initial, t_end, t_eval, progress):
     wall = time.perf_counter() - start
     if bar:
         bar.close()
-    out = {k: np.concatenate([part[k] for part in parts]) for k in parts[0]}
+    # One call (a short run) needs no concatenation: a compact copy of its rows is the same.
+    out = ({k: a.copy() for k, a in parts[0].items()} if len(parts) == 1 else
+           {k: np.concatenate([part[k] for part in parts]) for k in parts[0]})
     out.update(events=events, n_events=n_events, last=last, counters=counters)
     return out, compile_time, wall
 

@@ -89,15 +89,20 @@ def vector(name, value, n, coords):
     try:
         # a copy: the caller's array stays untouched, and the glue always sees a writable
         # C-contiguous float64 array (one numba type for every call)
-        arr = np.array(value, dtype=np.float64).reshape(-1)
+        arr = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise SimulationError(f"{name} must be a sequence of {n} numbers, got {value!r}") from None
+    if arr.ndim != 1:
+        arr = np.ascontiguousarray(arr.reshape(-1))
     if arr.shape[0] != n:
         raise SimulationError(f"{name} has {arr.shape[0]} entries but the model has {n} "
                               f"coordinates ({', '.join(coords)})")
-    if not np.all(np.isfinite(arr)):
+    # A finite sum has finite terms (a NaN or an infinity makes the sum NaN or infinite): one
+    # sum instead of two numpy calls on the common finite vector; a sum that overflows is
+    # looked at entry by entry. In Python floats, which overflow without numpy's warning.
+    if not math.isfinite(sum(arr.tolist())) and not np.all(np.isfinite(arr)):
         raise SimulationError(f"{name} contains a non-finite value: {arr.tolist()}")
-    return np.ascontiguousarray(arr)
+    return arr
 
 
 def state_vector(name, value, n, coords):

@@ -26,6 +26,7 @@ dependence with power as not; a model left undecided (every sample singular) get
 
 from __future__ import annotations
 
+import math
 import sys
 
 import numpy as np
@@ -46,8 +47,18 @@ FEW_ROWS = 17
 def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
     """One line (str) or None. q, v (S, n), t (S,), energy (S,) of a finished unconstrained run,
     p (n_params,), h the step (an adaptive run: its mean step), advice what to change."""
-    err = float(np.max(np.abs(energy - energy[0])))
-    floor = 64 * sys.float_info.epsilon * float(np.max(np.abs(energy)))
+    # max |E_k - E_0| = max(max E - E_0, E_0 - min E): rounding is monotone, so the same
+    # number as the largest rounded difference, without a temporary array; on a few rows in
+    # Python floats (a numpy reduction costs more than the comparisons it does).
+    if len(energy) <= FEW_ROWS:
+        values = energy.tolist()
+        if math.isnan(sum(values)):           # as numpy's max would: NaN, and no warning
+            return None
+        e0, high, low = values[0], max(values), min(values)
+    else:
+        e0, high, low = float(energy[0]), float(energy.max()), float(energy.min())
+    err = max(high - e0, e0 - low)
+    floor = 64 * sys.float_info.epsilon * max(abs(high), abs(low))
     if not err > floor:
         return None
     # Cheapest first. The scale over a few rows is at most the scale over all of them (a max
@@ -74,14 +85,23 @@ def energy_warning(module, method, q, v, t, energy, p, h, advice="reduce h"):
 def energy_scale(module, q, t, energy, p, most=SCALE_ROWS):
     """max T + (max V - min V) over up to ``most`` saved rows, evenly spaced, the first and the
     last included; V = E(q, 0, t), T = E - V."""
-    rows = (np.arange(len(t)) if len(t) <= most else
-            np.unique(np.linspace(0, len(t) - 1, most).astype(np.int64)))
+    rows = spaced_rows(len(t), most)
+    q = np.ascontiguousarray(q, dtype=np.float64)     # rows q[k] of the kernel's type
     zero = np.zeros(module.N_COORDS)
     energy_of = unchecked(module.energy)      # arrays made here, of the kernel's shapes
-    V = np.array([energy_of(np.ascontiguousarray(q[k], dtype=np.float64), zero, float(t[k]), p)
-                  for k in rows])
-    T = energy[rows] - V
-    return float(np.max(T) + np.max(V) - np.min(V))
+    # Python floats: on the few rows of the first estimate a numpy call costs more than the
+    # arithmetic it does.
+    V = [energy_of(q[k], zero, float(t[k]), p) for k in rows]
+    E = (energy if len(t) <= most else energy[rows]).tolist()
+    return max(ek - vk for ek, vk in zip(E, V)) + max(V) - min(V)
+
+
+def spaced_rows(count, most):
+    """Indices of up to ``most`` rows of ``count`` (>= 1), evenly spaced, the first and the last
+    included: every row when count <= most, else floor(k (count - 1) / (most - 1))."""
+    if count <= most:
+        return range(count)
+    return [k * (count - 1) // (most - 1) for k in range(most)]
 
 
 def is_conservative(module, q0, v0, t0, p):

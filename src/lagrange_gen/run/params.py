@@ -41,6 +41,8 @@ def resolve_params(names, defaults, given=None, model="model", frozen=None):
 
 def is_number(value):
     """A real number that is not a bool (h=True must not run with h = 1)."""
+    if type(value) is float or type(value) is int:      # the common case, first (bool is not int)
+        return True
     return isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(
         value, (bool, np.bool_))
 

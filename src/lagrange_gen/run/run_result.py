@@ -39,7 +39,9 @@ def fixed_step_trajectory(task, out, wall, compile_time):
     event stopped the run), energies, and the energy warning."""
     m, n, h, p = task.module, task.module.N_COORDS, task.h, task.p
     last, row = out["last"], out["rows"] - 1
-    out["t"][:row + 1] = task.t0 + h * task.save_every * np.arange(row + 1)
+    times = out["t"][:row + 1]          # t0 + k (h save_every), written in place
+    np.multiply(np.arange(row + 1), h * task.save_every, out=times)
+    times += task.t0
     steps = out["steps"]
     if steps % task.save_every or steps < task.n_steps:
         row += 1
@@ -86,20 +88,21 @@ def _has_work(module):
 
 def _build(task, rows, out, steps, h, wall, compile_time):
     """A Trajectory from the saved rows {t, q, v, stats, extra} of a run."""
-    m, n, p, spec = task.module, task.module.N_COORDS, task.p, task.spec
-    layout = spec.saved_layout(n, m.N_CONSTRAINTS, m.N_ELEMENTS, getattr(m, "N_CONTACTS", 0),
-                               getattr(m, "N_NONHOLONOMIC", 0))
-    saved = {name: rows["extra"][:, start:start + width].copy() for name, start, width in layout}
-    energy = rows["stats"][:, STAT_ENERGY].copy()
+    m, p, spec = task.module, task.p, task.spec
+    extra = rows["extra"]
+    saved = {name: extra[:, start:start + width].copy() for name, start, width in task.layout}
+    # One copy of the statistics, transposed: each column (energy, Newton iterations and
+    # residuals, W) is then a contiguous row of it, without a copy per column.
+    stats = rows["stats"].T.copy()
+    energy = stats[STAT_ENERGY]
     if "element_state" in saved:
         energy = energy + element_energy(m, p, saved["element_state"])
     return Trajectory(t=rows["t"], q=rows["q"], v=rows["v"], energy=energy,
-                      newton_iters=rows["stats"][:, STAT_ITERS].copy(),
-                      newton_residual=rows["stats"][:, STAT_RESIDUAL].copy(), method=spec.name,
-                      h=h, model=m.NAME, params=dict(zip(m.PARAMS, p.tolist())),
-                      coords=tuple(m.COORDS), n_steps=steps, wall_time=wall,
-                      compile_time=compile_time, jit=task.ran, saved=saved,
-                      work=rows["stats"][:, STAT_WORK].copy() if _has_work(m) else None,
+                      newton_iters=stats[STAT_ITERS], newton_residual=stats[STAT_RESIDUAL],
+                      method=spec.name, h=h, model=m.NAME,
+                      params=dict(zip(m.PARAMS, p.tolist())), coords=tuple(m.COORDS),
+                      n_steps=steps, wall_time=wall, compile_time=compile_time, jit=task.ran,
+                      saved=saved, work=stats[STAT_WORK] if _has_work(m) else None,
                       settings=_settings(task.settings),
                       element_names=tuple(m.ELEMENTS) if spec.elements else (),
                       constraint_names=(tuple(m.CONSTRAINTS)

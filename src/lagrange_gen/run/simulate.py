@@ -10,7 +10,9 @@ run/adaptive_driver.py; this module only checks inputs (run_checks: element coef
 time resolution, memory; the method's settings by its spec) and hands the finished run to
 run/run_result.py, which builds the Trajectory from the method's declared saved fields and warns
 when a conservative run lost its energy (run/energy_check.py). What a method is and which models it applies to is read from its spec
-(steppers/core/method_spec.py), never from its name.
+(steppers/core/method_spec.py), never from its name. What the module and the method alone fix
+(the method that runs, whether it applies, its saved fields, default settings and parameters)
+is worked out on the first call of the pair and kept (run/call_plan.py).
 """
 
 from __future__ import annotations
@@ -24,8 +26,9 @@ import numpy as np
 
 from . import checks as run_checks
 from .adaptive_driver import integrate_adaptive
+from .call_plan import element_method, method_plan, run_params
 from ..codegen.keys import regeneration_command_for
-from .control import attach_inputs_outputs, blame_inputs, controlled_run, resolve_inputs
+from .control import attach_inputs_outputs, blame_inputs, controlled_run
 from ..errors import SimulationError
 from .fixed_driver import allocate, integrate_fixed, n_steps_to
 from ..jit.portable import choose, jit_mode
@@ -69,21 +72,6 @@ def _runner(module, method):
             f"{module.NAME}: module {module.__file__} was generated without method {method!r} "
             f"(it has: {have}); run `{regeneration_command_for(module, methods=[method])}`")
     return run
-
-
-def element_method(module, method):
-    """The method that actually runs: on a model with nonsmooth elements a method that a
-    nonsmooth one stands in for (SPEC.stands_in_for) becomes it; a method that cannot treat
-    them is refused, naming them."""
-    names = tuple(getattr(module, "ELEMENTS", ()))
-    runs = registry.runs_as(method, len(names)) if method in registry.METHODS else method
-    if not names or runs not in registry.METHODS or registry.spec(runs).elements:
-        return runs
-    use = "; ".join(f"method={asked!r} (runs {m}: {registry.spec(m).summary})"
-                    for asked, m in registry.ON_ELEMENTS.items())
-    raise SimulationError(
-        f"{module.NAME}: method {method!r} cannot treat the nonsmooth element(s) "
-        f"{', '.join(names)} (no silent regularization); use {use}")
 
 
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
@@ -149,26 +137,22 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
     jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method, force)
-    method = element_method(module, method)
-    from .consistent import check_method
-    check_method(module, method)
+    plan = method_plan(module, method)      # element_method, check_method, spec: once each
+    method, spec = plan.runs, plan.spec
     run = _runner(module, method)
-    spec = registry.spec(method)
     n = module.N_COORDS
     h = check_times(spec, h, t0, t_end, save_every, t_eval)
-    config = make_settings(spec, settings)
+    config = make_settings(spec, settings) if settings else plan.default_settings
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
-    p, hook, data = resolve_inputs(module, params, control, h, t0, q, v,      # run/control.py
-                                   control_params)
+    p, hook, data = run_params(plan, module, params, control, control_params, h, t0, q, v)
     if hook is not None:
         run = _with_data(controlled_run(module, method, hook), data)
         jit = "specialized"       # the control glue is compiled per model and controller
     run_checks.check_element_coefficients(module, p)
     run_checks.check_contact_coefficients(module, p, q)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
-    n_saved = spec.n_saved(n, module.N_CONSTRAINTS, module.N_ELEMENTS,
-                           getattr(module, "N_CONTACTS", 0), getattr(module, "N_NONHOLONOMIC", 0))
+    n_saved = plan.n_saved
     initial = np.zeros(0)
     constrained = spec.saves_constraints(module.N_CONSTRAINTS)
     if keep and not constrained:
@@ -191,7 +175,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
         initial = run_checks.vector("element_state0", element_state0, n_saved, module.ELEMENTS)
     run_checks.check_events_at_start(module, q, v, t0, p)
     if spec.adaptive:
-        task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit)
+        task = _Task(module, spec, run, p, config, h, t0, 0, 1, jit=jit, layout=plan.layout)
         wanted = None if t_eval is None else np.asarray(t_eval, dtype=np.float64)
         out, compile_time, wall = integrate_adaptive(
             task, q, v, initial, t_end, None if wanted is None else wanted[wanted > t0], progress)
@@ -204,7 +188,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
-                 jit=jit, hook=hook)
+                 jit=jit, hook=hook, layout=plan.layout)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     try:
@@ -269,6 +253,7 @@ class _Task:
     jit: str = "specialized"    # simulate(jit=): "auto", "specialized" or "portable"
     ran: str = ""               # what ran (Trajectory.jit), set by fixed_run / adaptive_run
     hook: object = None         # the input hook compiled into ``run`` (control.make_apply)
+    layout: tuple = None        # ((name, start, width), ...) of the saved fields (MethodPlan)
 
     def ready_key(self):
         """What the glue's choice and compile depend on, besides argument types that simulate

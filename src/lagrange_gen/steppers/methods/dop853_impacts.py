@@ -79,9 +79,8 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import events
-from ..core.contact_problem import (BILATERAL, COULOMB, SLIDE, SLIDE_NEGATIVE, SLIDE_POSITIVE,
-                                    STICK, UNILATERAL, contact_row, delassus,
-                                    gauss_seidel_sliding)
+from ..core.contact_problem import (BILATERAL, SLIDE, SLIDE_NEGATIVE, SLIDE_POSITIVE, STICK,
+                                    contact_row, delassus, gauss_seidel_sliding)
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.options import FAST
