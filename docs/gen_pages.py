@@ -29,7 +29,8 @@ log = logging.getLogger("mkdocs.gen_pages")
 def run_example(script, out_dir):
     """Run ``script`` from the repository root; its stdout, or RuntimeError (failing the
     build) naming the script with the end of its stderr."""
-    env = dict(os.environ, MPLBACKEND="Agg")
+    # no detached background compile (jit/first_run.py) outliving the build
+    env = dict(os.environ, MPLBACKEND="Agg", LAGRANGE_GEN_BACKGROUND_COMPILE="0")
     start = time.perf_counter()
     done = subprocess.run([sys.executable, str(script), str(out_dir)], cwd=ROOT, env=env,
                           capture_output=True, text=True, timeout=EXAMPLE_TIMEOUT_S)

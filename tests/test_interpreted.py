@@ -36,6 +36,10 @@ CASES += [(m, "slider_crank", ([0.0, 1.3, 0.1], [1.8, 0.0, 0.0]), 1e-3, 25)
           for m in registry.CONSTRAINED_METHODS]
 CASES += [("nonsmooth_euler", "prandtl", [0.0], 1e-2, 60)]
 CASES += [("moreau_jean", "bouncing_ball", [0.02], 1e-3, 200)]       # lands within the run
+# a rod constraint beside a wall contact, hit within the run (v0 on the rod's tangent)
+CASES += [(m, "pendulum_wall_cartesian", ([0.45, -0.8930285549745876],
+                                          [1.0, 0.5039032598602688]), 1e-3, 120)
+          for m in ("spook_contacts", "moreau_jean")]
 CASES += [(m, "chaplygin_sleigh", ([0.0, 0.0, 0.0], [0.3, 1.0, 2.0]), 1e-3, 25)
           for m in registry.NONHOLONOMIC_METHODS]
 EVENT_CASES = [("verlet", "cart_pendulum_events", [0.3, 1.0], 1e-2, 60),
@@ -100,7 +104,7 @@ def _interpreted_and_compiled(mod, method, q0, v0, h, steps):
     return ours, simulate(mod, method, q0, v0, t_end=steps * h, h=h, jit="portable")
 
 
-@pytest.mark.parametrize("method, stem, q0, h, steps", CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize("method, stem, q0, h, steps", CASES, ids=[f"{c[0]}-{c[1]}" for c in CASES])
 def test_interpreted_run_equals_the_compiled_one(generated, first_use, method, stem, q0, h,
                                                  steps):
     q0, v0 = q0 if isinstance(q0, tuple) else (q0, None)

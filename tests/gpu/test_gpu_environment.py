@@ -79,7 +79,7 @@ EVERY_KIND = {"constrained_midpoint": "cartesian_pendulum",
               "index1": "cartesian_pendulum", "nonsmooth_euler": "coulomb_oscillator",
               "nonholonomic_rk4": "chaplygin_sleigh", "explicit_euler": "cart_pendulum",
               "symplectic_euler": "cart_pendulum", "verlet": "cart_pendulum",
-              "midpoint": "cart_pendulum"}
+              "midpoint": "cart_pendulum", "spook_contacts": "pendulum_wall_cartesian"}
 THOROUGH = [(m, model, "float64") for m, model in EVERY_KIND.items()]
 
 
