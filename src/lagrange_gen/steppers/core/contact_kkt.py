@@ -27,6 +27,9 @@ max|J v + dPhi/dt| (1 each, absent without constraints).
 import numpy as np
 from ...jit.cache import njit
 
+from .options import FAST
+from .status import OK
+
 from .contact_problem import contact_row, delassus, gauss_seidel
 from .constrained import max_abs_jv
 
@@ -44,6 +47,21 @@ def min_gap(g):
     for i in range(g.shape[0]):
         m = min(m, g[i])
     return m
+
+
+@njit(**FAST)
+def contact_prepare(kern, q, v, mom, t, p, settings, ws, extra):
+    """A contact method's prepare (the stepper contract, docs/STEPPERS.md): row 0 of the saved
+    fields, no active contact, no impulse, the initial smallest gap (ws.g, ws.WN, ws.WT,
+    ws.coef and ws.r (n_rows,) of the method's workspace); the contact work continues from what
+    extra holds (0 at the start of a run); the constrained fields keep the consistent start
+    simulate put there."""
+    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
+    R = ws.r.shape[0]
+    for i in range(R + 1):
+        extra[i] = 0.0
+    extra[R + 1] = min_gap(ws.g)
+    return OK
 
 
 @njit(inline="always")

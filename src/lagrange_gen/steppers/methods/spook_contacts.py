@@ -56,7 +56,7 @@ from ...jit.cache import njit
 from ..core.options import FAST, inline_step
 from ..core.constrained import constraint_rate
 from ..core.contact_kkt import (CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
-                                impulse_work, min_gap, pad_rows,
+                                contact_prepare, impulse_work, pad_rows,
                                 record_constraints, record_contacts, row_dot, solve_contacts)
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
@@ -99,17 +99,8 @@ def workspace(kern, n):
                      np.zeros((R, N)), np.zeros((R, R)), np.zeros(R), np.zeros(R))
 
 
-@njit(**FAST)
-def prepare(kern, q, v, mom, t, p, settings, ws, extra):
-    """Row 0 of the saved fields: no active contact, no impulse, the initial smallest gap; the
-    contact work continues from what extra holds (0 at the start of a run); the constrained
-    fields keep the consistent start simulate put there."""
-    kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
-    R = ws.r.shape[0]
-    for i in range(R + 1):
-        extra[i] = 0.0
-    extra[R + 1] = min_gap(ws.g)
-    return OK
+#: Row 0 of the saved fields (core/contact_kkt.py), shared with the other contact method.
+prepare = contact_prepare
 
 
 @njit(inline=inline_step, **FAST)
