@@ -146,10 +146,12 @@ def _call_details(calls, whole):
     lines = ["## The cost of one call (microseconds, medians of warm calls)", "",
              "The whole `lg.simulate(mod, method, q0, v0, ...)` call timed around it, against "
              "its stepping (Trajectory.wall_time: the jitted run and the chunk loop around it); "
-             "the phases are timed by wrapping the functions simulate calls (bench/speed.py "
-             "call_breakdown), each a median over the calls: the output buffers, the driver "
-             "less the stepping, the Trajectory less the energy check, the energy check, the "
-             "inputs and outputs; checks and set-up are the whole call less all of these.", "",
+             "the phases are timed in a second pass by wrapping the functions simulate calls "
+             "(bench/speed.py call_breakdown; the wrappers add about a microsecond each, so "
+             "the first three columns come from calls without them), each a median over the "
+             "calls: the output buffers, the driver less the stepping, the Trajectory less the "
+             "energy check, the energy check, the inputs and outputs; checks and set-up are "
+             "the wrapped call less the stepping and all of these.", "",
              "| call | glue | whole call | stepping | beyond the stepping | checks and set-up | "
              "buffers | driver (less stepping) | Trajectory | energy check | inputs, outputs |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
