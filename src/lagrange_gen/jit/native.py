@@ -29,7 +29,7 @@ import tempfile
 import threading
 from pathlib import Path
 
-from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, parse_function
+from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, function_source
 
 #: Environment variable that turns native kernels off ("0", "off", "no", "false").
 NATIVE_ENV = "LAGRANGE_GEN_NATIVE"
@@ -112,21 +112,20 @@ def _closure(fn):
         if id(py) in seen:
             continue
         seen.add(id(py))
-        node, globs = parse_function(py)
+        source, node, globs = function_source(py)
         constants = {}
-        for sub in ast.walk(node):
-            if isinstance(sub, ast.Name) and sub.id in globs:
-                value = globs[sub.id]
-                if isinstance(value, (bool, int, float)):
-                    constants[sub.id] = repr(value)
-                elif hasattr(value, "tobytes") and hasattr(value, "dtype"):
-                    constants[sub.id] = (str(value.dtype), value.shape,
-                                         hashlib.sha256(value.tobytes()).hexdigest())
-                elif callable(value) and (hasattr(value, "py_func") or hasattr(value, "__code__")) \
-                        and getattr(value, "__module__", "") != "builtins":
-                    todo.append(value)
-        out.append((f"{py.__module__}.{py.__qualname__}", ast.unparse(node),
-                    sorted(constants.items())))
+        names = {sub.id for sub in ast.walk(node) if isinstance(sub, ast.Name)}
+        for name in sorted(names & globs.keys()):
+            value = globs[name]
+            if isinstance(value, (bool, int, float)):
+                constants[name] = repr(value)
+            elif hasattr(value, "tobytes") and hasattr(value, "dtype"):
+                constants[name] = (str(value.dtype), value.shape,
+                                   hashlib.sha256(value.tobytes()).hexdigest())
+            elif callable(value) and (hasattr(value, "py_func") or hasattr(value, "__code__")):
+                todo.append(value)
+        out.append((f"{py.__module__}.{py.__qualname__}",
+                    hashlib.sha256(source.encode()).hexdigest(), sorted(constants.items())))
     return out
 
 
@@ -222,7 +221,9 @@ def _native_kernel_class():
         """A generated kernel compiled by llvmlite, as a numba first-class function: the
         address of its function with numba's C-wrapper ABI, and its numba signature."""
 
-        def __init__(self, name, address, signature, key, seconds, cached):
+        def __init__(self, dispatcher, name, address, signature, key, seconds, cached):
+            # the generated kernel it was lowered from: the interpreted tier runs its Python
+            self.dispatcher = dispatcher
             self.name, self.address, self.sig = name, address, signature
             self.key, self.seconds, self.cached = key, seconds, cached
 
@@ -294,7 +295,7 @@ def native_kernel(module, name):
             raise
         except Exception as exc:
             raise Unsupported(f"loading the object code: {exc}".splitlines()[0]) from None
-        kernel = _native_kernel_class()(name, address, _signature(ret, arg_types), key,
+        kernel = _native_kernel_class()(fn, name, address, _signature(ret, arg_types), key,
                                         time.perf_counter() - start, cached)
         _KERNELS[memo] = kernel
         return kernel

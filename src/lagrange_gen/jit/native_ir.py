@@ -105,18 +105,31 @@ def array_struct_types(ndim):
     return _STRUCTS[ndim]
 
 
-def parse_function(fn):
-    """(ast.FunctionDef, globals) of a Python function or a numba dispatcher."""
+_PARSED: dict = {}
+
+
+def function_source(fn):
+    """(source text, ast.FunctionDef, globals) of a Python function or a numba dispatcher,
+    parsed once per function object."""
     py = getattr(fn, "py_func", fn)
+    entry = _PARSED.get(id(py))
+    if entry is not None and entry[0] is py:
+        return entry[1]
     try:
         source = textwrap.dedent(inspect.getsource(py))
     except (OSError, TypeError) as exc:
         raise Unsupported(f"no source for {getattr(py, '__name__', py)!r}: {exc}") from None
-    tree = ast.parse(source)
-    node = tree.body[0]
+    node = ast.parse(source).body[0]
     if not isinstance(node, ast.FunctionDef):
         raise Unsupported(f"{py.__name__} is not a plain function")
-    return node, py.__globals__
+    _PARSED[id(py)] = (py, (source, node, py.__globals__))
+    return source, node, py.__globals__
+
+
+def parse_function(fn):
+    """(ast.FunctionDef, globals) of a Python function or a numba dispatcher."""
+    _, node, globs = function_source(fn)
+    return node, globs
 
 
 class ModuleBuilder:
@@ -225,6 +238,7 @@ class FunctionLowering:
         self.vars = {}          # name -> (kind, alloca) for scalars, or Array / ArrayTuple
         self.ret_kind = None
         self.declared = {}
+        self.single = frozenset()
 
     def fail(self, node, what):
         line = getattr(node, "lineno", "?")
@@ -235,6 +249,7 @@ class FunctionLowering:
         kinds = _KindPass(self)
         ret_kind = kinds.kind()
         self.declared = kinds.env
+        self.single = _single_assignments(self.node)
         ret_ty = {"f": F64, "i": I64, "b": I1, None: ir.VoidType()}[ret_kind]
         fnty = ir.FunctionType(ret_ty, _arg_types(self.arg_sig))
         fn = ir.Function(self.owner.module, fnty, name=self.name)
@@ -271,6 +286,14 @@ class FunctionLowering:
         return builder.alloca(ty, name=name)
 
     def _store_scalar(self, name, kind, value):
+        if name in self.single:
+            # assigned once, in the function's top-level block: the value itself (an SSA
+            # value dominates every later statement), no stack slot to load and store
+            declared = self.declared.get(name)
+            if declared in ("f", "i", "b") and _unify(declared, kind) == declared:
+                value, kind = self.cast(value, kind, declared), declared
+            self.vars[name] = (kind, None, value)
+            return
         entry = self.vars.get(name)
         if entry is None or not isinstance(entry, tuple):
             if isinstance(entry, (Array, ArrayTuple)):
@@ -512,6 +535,8 @@ class FunctionLowering:
         if name in self.vars:
             entry = self.vars[name]
             if isinstance(entry, tuple):
+                if len(entry) == 3:
+                    return entry[0], entry[2]
                 kind, slot = entry
                 return kind, self.b.load(slot)
             return entry
@@ -932,6 +957,36 @@ class _KindPass:
                     _, ret = self.lw.owner.internal(target, tuple(sig))
                     return ret if ret is not None else "?"
         return "?"
+
+
+def _single_assignments(fn_node):
+    """Names assigned exactly once in the function, by a statement of its top-level block
+    (not a parameter, a loop target, an augmented assignment or inside a branch or loop)."""
+    counts, top = {}, set()
+
+    def targets(t):
+        if isinstance(t, ast.Name):
+            yield t.id
+        elif isinstance(t, ast.Tuple):
+            for e in t.elts:
+                yield from targets(e)
+
+    for node in ast.walk(fn_node):
+        names = []
+        if isinstance(node, ast.Assign):
+            for t in node.targets:
+                names.extend(targets(t))
+        elif isinstance(node, (ast.AugAssign, ast.For)):
+            names.extend(targets(node.target))
+            names.extend(targets(node.target))       # never single
+        for name in names:
+            counts[name] = counts.get(name, 0) + 1
+    for stmt in fn_node.body:
+        if isinstance(stmt, ast.Assign):
+            for t in stmt.targets:
+                top.update(targets(t))
+    params = {a.arg for a in fn_node.args.args}
+    return frozenset(n for n in top if counts.get(n) == 1 and n not in params)
 
 
 def _float_array(value):

@@ -149,14 +149,31 @@ def _typeof_table(table, context):
 
 def kernel_table(module, method):
     """The kernel table of ``module`` for ``method`` (cached on the module): kernels as
-    FunctionKernel (compiled for the portable types on first use), constants as they are."""
+    first-class functions (table_kernel), constants as they are."""
     tables = module.__dict__.setdefault("_PORTABLE_TABLES", {})
     if method not in tables:
-        kernel = _function_kernel_class()
         cls = table_class(method)
         tables[method] = cls(*(getattr(module, field) if field.isupper()
-                               else kernel(getattr(module, field)) for field in cls._fields))
+                               else table_kernel(module, field) for field in cls._fields))
     return tables[method]
+
+
+def table_kernel(module, name):
+    """Kernel ``name`` of ``module`` as a numba first-class function of the portable argument
+    types: compiled by llvmlite from its source (jit/native.py: no numba compile, object code
+    cached), else compiled by numba (FunctionKernel), with one warning line naming the kernel
+    and why it could not be lowered. $LAGRANGE_GEN_NATIVE=0: always numba."""
+    from . import native
+    if native.enabled():
+        from .native_ir import Unsupported
+        try:
+            return native.native_kernel(module, name)
+        except Unsupported as exc:
+            from .speedups import _warn_once
+            _warn_once(("native", getattr(module, "NAME", module.__name__), name),
+                       f"lagrange-gen: {getattr(module, 'NAME', module.__name__)}.{name} "
+                       f"compiled by numba (native kernels: {exc})")
+    return _function_kernel_class()(getattr(module, name))
 
 
 def _library_hash(method: str) -> str:
