@@ -46,6 +46,9 @@ _OFF = ("0", "off", "no", "false")
 #: The exported symbol of a kernel in its LLVM module.
 EXPORT_PREFIX = "lagrange_gen_native_"
 
+#: What a kernel returns: a float, an int (a status), a bool, or nothing.
+_RETURN_KINDS = ("f", "i", "b", None)
+
 _LOCK = threading.Lock()
 _ENGINES: list = []          # every execution engine made: they own the compiled code
 _KERNELS: dict = {}          # (module file, kernel name, key) -> NativeKernel
@@ -274,7 +277,10 @@ def native_kernel(module, name):
         try:
             meta = json.loads(meta_path.read_text())
             obj, ret = obj_path.read_bytes(), meta["ret"]
-        except (OSError, ValueError, KeyError):
+            # a truncated or foreign file must not reach LLVM's loader, which aborts the process
+            if hashlib.sha256(obj).hexdigest() != meta["sha256"] or ret not in _RETURN_KINDS:
+                obj = None
+        except (OSError, ValueError, KeyError, TypeError):
             obj = None
         cached = obj is not None
         symbol = f"{EXPORT_PREFIX}{name}_{key[:16]}"
@@ -285,8 +291,10 @@ def native_kernel(module, name):
             except Exception as exc:        # LLVM refused the IR: a bug here, numba compiles
                 raise Unsupported(f"LLVM: {exc}".splitlines()[0]) from None
             try:
+                # the object first: a reader trusts an object only through its meta's hash
                 _write_atomic(obj_path, obj)
-                _write_atomic(meta_path, json.dumps({"ret": ret, "kernel": name}).encode())
+                _write_atomic(meta_path, json.dumps({"ret": ret, "kernel": name,
+                                                     "sha256": hashlib.sha256(obj).hexdigest()}).encode())
             except OSError:          # an unwritable cache: compiled again next time
                 pass
         try:

@@ -638,6 +638,8 @@ class FunctionLowering:
             return self._pow(left, right, node, right_node)
         if isinstance(op, ast.Div) or "f" in (lk, rk):
             lv, rv = self.cast(lv, lk, "f"), self.cast(rv, rk, "f")
+            if isinstance(op, ast.Mod):
+                return "f", self._float_mod(lv, rv)
             ops = {ast.Add: self.b.fadd, ast.Sub: self.b.fsub, ast.Mult: self.b.fmul,
                    ast.Div: self.b.fdiv}
             if type(op) not in ops:
@@ -648,6 +650,18 @@ class FunctionLowering:
         if type(op) not in ops:
             self.fail(node, f"the operator {type(op).__name__} on integers")
         return "i", ops[type(op)](lv, rv)
+
+    def _float_mod(self, a, b):
+        """Python's a % b on floats: the remainder takes the sign of b (C's fmod, then b added
+        when the signs differ), as numba computes it."""
+        r = self.b.frem(a, b)
+        zero = ir.Constant(F64, 0.0)
+        nonzero = self.b.fcmp_ordered("!=", r, zero)
+        differ = self.b.xor(self.b.fcmp_ordered("<", r, zero), self.b.fcmp_ordered("<", b, zero))
+        adjusted = self.b.select(self.b.and_(nonzero, differ), self.b.fadd(r, b), r)
+        # a zero remainder takes b's sign too (copysign), as in Python
+        return self.b.select(nonzero, adjusted,
+                             self.b.call(self.owner.intrinsic("llvm.copysign.f64", 2), [zero, b]))
 
     def _pow(self, left, right, node, right_node):
         (lk, lv), (rk, rv) = left, right
