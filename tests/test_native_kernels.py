@@ -69,7 +69,7 @@ def test_native_kernels_equal_the_printed_python(stem, generated):
     names = _kernel_names(mod)
     assert "forward_dynamics" in names
     for name in names:
-        kernel = native.native_kernel(mod, name)
+        kernel = native.native_kernel(mod, name, portable.native_dir())
         for _ in range(2):
             args = _inputs(mod, name, rng)
             mine = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
@@ -91,7 +91,7 @@ def test_native_signature_is_numbas(generated):
     mod = generated("bouncing_ball")
     function_kernel = portable._function_kernel_class()
     for name in ("forward_dynamics", "energy", "contacts", "events", "mass_matrix"):
-        assert native.native_kernel(mod, name).signature() == \
+        assert native.native_kernel(mod, name, portable.native_dir()).signature() == \
             function_kernel(getattr(mod, name)).signature(), name
 
 
@@ -113,19 +113,19 @@ def test_object_cache_is_reused_and_a_corrupt_file_is_compiled_again(generated, 
         status = _caller(len(mine))(kernel, *mine)
         return status, mine[-1]
 
-    first = native.native_kernel(mod, "forward_dynamics")
+    first = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
     assert not first.cached
-    objects = sorted(native.cache_dir().glob("*.o"))
+    objects = sorted(portable.native_dir().glob("*.o"))
     assert len(objects) == 1
     monkeypatch.setattr(native, "_KERNELS", {})
-    again = native.native_kernel(mod, "forward_dynamics")
+    again = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
     assert again.cached and again.key == first.key
     expected = run(first)
     assert run(again)[0] == expected[0] and np.array_equal(run(again)[1], expected[1])
     # a truncated object (a process killed while copying a cache, a full disk) is not loaded
     objects[0].write_bytes(objects[0].read_bytes()[:100])
     monkeypatch.setattr(native, "_KERNELS", {})
-    repaired = native.native_kernel(mod, "forward_dynamics")
+    repaired = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
     assert not repaired.cached
     assert np.array_equal(run(repaired)[1], expected[1])
     meta = json.loads(objects[0].with_suffix(".json").read_text())
@@ -137,14 +137,14 @@ def test_a_changed_kernel_is_a_new_key(generated, monkeypatch, tmp_path):
     another value (MASS_FACTOR of other default parameters, SINGULAR_RTOL) is another object."""
     mod = generated("bouncing_ball")
     _fresh(monkeypatch, tmp_path)
-    before = native.native_kernel(mod, "forward_dynamics").key
+    before = native.native_kernel(mod, "forward_dynamics", portable.native_dir()).key
     changed = types.ModuleType(mod.__name__ + "_changed")
     changed.__dict__.update(vars(mod))
     # the same function source, reading another constant factor
     fn = mod.forward_dynamics.py_func
     scope = dict(fn.__globals__, MASS_FACTOR=2.0 * mod.MASS_FACTOR)
     changed.forward_dynamics = types.FunctionType(fn.__code__, scope, fn.__name__)
-    assert native.native_kernel(changed, "forward_dynamics").key != before
+    assert native.native_kernel(changed, "forward_dynamics", portable.native_dir()).key != before
 
 
 _OUTSIDE = '''
@@ -164,7 +164,6 @@ def test_a_kernel_outside_the_subset_is_compiled_by_numba_with_one_line(tmp_path
     and the portable table gets numba's kernel instead: the same numbers, one warning."""
     import importlib.util
     from lagrange_gen.jit import njit, KERNEL_OPTIONS
-    from lagrange_gen.jit import speedups
     path = tmp_path / "outside_kernels.py"
     path.write_text(_OUTSIDE)
     spec = importlib.util.spec_from_file_location("outside_kernels", path)
@@ -173,8 +172,8 @@ def test_a_kernel_outside_the_subset_is_compiled_by_numba_with_one_line(tmp_path
     mod.NAME = "outside"
     mod.loop_kernel = njit(**dict(KERNEL_OPTIONS, cache=False))(mod.loop_kernel)
     with pytest.raises(Unsupported, match=r"loop_kernel, line 3 of its source: statement While"):
-        native.native_kernel(mod, "loop_kernel")
-    monkeypatch.setattr(speedups, "_warned", set())
+        native.native_kernel(mod, "loop_kernel", portable.native_dir())
+    monkeypatch.setattr(native, "_WARNED", set())
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         kernel = portable.table_kernel(mod, "loop_kernel")

@@ -141,11 +141,12 @@ def native_kernels(mod):
     forward_dynamics) replaced by its native kernel (jit/native.py); a kernel outside the subset
     native_ir lowers raises Unsupported here, so the harness says which."""
     from lagrange_gen.jit.native import native_kernel
+    from lagrange_gen.jit.portable import native_dir
     env = vars(pure_kernels(mod))
     for name in (*mod.KERNELS, "forward_dynamics", *BODY_KERNELS, "forward_dynamics_torques"):
         if not hasattr(mod, name):
             continue
-        kernel = native_kernel(mod, name)
+        kernel = native_kernel(mod, name, native_dir())
 
         def call(*args, _kernel=kernel):
             return _caller(len(args))(_kernel, *args)

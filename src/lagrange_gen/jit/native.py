@@ -8,7 +8,8 @@ its source, and the sources of every function it calls (a sibling kernel, the Ch
 factorization of steppers/core/linalg.py), are lowered to one LLVM module, optimized at
 OPT_LEVEL for the host CPU (its name and features: a generic x86-64 target is several times
 slower on the Jacobians) and compiled in this process. The object code is written to
-``portable_dir()/native/<key>.o`` with its return kind beside it; the key hashes those sources,
+``<folder>/<key>.o`` (jit.portable.native_dir: beside the portable glue) with its return kind
+and hash beside it; the key hashes those sources,
 the module constants they read, this package's IR writer, llvmlite's version, the CPU and the
 optimization level, so an unchanged kernel loads in milliseconds in the next process.
 
@@ -52,6 +53,20 @@ _RETURN_KINDS = ("f", "i", "b", None)
 _LOCK = threading.Lock()
 _ENGINES: list = []          # every execution engine made: they own the compiled code
 _KERNELS: dict = {}          # (module file, kernel name, key) -> NativeKernel
+
+
+_WARNED: set = set()
+
+
+def warn_numba_compiles(module, name, reason) -> None:
+    """One warning line per kernel and process: kernel ``name`` of ``module`` is compiled by
+    numba because it could not be lowered (``reason``)."""
+    model = getattr(module, "NAME", module.__name__)
+    if (model, name) not in _WARNED:
+        _WARNED.add((model, name))
+        import warnings
+        warnings.warn(f"lagrange-gen: {model}.{name} compiled by numba (native kernels: "
+                      f"{reason})", RuntimeWarning, stacklevel=3)
 
 
 def enabled() -> bool:
@@ -144,10 +159,16 @@ def kernel_key(fn, arg_kinds, level) -> str:
     return digest.hexdigest()[:32]
 
 
-def cache_dir() -> Path:
-    """Where native object code is kept: beside the portable glue."""
-    from .portable import portable_dir
-    return portable_dir() / "native"
+def kernel_arg_types(fn):
+    """numba types of a kernel's arguments, from their names: t a float, the outputs that are
+    always 2-D (codegen.kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
+    C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
+    import inspect
+    from numba import types
+    from ..codegen.kernel_abi import ALWAYS_2D
+    names = list(inspect.signature(fn).parameters)
+    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
+                 else types.float64[::1] for a in names)
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -248,16 +269,16 @@ def _signature(ret, arg_types):
     return restype(*arg_types)
 
 
-def native_kernel(module, name):
+def native_kernel(module, name, folder: Path):
     """The kernel ``name`` of generated ``module`` compiled natively (a NativeKernel), from the
-    object cache when it holds it. Raises native_ir.Unsupported when the kernel is outside the
-    subset, or llvmlite lacks what is used (then the caller compiles it with numba)."""
+    object cache in ``folder`` when it holds it (jit.portable.native_dir). Raises
+    native_ir.Unsupported when the kernel is outside the subset, or llvmlite lacks what is used
+    (then the caller compiles it with numba)."""
     import time
     from numba import types
-    from .portable import _kernel_arg_types
     fn = getattr(module, name)
     py = getattr(fn, "py_func", fn)
-    arg_types = _kernel_arg_types(fn)
+    arg_types = kernel_arg_types(fn)
     arg_kinds = tuple("t" if ty == types.float64 else ty.ndim for ty in arg_types)
     level = opt_level()
     try:
@@ -271,7 +292,6 @@ def native_kernel(module, name):
         if memo in _KERNELS:
             return _KERNELS[memo]
         start = time.perf_counter()
-        folder = cache_dir()
         obj_path, meta_path = folder / f"{key}.o", folder / f"{key}.json"
         obj = ret = None
         try:

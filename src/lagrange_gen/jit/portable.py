@@ -33,7 +33,6 @@ import collections
 import functools
 import hashlib
 import importlib.util
-import inspect
 import os
 import sys
 import tempfile
@@ -77,14 +76,9 @@ def portable_dir() -> Path:
 
 
 def _kernel_arg_types(fn):
-    """numba types of a kernel's arguments, from their names: t a float, the outputs that are
-    always 2-D (codegen.kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
-    C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
-    from numba import types
-    from ..codegen.kernel_abi import ALWAYS_2D
-    names = list(inspect.signature(fn).parameters)
-    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
-                 else types.float64[::1] for a in names)
+    """numba types of a kernel's arguments (native.kernel_arg_types)."""
+    from .native import kernel_arg_types
+    return kernel_arg_types(fn)
 
 
 @functools.lru_cache(maxsize=None)
@@ -158,6 +152,11 @@ def kernel_table(module, method):
     return tables[method]
 
 
+def native_dir() -> Path:
+    """Where native kernels' object code is kept (jit/native.py): beside the portable glue."""
+    return portable_dir() / "native"
+
+
 def table_kernel(module, name):
     """Kernel ``name`` of ``module`` as a numba first-class function of the portable argument
     types: compiled by llvmlite from its source (jit/native.py: no numba compile, object code
@@ -167,12 +166,9 @@ def table_kernel(module, name):
     if native.enabled():
         from .native_ir import Unsupported
         try:
-            return native.native_kernel(module, name)
+            return native.native_kernel(module, name, native_dir())
         except Unsupported as exc:
-            from .speedups import _warn_once
-            _warn_once(("native", getattr(module, "NAME", module.__name__), name),
-                       f"lagrange-gen: {getattr(module, 'NAME', module.__name__)}.{name} "
-                       f"compiled by numba (native kernels: {exc})")
+            native.warn_numba_compiles(module, name, exc)
     return _function_kernel_class()(getattr(module, name))
 
 
