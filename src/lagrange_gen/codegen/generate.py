@@ -19,7 +19,7 @@ from .compose import make_kernels
 from ..derive import derive
 from .emit import render_kernel
 from ..errors import GenerationError
-from .keys import key_of_text, methods_for
+from .keys import key_of_text
 from .needs import methods_needs, select_kernels
 from .printer import Inputs
 from .render import COMPILED_IMPORTS, render_module
@@ -98,8 +98,27 @@ def model_counts(model):
 
 
 def resolve_methods(requested, model, drop_inapplicable=False):
-    """Methods to emit glue for ``model``: keys.methods_for its counts (model_counts)."""
-    return methods_for(requested, model_counts(model), model.name, drop_inapplicable)
+    """Methods to emit glue for, in registry order: for None those that apply to ``model``
+    (steppers.registry.applicable_methods), else the requested ones, implicit_euler becoming
+    nonsmooth_euler on a model with elements as in simulate. GenerationError for an unknown
+    method, and for one that does not apply (one line naming it and why) unless
+    ``drop_inapplicable`` (load(): simulate then refuses it with its own message)."""
+    from ..steppers.core.registry import METHODS, applicable_methods, inapplicable, runs_as
+    counts = model_counts(model)
+    n_elements = counts[1]
+    if requested is None:
+        return list(applicable_methods(*counts))
+    unknown = [m for m in requested if m not in METHODS]
+    if unknown:
+        raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
+    wanted = {runs_as(m, n_elements) for m in requested}
+    for method in (m for m in METHODS if m in wanted):
+        why = inapplicable(method, *counts)
+        if why and not drop_inapplicable:
+            raise GenerationError(f"method {method} does not apply to model {model.name!r}: {why}")
+        if why:
+            wanted.discard(method)
+    return [m for m in METHODS if m in wanted]
 
 
 @dataclass

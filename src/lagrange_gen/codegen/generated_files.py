@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ..errors import GenerationError
 from .generate import (GenerationResult, Progress, generate_parts, generate_text, generation_options,
-                       model_counts, output_path, resolve_methods)
+                       output_path, resolve_methods)
 from .keys import (changed_input, default_generated_dir, derivation_record_path, generator_hash,
                    input_change, key_of_text, model_hash, read_derivation_record, read_header,
                    regeneration_command, text_hash, why_stale)
@@ -90,11 +90,11 @@ def refuse_overwrite(model_path, target, name):
 
 def _record(model, key, options) -> dict:
     """What makes re-deriving needless: the same model text, files it read or imported (their
-    sha256), generator sources, options and KEY; and the model's counts (generate.model_counts:
-    the methods that apply, for generation without running the model file)."""
+    sha256), generator sources, options and KEY; and the methods that apply to the model (what
+    generation without --methods glues, known without running the model file)."""
     data = {name: rec.get("sha256") for name, rec in getattr(model, "data_files", {}).items()}
     return {"model": model_hash(model.source_text), "data": data, "generator": generator_hash(),
-            "options": options, "key": key, "counts": list(model_counts(model))}
+            "options": options, "key": key, "applicable": resolve_methods(None, model)}
 
 
 def _recorded(path) -> dict:

@@ -242,31 +242,6 @@ def default_generated_dir(model_path) -> Path:
     return Path(_shown(base / "generated"))
 
 
-def methods_for(requested, counts, model_name, drop_inapplicable=False) -> list:
-    """Methods to emit glue for, in registry order, for a model with ``counts`` (constraints,
-    nonsmooth elements, contacts, nonholonomic constraints: generate.model_counts): for None
-    those that apply (steppers.registry.applicable_methods), else the requested ones,
-    implicit_euler becoming nonsmooth_euler on a model with elements as in simulate.
-    GenerationError for an unknown method, and for one that does not apply (one line naming it
-    and why) unless ``drop_inapplicable`` (load(): simulate then refuses it with its own
-    message). Light (no sympy): generation asks it before running a model file."""
-    from ..errors import GenerationError
-    from ..steppers.core.registry import METHODS, applicable_methods, inapplicable, runs_as
-    if requested is None:
-        return list(applicable_methods(*counts))
-    unknown = [m for m in requested if m not in METHODS]
-    if unknown:
-        raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
-    wanted = {runs_as(m, counts[1]) for m in requested}
-    for method in (m for m in METHODS if m in wanted):
-        why = inapplicable(method, *counts)
-        if why and not drop_inapplicable:
-            raise GenerationError(f"method {method} does not apply to model {model_name!r}: {why}")
-        if why:
-            wanted.discard(method)
-    return [m for m in METHODS if m in wanted]
-
-
 def regeneration_command(model_path, out_dir=None, build=None, methods=None, freeze=None) -> str:
     """The shell command that generates ``model_path`` into ``out_dir`` with these options
     (paths quoted; -o omitted for the model's default_generated_dir, and for out_dir None;

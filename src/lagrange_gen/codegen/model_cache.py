@@ -24,13 +24,11 @@ import json
 import os
 from pathlib import Path
 
-from ..errors import GenerationError
-from .keys import (changed_input, generator_hash, methods_for, read_derivation_record, read_header,
-                   why_stale)
+from .keys import changed_input, generator_hash, read_derivation_record, read_header, why_stale
 
 #: The fields of a derivation record this check compares (codegen.generated_files._record and the
 #: data files' sizes and times that remember_current adds).
-_RECORD_FIELDS = {"model", "data", "generator", "options", "key", "counts", "data_files"}
+_RECORD_FIELDS = {"model", "data", "generator", "options", "key", "applicable", "data_files"}
 
 
 def entry_path(model_path, out_dir, options) -> Path:
@@ -75,21 +73,21 @@ def current_module(model_path, out_dir, methods=None, options=None, freeze=None)
 
 def generation_current(model_path, out_dir, methods=None, options=None, freeze=None):
     """The path of the generated module in ``out_dir`` that generating ``model_path`` with these
-    arguments would write again unchanged, found without running the model file; else None
-    (then generation runs it). Exactly these options: build ``options`` and ``freeze`` (None:
-    none), ``methods`` (None: those that apply to the model, from the counts in its record)."""
+    arguments would write again unchanged, found without running the model file (nor importing
+    sympy or the steppers); else None (then generation runs it). Exactly these options: build
+    ``options`` and ``freeze`` (None: none), ``methods`` (None: those that apply to the model,
+    recorded at generation). Requested methods are compared as given: one that generation would
+    rename (implicit_euler on a model with nonsmooth elements), drop or refuse is not among the
+    module's, so the ordinary way decides (and says why in one line)."""
     found = _current(model_path, out_dir, options or {})
     if found is None:
         return None
     target, disk, record = found
-    counts = record.get("counts")
-    try:
-        wanted = methods_for(methods, tuple(counts), target.stem)
-    except (GenerationError, TypeError):
-        return None           # not applicable: generation says why, in one line
-    if (disk.get("build", {}) != dict(options or {})
+    wanted = record.get("applicable") if methods is None else list(methods)
+    if (not isinstance(wanted, list)
+            or disk.get("build", {}) != dict(options or {})
             or disk.get("freeze", {}) != dict(sorted((freeze or {}).items()))
-            or disk.get("methods") != wanted):
+            or set(disk.get("methods", ())) != set(wanted)):
         return None
     return target
 
