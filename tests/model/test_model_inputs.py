@@ -83,6 +83,26 @@ def test_a_helper_imported_from_another_folder_is_recorded_and_read_again(path_p
     assert load_model(path_project / "models" / "path_spring.py").params[0].default == 4.0
 
 
+def test_files_numpy_reads_are_recorded(tmp_path):
+    import numpy as np
+    np.save(tmp_path / "table.npy", np.array([1.5, 2.5]))
+    np.savetxt(tmp_path / "table.csv", np.array([[3.0, 4.0]]), delimiter=",")
+    (tmp_path / "np_spring.py").write_text(textwrap.dedent('''\
+        from pathlib import Path
+        import numpy as np
+        from lagrange_gen import Model, coordinates, parameters
+        here = Path(__file__).parent
+        a = np.load(here / "table.npy")
+        b = np.loadtxt(here / "table.csv", delimiter=",")
+        x = coordinates("x")
+        k = parameters("k", defaults=(float(a[0] + b[1]),))
+        model = Model("np_spring", coords=[x], T=x.d**2 / 2, V=k * x**2 / 2)
+        '''))
+    model = load_model(tmp_path / "np_spring.py")
+    assert model.params[0].default == 5.5
+    assert {str((tmp_path / name).resolve()) for name in ("table.npy", "table.csv")} <= set(model.data_files)
+
+
 @pytest.mark.parametrize("case", ["exec", "path"])
 def test_load_check_and_import_see_a_changed_input(case, exec_project, path_project, capsys):
     project = exec_project if case == "exec" else path_project

@@ -133,8 +133,8 @@ def input_change(changed, model_path, since) -> str:
     generated, and, for a file other than the model file ``model_path``, that the model reads it."""
     if os.path.realpath(changed) == os.path.realpath(model_path):
         return f"{_shown(model_path)} changed since {since} was generated"
-    return (f"{_shown(changed)} changed since {since} was generated (a data file or helper module "
-            f"that {_shown(model_path)} reads or imports)")
+    return (f"{_shown(changed)} changed since {since} was generated; {_shown(model_path)} reads or "
+            "imports it")
 
 
 def _model_changed(here, model_relpath, key):
