@@ -78,6 +78,9 @@ def test_a_changed_model_file_or_input_is_derived_again(counted, capsys):
     assert "DEFAULTS = (6.0,)" in target.read_text()
     assert _generate(counted, "--methods", "rk4") == 0
     assert _runs(counted) == 3
+    target.unlink()                                     # a deleted module is generated again
+    assert _generate(counted, "--methods", "rk4") == 0
+    assert _runs(counted) == 4 and "DEFAULTS = (6.0,)" in target.read_text()
 
 
 def test_force_or_other_options_run_the_model_file(counted, capsys):
