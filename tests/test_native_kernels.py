@@ -63,7 +63,22 @@ def _same(got, expected):
 
 @pytest.mark.parametrize("stem", MODELS)
 def test_native_kernels_equal_the_printed_python(stem, generated):
-    mod = generated(stem)
+    _check_every_kernel(generated(stem))
+
+
+@pytest.mark.parametrize("stem", ["ur5", "bicycle", "slider_crank"])
+def test_kernels_lowered_in_pieces_equal_the_printed_python(stem, generated, monkeypatch):
+    """Long runs of assignments become functions of their own (native_ir._statements): with
+    pieces of a few statements, every boundary case (a value crossing several pieces, a name
+    assigned again in a later piece, inputs stored once before a column loop) is exercised."""
+    from lagrange_gen.jit import native_ir
+    monkeypatch.setattr(native_ir, "CHUNK_STATEMENTS", 7)
+    monkeypatch.setattr(native_ir, "LOOP_CHUNK_STATEMENTS", 3)
+    monkeypatch.setattr(native, "_KERNELS", {})
+    _check_every_kernel(generated(stem))
+
+
+def _check_every_kernel(mod):
     python = pure_kernels(mod)
     rng = np.random.default_rng(7)
     names = _kernel_names(mod)

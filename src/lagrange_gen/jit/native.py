@@ -30,6 +30,7 @@ import tempfile
 import threading
 from pathlib import Path
 
+from . import native_ir
 from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, function_source
 
 #: Environment variable that turns native kernels off ("0", "off", "no", "false").
@@ -153,7 +154,9 @@ def kernel_key(fn, arg_kinds, level) -> str:
     import llvmlite
     digest = hashlib.sha256()
     digest.update(repr((_writer_hash(), llvmlite.__version__, llvm.get_host_cpu_name(),
-                        llvm.get_host_cpu_features().flatten(), level, tuple(arg_kinds))).encode())
+                        llvm.get_host_cpu_features().flatten(), level, tuple(arg_kinds),
+                        native_ir.CHUNK_STATEMENTS,
+                        native_ir.LOOP_CHUNK_STATEMENTS)).encode())
     for item in _closure(fn):
         digest.update(repr(item).encode())
     return digest.hexdigest()[:32]
@@ -210,12 +213,18 @@ def _optimize(llvm, module, tm, level):
     the legacy PassManagerBuilder (llvmlite < 0.44, with numba 0.59 and 0.60)."""
     if hasattr(llvm, "create_pass_builder"):
         pto = llvm.create_pipeline_tuning_options(speed_level=level)
+        # a kernel's loops run over a handful of columns: vectorizing them across iterations
+        # costs compile time (a fifth of a humanoid Jacobian's) and wins nothing
+        pto.loop_vectorization = False
+        pto.slp_vectorization = False
         pb = llvm.create_pass_builder(tm, pto)
         pm = pb.getModulePassManager()
         pm.run(module, pb)
         return
     pmb = llvm.create_pass_manager_builder()
     pmb.opt_level = level
+    pmb.loop_vectorize = False
+    pmb.slp_vectorize = False
     pm = llvm.create_module_pass_manager()
     tm.add_analysis_passes(pm)
     pmb.populate(pm)

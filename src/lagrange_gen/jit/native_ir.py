@@ -239,6 +239,8 @@ class FunctionLowering:
         self.ret_kind = None
         self.declared = {}
         self.single = frozenset()
+        self.frame, self.frame_slots = None, {}
+        self.loops = []          # _Loop of each loop being lowered, outermost first
 
     def fail(self, node, what):
         line = getattr(node, "lineno", "?")
@@ -272,13 +274,105 @@ class FunctionLowering:
                 self.vars[name] = Array(data, shape)
             else:
                 self._store_scalar(name, kind, next(args))
-        self._block(self.node.body)
+        self._statements(self.node.body, CHUNK_STATEMENTS)
+        if self.frame is not None:       # its size is known once every piece is lowered
+            self.frame.operands = [ir.Constant(I64, max(1, len(self.frame_slots)))]
         if not self.b.block.is_terminated:
             if ret_kind is not None:
                 self.fail(self.node, "a path ends without returning a value")
             self.b.ret_void()
         ir.IRBuilder(self.entry).branch(body)
         return fn, ret_kind
+
+    # -- long straight-line runs as functions of their own ---------------------------------
+    def _statements(self, stmts, chunk):
+        """Lower a block like _block, with its runs of at least ``chunk`` plain assignments
+        lowered as separate functions ("pieces") of at most CHUNK_STATEMENTS each: LLVM's
+        register allocator and optimizer take time that grows faster than linearly with the
+        values live at once in one function, and a kernel of a 30-body robot holds tens of
+        thousands of statements (a Jacobian's column loop, thousands per iteration, with the
+        primal values live across it). The values a piece reads from before it and the ones it
+        defines for later statements pass through a frame of doubles on the kernel's stack; an
+        input that does not change in a loop is stored there once, before the loop."""
+        later_reads = [set() for _ in range(len(stmts) + 1)]
+        for i in range(len(stmts) - 1, -1, -1):
+            later_reads[i] = later_reads[i + 1] | _names_read(stmts[i])
+        run = []
+        for i, stmt in enumerate(stmts):
+            if self.b.block.is_terminated:
+                return
+            if _plain_assignment(stmt):
+                run.append(stmt)
+                if len(run) == CHUNK_STATEMENTS:
+                    self._run(run, later_reads[i + 1], chunk)
+                    run = []
+                continue
+            if run:
+                self._run(run, later_reads[i], chunk)
+                run = []
+            self._stmt(stmt)
+        if run and not self.b.block.is_terminated:
+            self._run(run, later_reads[len(stmts)], chunk)
+
+    def _run(self, stmts, read_after, chunk):
+        """Lower ``stmts`` (plain assignments) here, or as one piece when there are at least
+        ``chunk`` of them and every value crossing its boundary is a float."""
+        if len(stmts) < chunk:
+            self._block(stmts)
+            return
+        assigned = set()
+        for stmt in stmts:
+            for t in stmt.targets:
+                if isinstance(t, ast.Name):
+                    assigned.add(t.id)
+        read = set().union(*(_names_read(s) for s in stmts))
+        scalars = {n for n, v in self.vars.items() if isinstance(v, tuple)}
+        inputs = sorted(read & scalars)
+        outputs = sorted(assigned & read_after)
+        crossing = inputs + [n for n in outputs if n not in inputs]
+        arrays = [(n, v) for n, v in self.vars.items() if isinstance(v, Array)]
+        if any(self.vars[n][0] != "f" for n in inputs) or any(
+                self.declared.get(n) not in ("f", None) for n in outputs):
+            self._block(stmts)
+            return
+        for name in crossing:
+            self.frame_slots.setdefault(name, len(self.frame_slots))
+        if self.frame is None:
+            self.frame = ir.IRBuilder(self.entry).alloca(F64, size=ir.Constant(I64, 1),
+                                                         name="frame")
+        for name in inputs:
+            self._store_input(name)
+        piece = _PieceLowering(self, stmts, inputs, outputs, arrays)
+        fn = piece.lower()
+        args = [self.frame]
+        for _, array in arrays:
+            args.append(array.data)
+            args.extend(array.shape)
+        self.b.call(fn, args)
+        for name in outputs:
+            self._store_scalar(name, "f", self.b.load(self._slot(self.frame, name)))
+
+    def _store_input(self, name):
+        """Store a piece's input into its frame slot: once, before the outermost loop in which
+        it does not change, or here."""
+        for loop in self.loops:
+            if name in loop.before and name not in loop.assigned:
+                if name not in loop.stored:
+                    loop.stored.add(name)
+                    builder = ir.IRBuilder(loop.preheader)
+                    builder.position_before(loop.preheader.terminator)
+                    saved, self.b = self.b, builder
+                    try:
+                        kind, value = self._e_Name(ast.Name(id=name, ctx=ast.Load()))
+                        self.b.store(value, self._slot(self.frame, name))
+                    finally:
+                        self.b = saved
+                return
+        kind, value = self._e_Name(ast.Name(id=name, ctx=ast.Load()))
+        self.b.store(value, self._slot(self.frame, name))
+
+    def _slot(self, frame, name):
+        return self.b.gep(frame, [ir.Constant(I64, self.frame_slots[name])])
 
     # -- variables ------------------------------------------------------------------------
     def _alloca(self, ty, name):
@@ -445,6 +539,7 @@ class FunctionLowering:
         head = self.fn.append_basic_block("loop")
         body = self.fn.append_basic_block("loop_body")
         after = self.fn.append_basic_block("loop_end")
+        preheader = self.b.block
         self.b.branch(head)
         self.b.position_at_end(head)
         index = self.b.load(counter)
@@ -453,10 +548,23 @@ class FunctionLowering:
         self.b.position_at_end(body)
         self._store_scalar(node.target.id, "i", index)
         self.b.store(self.b.add(index, ir.Constant(I64, step_value)), counter)
-        self._block(node.body)
+        self._loop_body(node, preheader)
         if not self.b.block.is_terminated:
             self.b.branch(head)
         self.b.position_at_end(after)
+
+    def _loop_body(self, node, preheader):
+        """The body of a loop whose entry branch ends ``preheader``: its long runs as pieces
+        (_statements), their loop-invariant inputs stored in the preheader."""
+        before = {n for n, v in self.vars.items() if isinstance(v, tuple)}
+        assigned = {t.id for sub in node.body for t in ast.walk(sub)
+                    if isinstance(t, ast.Name) and isinstance(t.ctx, ast.Store)}
+        assigned.add(node.target.id)
+        self.loops.append(_Loop(preheader, before, assigned))
+        try:
+            self._statements(node.body, LOOP_CHUNK_STATEMENTS)
+        finally:
+            self.loops.pop()
 
     def _for_constant(self, node, values):
         """``for k in INDICES``: a loop over a module constant int64 array."""
@@ -468,6 +576,7 @@ class FunctionLowering:
         head = self.fn.append_basic_block("cloop")
         body = self.fn.append_basic_block("cloop_body")
         after = self.fn.append_basic_block("cloop_end")
+        preheader = self.b.block
         self.b.branch(head)
         self.b.position_at_end(head)
         at = self.b.load(counter)
@@ -476,7 +585,7 @@ class FunctionLowering:
         value = self.b.load(self.b.gep(var, [ir.Constant(I64, 0), at]))
         self._store_scalar(node.target.id, "i", value)
         self.b.store(self.b.add(at, ir.Constant(I64, 1)), counter)
-        self._block(node.body)
+        self._loop_body(node, preheader)
         if not self.b.block.is_terminated:
             self.b.branch(head)
         self.b.position_at_end(after)
@@ -848,6 +957,100 @@ class FunctionLowering:
 
 
 _KIND_NAMES = {"f": "float", "i": "integer", "b": "bool"}
+
+#: Plain assignments lowered into one function (FunctionLowering._statements): LLVM compiles
+#: pieces of this size in time about linear in their number, at the cost of a call and the
+#: frame's loads and stores per piece.
+CHUNK_STATEMENTS = 2000
+
+#: Inside a loop, a run of plain assignments this long is a piece already: what would make the
+#: register allocator slow is the values live across the loop, which a piece does not see.
+LOOP_CHUNK_STATEMENTS = 200
+
+
+class _Loop:
+    """A loop being lowered: the block that enters it, the scalar names defined before it, the
+    names its body assigns, and the piece inputs already stored in its preheader."""
+
+    def __init__(self, preheader, before, assigned):
+        self.preheader, self.before, self.assigned = preheader, before, assigned
+        self.stored = set()
+
+_PURE_BUILTINS = ("abs", "max", "min", "float")
+
+
+def _names_read(node):
+    return {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+
+
+def _plain_assignment(stmt):
+    """An assignment of arithmetic to names or array elements: no call but math functions
+    and pure builtins, no tuple unpacking (what a piece may hold)."""
+    if not isinstance(stmt, ast.Assign):
+        return False
+    for t in stmt.targets:
+        if not (isinstance(t, ast.Name) or (isinstance(t, ast.Subscript)
+                                            and isinstance(t.value, ast.Name))):
+            return False
+    for node in ast.walk(stmt.value):
+        if isinstance(node, ast.Call):
+            f = node.func
+            if isinstance(f, ast.Name) and f.id in _PURE_BUILTINS:
+                continue
+            if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) \
+                    and f.value.id == "math":
+                continue
+            return False
+        if isinstance(node, (ast.Lambda, ast.NamedExpr)):
+            return False
+    return True
+
+
+class _PieceLowering(FunctionLowering):
+    """A run of plain assignments of ``parent`` as a function of its own: arguments the
+    frame (double*) and the parent's arrays in scope; its inputs are loaded from the frame, its
+    outputs stored there."""
+
+    def __init__(self, parent, stmts, inputs, outputs, arrays):
+        super().__init__(parent.owner, parent.node, parent.globs, (), f"{parent.name}_piece")
+        self.parent, self.stmts = parent, stmts
+        self.inputs, self.outputs, self.arrays = inputs, outputs, arrays
+        self.declared = parent.declared
+        self.single = parent.single
+
+    def lower(self):
+        arg_types = [F64P]
+        for _, array in self.arrays:
+            arg_types.append(F64P)
+            arg_types.extend([I64] * array.ndim)
+        fn = ir.Function(self.owner.module, ir.FunctionType(ir.VoidType(), arg_types),
+                         name=self.owner.module.get_unique_name(self.name))
+        fn.linkage = "internal"
+        fn.attributes.add("noinline")
+        self.fn = fn
+        self.entry = fn.append_basic_block("entry")
+        body = fn.append_basic_block("body")
+        self.b = ir.IRBuilder(body)
+        args = iter(fn.args)
+        frame = next(args)
+        for name, array in self.arrays:
+            data = next(args)
+            self.vars[name] = Array(data, [next(args) for _ in range(array.ndim)])
+        slots = self.parent.frame_slots
+        for name in self.inputs:
+            value = self.b.load(self.b.gep(frame, [ir.Constant(I64, slots[name])]))
+            if name in self.single:
+                self.vars[name] = ("f", None, value)
+            else:                       # the piece may assign it again: a slot of its own
+                self._store_scalar(name, "f", value)
+        self._block(self.stmts)
+        for name in self.outputs:
+            kind, value = self._e_Name(ast.Name(id=name, ctx=ast.Load()))
+            self.b.store(self.cast(value, kind, "f"),
+                         self.b.gep(frame, [ir.Constant(I64, slots[name])]))
+        self.b.ret_void()
+        ir.IRBuilder(self.entry).branch(body)
+        return fn
 
 
 def _load(target):
