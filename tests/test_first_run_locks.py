@@ -62,7 +62,8 @@ def lock(tmp_path):
     return tmp_path / ".run_rk4.compiling"
 
 
-@pytest.mark.parametrize("content", ["not-a-pid", "", "   \n", "12 34", "{\"pid\": \"x\"}", "[1]"])
+@pytest.mark.parametrize("content", ["not-a-pid", "", "   \n", "12 34", "{\"pid\": \"x\"}", "[1]",
+                                     "{\"pid\": -5}", "{\"pid\": 100000000000000000000}"])
 def test_a_lock_of_junk_is_taken_over_at_once(lock, content):
     lock.write_text(content)
     notes = []

@@ -233,7 +233,7 @@ def _stale(lock: Path):
     try:
         record = json.loads(text)
         pid = record["pid"]
-        if isinstance(pid, bool) or not isinstance(pid, int) or pid <= 0:
+        if isinstance(pid, bool) or not isinstance(pid, int) or not 0 < pid < 2**31:
             raise TypeError
     except (ValueError, TypeError, KeyError):
         return f"not a lock record: {text.strip()[:40]!r}"
