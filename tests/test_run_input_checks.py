@@ -135,3 +135,24 @@ def _probe_arguments(cart):
     q, v = np.array(Q0), np.zeros(2)
     out = fixed_driver.allocate(2, 2, plan.n_saved, np.zeros(plan.n_saved), 0)
     return task, cart.run_midpoint, q, v, out
+
+
+def test_a_run_that_starts_interpreted_says_it_once_compiled(cart, capsys, monkeypatch):
+    """An interpreted first run (jit/interpreted.py) measures nothing while Python steps; once
+    it goes on compiled, the remaining steps are measured and announced."""
+    from lagrange_gen.jit import first_run, portable
+    monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
+    monkeypatch.setattr(portable, "portable_cached", lambda module, method: False)
+    monkeypatch.setattr(fixed_driver, "_READY", {})
+    monkeypatch.setattr(fixed_driver, "_INTERPRETED_S", {})
+    monkeypatch.setattr(first_run, "expected_compile_seconds", lambda method: 0.0)
+    monkeypatch.setenv(first_run.INTERPRETED_ENV, "1")
+    remaining = []
+    monkeypatch.setattr(fixed_driver, "seconds_per_step",
+                        lambda task, run, q, v, out, steps: remaining.append(steps) or (0.01, 64))
+    traj = simulate(cart, "rk4", Q0, None, t_end=20.0, h=1e-3)
+    first = fixed_driver.PROBE_STEPS
+    assert traj.jit == f"interpreted, then portable from step {first}"
+    assert remaining == [20_000 - first]
+    lines = [line for line in capsys.readouterr().err.splitlines() if "will take" in line]
+    assert len(lines) == 1 and "about 3.3 minutes" in lines[0]
