@@ -149,10 +149,11 @@ def test_a_run_that_starts_interpreted_says_it_once_compiled(cart, capsys, monke
     monkeypatch.setenv(first_run.INTERPRETED_ENV, "1")
     remaining = []
     monkeypatch.setattr(fixed_driver, "seconds_per_step",
-                        lambda task, run, q, v, out, steps: remaining.append(steps) or (0.01, 64))
+                        lambda task, run, q, v, out, steps, t: remaining.append((steps, t))
+                        or (0.01, 64))
     traj = simulate(cart, "rk4", Q0, None, t_end=20.0, h=1e-3)
     first = fixed_driver.PROBE_STEPS
     assert traj.jit == f"interpreted, then portable from step {first}"
-    assert remaining == [20_000 - first]
+    assert remaining == [(20_000 - first, pytest.approx(first * 1e-3))]
     lines = [line for line in capsys.readouterr().err.splitlines() if "will take" in line]
     assert len(lines) == 1 and "about 3.3 minutes" in lines[0]
