@@ -1,8 +1,9 @@
 """Generate a drawn model, call every kernel its module emits, compare with the reference.
 
-Two ways to run a module: ``"njit"`` calls the compiled dispatchers; ``"py_func"`` runs the
+Three ways to run a module: ``"njit"`` calls the compiled dispatchers; ``"py_func"`` runs the
 printed source as plain Python (pure_kernels), with every kernel a kernel calls (composed
-kernels, forward_dynamics) replaced by its py_func too, so nothing is compiled.
+kernels, forward_dynamics) replaced by its py_func too, so nothing is compiled; ``"native"``
+calls the kernels lowered to LLVM by jit/native.py, as the portable glue does (native_kernels).
 
 Every comparison is recorded in CHECKED {(kind, mode): count}, kind being a kernel name,
 ``<kernel>[composed]``, a forward-dynamics path or ``fd:<kernel>`` (finite differences), so a
@@ -117,6 +118,40 @@ def pure_kernels(mod):
             env[name] = types.FunctionType(f.__code__, scope, name, f.__defaults__, f.__closure__)
     acc = mod.accelerations
     env["accelerations"] = types.FunctionType(acc.__code__, env, "accelerations", acc.__defaults__)
+    return types.SimpleNamespace(**env)
+
+
+_CALLERS: dict = {}
+
+
+def _caller(n_args):
+    """A jitted function calling a first-class function with ``n_args`` arguments: how a
+    native kernel is called from Python (numba compiles it once per kernel signature)."""
+    if n_args not in _CALLERS:
+        from numba import njit
+        names = ", ".join(f"a{i}" for i in range(n_args))
+        scope = {}
+        exec(f"def call(kernel, {names}):\n    return kernel({names})", scope)
+        _CALLERS[n_args] = njit(scope["call"])
+    return _CALLERS[n_args]
+
+
+def native_kernels(mod):
+    """pure_kernels with every kernel that the portable glue can reach (the module's KERNELS and
+    forward_dynamics) replaced by its native kernel (jit/native.py); a kernel outside the subset
+    native_ir lowers raises Unsupported here, so the harness says which."""
+    from lagrange_gen.jit.native import native_kernel
+    from lagrange_gen.jit.portable import native_dir
+    env = vars(pure_kernels(mod))
+    for name in (*mod.KERNELS, "forward_dynamics", *BODY_KERNELS, "forward_dynamics_torques"):
+        if not hasattr(mod, name):
+            continue
+        kernel = native_kernel(mod, name, native_dir())
+
+        def call(*args, _kernel=kernel):
+            return _caller(len(args))(_kernel, *args)
+
+        env[name] = call
     return types.SimpleNamespace(**env)
 
 
@@ -252,14 +287,15 @@ def _residual(label, qdd, H, rhs):
 def check_model(drawn, methods, out_dir, modes, seed, n_states):
     """Generate a DrawnModel for ``methods``, then at ``n_states`` random states check every
     kernel against the reference and every Jacobian kernel against finite differences, in each
-    of ``modes`` ("py_func", "njit"). Returns the list of mismatches (empty when all agree)."""
+    of ``modes`` ("py_func", "njit", "native"). Returns the list of mismatches (empty when all agree)."""
     from .fd import check_derivatives
     from .reference import Reference
     mod = generate(drawn, out_dir, methods)
     ref = Reference(drawn)
     failures = []
     for mode in modes:
-        kern = mod if mode == "njit" else pure_kernels(mod)
+        kern = mod if mode == "njit" else native_kernels(mod) if mode == "native" \
+            else pure_kernels(mod)
         for state in states(drawn, mod, np.random.default_rng(seed), n_states):
             failures += [f"{mode}: {f}" for f in check_kernels(mod, kern, ref, state, mode)]
             try:

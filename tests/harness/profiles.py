@@ -18,8 +18,10 @@ PROFILES = {
     # examples per model class: run as py_func / compiled (njit and py_func); states per model;
     # spatial trees (test_spatial_trees.py): 3-4 bodies against the reference (py_func; njit),
     # 5-10 bodies against the invariants (py_func)
-    "ci": {"py_func": 6, "njit": 1, "states": 3, "trees": 1, "trees_njit": 0, "large_trees": 1},
-    "thorough": {"py_func": 60, "njit": 8, "states": 4, "trees": 30, "trees_njit": 1, "large_trees": 10},
+    "ci": {"py_func": 6, "njit": 1, "native": 3, "states": 3, "trees": 1, "trees_njit": 0,
+           "large_trees": 1},
+    "thorough": {"py_func": 60, "njit": 8, "native": 30, "states": 4, "trees": 30, "trees_njit": 1,
+                 "large_trees": 10},
 }
 _current = {"name": "ci", "count_only": False}
 
@@ -34,7 +36,8 @@ def current():
 
 
 def hypothesis_settings(mode):
-    """Hypothesis settings of the tests running kernels in ``mode`` ("py_func" or "njit"; or a
+    """Hypothesis settings of the tests running kernels in ``mode`` ("py_func", "njit" or
+    "native"; or a
     count of the spatial-tree tests: "trees", "trees_njit", "large_trees")."""
     return settings(max_examples=max(1, current()[mode]), derandomize=True, database=None, deadline=None,
                     phases=(Phase.explicit, Phase.generate), print_blob=False,

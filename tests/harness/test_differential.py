@@ -42,7 +42,7 @@ CASES = {
     "constrained, nonholonomic": (dict(constrained=True, nonholonomic=True), []),
 }
 HARNESS_TESTS = ("test_kernels_as_python_match_reference", "test_compiled_kernels_match_reference",
-                 "test_kepler_kernels_match_reference")
+                 "test_native_kernels_match_reference", "test_kepler_kernels_match_reference")
 
 
 def _run(case, data, out_dir, modes):
@@ -73,6 +73,16 @@ def test_kernels_as_python_match_reference(case, data, tmp_path_factory):
 @given(data=st.data())
 def test_compiled_kernels_match_reference(case, data, tmp_path_factory):
     _run(case, data, tmp_path_factory.mktemp("harness"), MODES)
+
+
+@pytest.mark.parametrize("case", CASES)
+@profiles.hypothesis_settings("native")
+@given(data=st.data())
+def test_native_kernels_match_reference(case, data, tmp_path_factory):
+    """The kernels lowered to LLVM without numba (jit/native.py), as the portable glue calls
+    them, against the same reference: every construct of the users' grammar the printer writes
+    must lower, or the test names the kernel and construct it could not."""
+    _run(case, data, tmp_path_factory.mktemp("harness"), ("native",))
 
 
 def test_kepler_kernels_match_reference(tmp_path):
@@ -113,10 +123,11 @@ def _expected_kinds():
 
 def test_every_kernel_kind_was_checked(request):
     """Coverage of this run: every kernel kind (and composed kernel, forward-dynamics path and
-    finite-difference check) was compared at least once as Python and compiled."""
+    finite-difference check) was compared at least once as Python, compiled by numba and
+    lowered natively."""
     ran = {item.originalname for item in request.session.items}
     if not set(HARNESS_TESTS) <= ran:
         pytest.skip("coverage is judged on a run of the whole harness")
-    missing = sorted(f"{kind} ({mode})" for kind in _expected_kinds() for mode in MODES
-                     if not CHECKED[(kind, mode)])
+    missing = sorted(f"{kind} ({mode})" for kind in _expected_kinds()
+                     for mode in (*MODES, "native") if not CHECKED[(kind, mode)])
     assert not missing, f"never checked: {', '.join(missing)}"

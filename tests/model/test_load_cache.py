@@ -7,7 +7,7 @@ import sys
 import textwrap
 
 from lagrange_gen import load
-from lagrange_gen.run import model_cache
+from lagrange_gen.codegen import model_cache
 
 SPRING = textwrap.dedent("""\
     from pathlib import Path

@@ -65,8 +65,11 @@ def generate_parser():
     p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
                    help="options passed to the model file's build() (e.g. n=8), repeatable")
     p.add_argument("--force", action="store_true",
-                   help="overwrite a generated file even when it was generated from another model "
-                        "file with the same model name (or was not written by lagrange-gen)")
+                   help="derive and write again even when the generated file is current (an "
+                        "unchanged model file, and unchanged files it reads or imports, is "
+                        "otherwise not run again), and overwrite a generated file even when it "
+                        "was generated from another model file with the same model name (or was "
+                        "not written by lagrange-gen)")
     p.add_argument("--debug", action="store_true", help="show tracebacks")
     return p
 
@@ -90,10 +93,17 @@ def run_generate(args) -> int:
 
 
 def _generate_one(path, args, methods, options, freeze):
+    start, where = time.perf_counter(), out_dir(path, args.out_dir)
+    if not args.force:
+        # decided before codegen.generated_files is imported: a current module costs no sympy
+        from ..codegen.model_cache import generation_current
+        target = generation_current(path, where, methods, options, freeze)
+        if target is not None:
+            print(f"{target} is current: not derived again ({time.perf_counter() - start:.2f} s; "
+                  "--force derives it again)")
+            return True
     from ..codegen.generated_files import generate_model
-    start = time.perf_counter()
-    result = generate_model(path, out_dir(path, args.out_dir), methods, options, freeze,
-                            force=args.force)
+    result = generate_model(path, where, methods, options, freeze, force=args.force)
     what = "written" if result.written else "unchanged"
     print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
     return True

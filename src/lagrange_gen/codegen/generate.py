@@ -33,9 +33,13 @@ PROGRESS_EVERY = 30.0
 
 @dataclass
 class GenerationResult:
+    """path: the generated module; written: its file changed; key: its KEY; current: found
+    current without running the model file (nothing derived)."""
+
     path: Path
     written: bool
     key: str
+    current: bool = False
 
 
 def output_path(model_name: str, out_dir) -> Path:

@@ -80,9 +80,10 @@ def check_current(module_file, key, sources, model_relpath, options, text_sha):
     and KEY (a hand edit anywhere), and every package source its compiled code is built from
     against SOURCES (numba's on-disk cache is keyed on the generated file only, so a changed
     stepper must make the module stale). A changed model file is seen by re-deriving:
-    ``lagrange-gen --check`` and ``lagrange_gen.load``; at import, a model text that differs
-    from the one recorded when the module was last generated or checked (derivation_record) is
-    stale too, so a direct import never runs old kernels silently.
+    ``lagrange-gen --check`` and ``lagrange_gen.load``; at import, a model text or a file the
+    model read or imported that differs from the one recorded when the module was last
+    generated or checked (changed_input) is stale too, so a direct import never runs old kernels
+    silently.
     """
     problem = why_stale(Path(module_file), key, sources, text_sha) or _model_changed(
         Path(module_file), model_relpath, key)
@@ -97,25 +98,60 @@ def derivation_record_path(target) -> Path:
     return target.parent / "__pycache__" / f"{target.stem}.lagrange-gen.json"
 
 
-def _model_changed(here, model_relpath, key):
-    """A phrase when the model file's text differs from the recorded one for this KEY, else None
-    (also None without a record, e.g. a fresh clone: --check re-derives to tell)."""
+def read_derivation_record(target) -> dict | None:
+    """The derivation record of the generated module ``target`` (a dict), or None when it is
+    missing or unreadable."""
     try:
-        record = json.loads(derivation_record_path(here).read_text())
-        text = (here.parent / model_relpath).read_text()
+        record = json.loads(derivation_record_path(target).read_text())
     except (OSError, ValueError, UnicodeDecodeError):
         return None
-    if not isinstance(record, dict) or record.get("key") != key:
-        return None
+    return record if isinstance(record, dict) else None
+
+
+def changed_input(record, model_path) -> str | None:
+    """The first input of a generated module whose content differs from its derivation
+    ``record`` (read_derivation_record), or that is gone: the model file ``model_path``, then
+    every file the model file read or imported while it ran (its data files, a Python file it
+    exec()d, its helper modules: model.data_files). Its path, or None when all are as recorded.
+
+    The one verdict on a module's inputs: the check every generated module runs on import, load
+    and simulate of a model file (codegen.model_cache, without running the file), generation
+    (which skips an unchanged model) and ``--check`` (which names the file) all ask it. Cheap:
+    a recorded file whose size and mtime are unchanged is not read."""
+    try:
+        text = Path(model_path).read_text()
+    except (OSError, UnicodeDecodeError):
+        return str(model_path)
     if record.get("model") != model_hash(text):
-        return (f"{_shown(here.parent / model_relpath)} changed since {here} was generated (if "
-                "only comments changed, regenerating leaves the module as it is)")
-    data_files = record.get("data_files")
-    changed = changed_data_file(data_files) if isinstance(data_files, dict) else None
-    if changed is not None:
-        return (f"{_shown(changed)} changed since {here} was generated (a data file or helper "
-                f"module that {_shown(here.parent / model_relpath)} reads or imports)")
-    return None
+        return str(model_path)
+    inputs = record.get("data_files", {})
+    return changed_data_file(inputs) if isinstance(inputs, dict) else str(model_path)
+
+
+def input_change(changed, model_path, since) -> str:
+    """The phrase saying that ``changed`` (from changed_input) changed since ``since`` was
+    generated, and, for a file other than the model file ``model_path``, that the model reads it."""
+    if os.path.realpath(changed) == os.path.realpath(model_path):
+        return f"{_shown(model_path)} changed since {since} was generated"
+    return (f"{_shown(changed)} changed since {since} was generated; {_shown(model_path)} reads or "
+            "imports it")
+
+
+def _model_changed(here, model_relpath, key):
+    """A phrase when the model file or a file it read differs from the derivation record for
+    this KEY (changed_input), else None (also None without a record, e.g. a fresh clone:
+    --check re-derives to tell)."""
+    record = read_derivation_record(here)
+    if record is None or record.get("key") != key:
+        return None
+    model_path = here.parent / model_relpath
+    changed = changed_input(record, model_path)
+    if changed is None or (changed == str(model_path) and not model_path.is_file()):
+        return None
+    if changed == str(model_path):
+        return (f"{input_change(changed, model_path, here)} (if only comments changed, "
+                "regenerating leaves the module as it is)")
+    return input_change(changed, model_path, here)
 
 
 def changed_data_file(records) -> str | None:

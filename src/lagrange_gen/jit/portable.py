@@ -33,7 +33,6 @@ import collections
 import functools
 import hashlib
 import importlib.util
-import inspect
 import os
 import sys
 import tempfile
@@ -126,14 +125,9 @@ def _use_fallback_dir(failed: Path, exc: OSError) -> Path:
 
 
 def _kernel_arg_types(fn):
-    """numba types of a kernel's arguments, from their names: t a float, the outputs that are
-    always 2-D (codegen.kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
-    C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
-    from numba import types
-    from ..codegen.kernel_abi import ALWAYS_2D
-    names = list(inspect.signature(fn).parameters)
-    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
-                 else types.float64[::1] for a in names)
+    """numba types of a kernel's arguments (native.kernel_arg_types)."""
+    from .native import kernel_arg_types
+    return kernel_arg_types(fn)
 
 
 @functools.lru_cache(maxsize=None)
@@ -198,14 +192,33 @@ def _typeof_table(table, context):
 
 def kernel_table(module, method):
     """The kernel table of ``module`` for ``method`` (cached on the module): kernels as
-    FunctionKernel (compiled for the portable types on first use), constants as they are."""
+    first-class functions (table_kernel), constants as they are."""
     tables = module.__dict__.setdefault("_PORTABLE_TABLES", {})
     if method not in tables:
-        kernel = _function_kernel_class()
         cls = table_class(method)
         tables[method] = cls(*(getattr(module, field) if field.isupper()
-                               else kernel(getattr(module, field)) for field in cls._fields))
+                               else table_kernel(module, field) for field in cls._fields))
     return tables[method]
+
+
+def native_dir() -> Path:
+    """Where native kernels' object code is kept (jit/native.py): beside the portable glue."""
+    return portable_dir() / "native"
+
+
+def table_kernel(module, name):
+    """Kernel ``name`` of ``module`` as a numba first-class function of the portable argument
+    types: compiled by llvmlite from its source (jit/native.py: no numba compile, object code
+    cached), else compiled by numba (FunctionKernel), with one warning line naming the kernel
+    and why it could not be lowered. $LAGRANGE_GEN_NATIVE=0: always numba."""
+    from . import native
+    if native.enabled():
+        from .native_ir import Unsupported
+        try:
+            return native.native_kernel(module, name, native_dir())
+        except Unsupported as exc:
+            native.warn_numba_compiles(module, name, exc)
+    return _function_kernel_class()(getattr(module, name))
 
 
 def _library_hash(method: str) -> str:

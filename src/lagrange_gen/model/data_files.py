@@ -1,13 +1,17 @@
-"""The data files a model file reads while it runs (its parameters from a JSON file, a table of
-coefficients): recorded at generation, so that a changed data file makes the generated module
-stale for load, simulate and a direct import, as it is for ``lagrange-gen --check``
-(codegen.generated_files records them; codegen.keys.changed_data_file checks them on import).
+"""The files a model file reads while it runs (its parameters from a JSON file, a table of
+coefficients, a Python file it exec()s): recorded at generation, so that a changed one makes the
+generated module stale for load, simulate, generation and a direct import, as it is for
+``lagrange-gen --check`` (codegen.generated_files records them; codegen.keys.changed_input
+decides for all of them).
 
 Files are seen through Python's audit hook "open" (sys.addaudithook, installed once on first
-use, recording only inside ``files_read``). Recorded: regular files opened for reading, but not
-the model file itself, Python source or bytecode (imports), nor files of the Python
-installation or of installed packages, which are not the model's data. (The helper modules a
-model file imports from its own folder are recorded beside these by model/model_file.py.)
+use, recording only inside ``files_read``): whatever opens them (open, Path.read_text, numpy's
+loaders), as long as it goes through Python's open. Recorded: regular files opened for reading,
+Python source too (a file exec()d as data), but not the model file itself, bytecode and
+extension modules, nor files of the Python installation, of installed packages or of
+lagrange-gen itself (its sources are the generator's, keys.generator_hash). The modules a model
+file imports that are not installed (a helper beside it, or in a folder it put on sys.path) are
+recorded beside these by model/model_file.py, with the same rule (is_model_input).
 """
 
 from __future__ import annotations
@@ -19,11 +23,12 @@ import threading
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["files_read", "file_record"]
+__all__ = ["files_read", "file_record", "is_model_input"]
 
 _STATE = threading.local()
 _HOOK_INSTALLED = False
-_NOT_DATA_SUFFIXES = (".py", ".pyc", ".pyo", ".pyd", ".so", ".pth")
+_NOT_INPUT_SUFFIXES = (".pyc", ".pyo", ".pyd", ".so", ".pth")
+_PACKAGE = os.path.realpath(Path(__file__).resolve().parents[1])       # src/lagrange_gen
 
 
 @contextmanager
@@ -39,7 +44,7 @@ def files_read(exclude=()):
     finally:
         _STATE.found = outer
         skip = {os.path.realpath(p) for p in exclude}
-        kept = {p for p in found if p not in skip and _is_data_file(p)}
+        kept = {p for p in found if p not in skip and is_model_input(p)}
         found.clear()
         found.update(kept)
         if outer is not None:
@@ -93,11 +98,14 @@ def _audit(event, args):
         pass
 
 
-def _is_data_file(path):
-    if not os.path.isfile(path) or path.endswith(_NOT_DATA_SUFFIXES):
+def is_model_input(path) -> bool:
+    """True when the file at the real path ``path`` is the model's own input: a regular file
+    that is not bytecode or an extension module, and not part of the Python installation, an
+    installed package (site-packages, dist-packages) or lagrange-gen."""
+    if not os.path.isfile(path) or path.endswith(_NOT_INPUT_SUFFIXES):
         return False
     parts = Path(path).parts
     if "site-packages" in parts or "dist-packages" in parts or "__pycache__" in parts:
         return False
-    roots = {os.path.realpath(p) for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)}
+    roots = {os.path.realpath(p) for p in (sys.prefix, sys.base_prefix, sys.exec_prefix)} | {_PACKAGE}
     return not any(path.startswith(root + os.sep) for root in roots)

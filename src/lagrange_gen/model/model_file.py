@@ -2,9 +2,13 @@
 (exceptions, sys.exit, os.chdir) into one ModelError line naming the file and line.
 
 While the file runs its folder is first on sys.path, as for ``python model.py``, so that it can
-import a helper module beside it; afterwards sys.path is as it was, and the helper modules it
-imported leave sys.modules (the next load reads them again) and are recorded with the data
-files it read, so that a changed helper makes the generated module stale."""
+import a helper module beside it; afterwards sys.path is as it was. Everything the file read
+while it ran is recorded in ``Model.data_files`` with its content hash (generation keeps the
+record, codegen.keys.changed_input checks it): the files it opened for reading (data files, a
+Python file it exec()s) and the modules it imported that are not installed packages (a helper
+beside it, or in a folder it put on sys.path). Those modules leave sys.modules afterwards, so the
+next load reads them again.
+"""
 
 from __future__ import annotations
 
@@ -17,7 +21,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..errors import ModelError
-from .data_files import file_record, files_read
+from .data_files import file_record, files_read, is_model_input
 from .model import Model
 
 __all__ = ["load_model"]
@@ -45,7 +49,7 @@ def load_model(path, **options) -> Model:
         compile(source, str(path), "exec")
     except SyntaxError as exc:
         raise ModelError(f"{path}:{exc.lineno}: not valid Python: {exc.msg}") from None
-    with files_read(exclude=[path]) as data_files, _folder_importable(path) as helpers:
+    with files_read(exclude=[path]) as data_files, _imports_recorded(path) as helpers:
         model = _run_model_file(path, options)
     model.source_path = str(path)
     # What the model read besides its own text: generation records it (codegen.generated_files).
@@ -73,11 +77,11 @@ def _refuse_generated(path, source):
 
 
 @contextmanager
-def _folder_importable(path):
+def _imports_recorded(path):
     """Within the block the model file's folder is first on sys.path; yields a set filled, when
-    the block ends, with the source files of the modules imported from that folder (or below)
-    during the block, which then leave sys.modules. sys.path is restored whatever the file did
-    to it."""
+    the block ends, with the source files of the modules first imported during the block that
+    are the model's own (data_files.is_model_input: not installed, not lagrange-gen), which then
+    leave sys.modules. sys.path is restored whatever the file did to it."""
     folder = str(Path(path).resolve().parent)
     saved_path, known = list(sys.path), set(sys.modules)
     sys.path.insert(0, folder)
@@ -87,25 +91,22 @@ def _folder_importable(path):
     finally:
         sys.path[:] = saved_path
         for name in set(sys.modules) - known:
-            source = _helper_source(name, sys.modules.get(name), folder)
+            source = _helper_source(name, sys.modules.get(name))
             if source is not None:
                 helpers.add(source)
                 sys.modules.pop(name, None)
 
 
-def _helper_source(name, module, folder):
-    """The real path of the .py file of module ``name`` when it was imported from ``folder`` as
-    a helper: its top-level module or package sits directly in the folder (not, say, in a
-    virtual environment below it, nor lagrange_gen itself). Else None."""
+def _helper_source(name, module):
+    """The real path of the .py file of module ``name`` when it is the model's own (a helper
+    beside it or in a folder it put on sys.path; not an installed package, not the standard
+    library, not lagrange_gen itself); else None."""
     filename = getattr(module, "__file__", None)
-    top = name.partition(".")[0]
-    if not isinstance(filename, str) or not filename.endswith(".py") or top == "lagrange_gen":
+    if (not isinstance(filename, str) or not filename.endswith(".py")
+            or name.partition(".")[0] == "lagrange_gen"):
         return None
     source = os.path.realpath(filename)
-    for root in (os.path.join(folder, top + ".py"), os.path.join(folder, top)):
-        if source == root or source.startswith(root + os.sep):
-            return source
-    return None
+    return source if is_model_input(source) else None
 
 
 def _run_model_file(path, options):

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..codegen.keys import check_current, default_generated_dir, read_key
 from ..errors import GenerationError, StaleModuleError
-from . import model_cache
+from ..codegen import model_cache
 from ..jit.cache import GENERATED_MODULE_PREFIX
 
 

@@ -1,0 +1,329 @@
+"""Native kernels: a generated kernel compiled by llvmlite from the IR jit/native_ir.py writes,
+without numba's front end, and cached as object code.
+
+The portable glue (jit/portable.py) calls a model's kernels through numba first-class functions:
+all it needs of a kernel is the address of a function with numba's C-wrapper ABI and its numba
+signature. ``native_kernel(module, name)`` gives that object for a kernel of a generated module:
+its source, and the sources of every function it calls (a sibling kernel, the Cholesky
+factorization of steppers/core/linalg.py), are lowered to one LLVM module, optimized at
+OPT_LEVEL for the host CPU (its name and features: a generic x86-64 target is several times
+slower on the Jacobians) and compiled in this process. The object code is written to
+``<folder>/<key>.o`` (jit.portable.native_dir: beside the portable glue) with its return kind
+and hash beside it; the key hashes those sources,
+the module constants they read, this package's IR writer, llvmlite's version, the CPU and the
+optimization level, so an unchanged kernel loads in milliseconds in the next process.
+
+A kernel outside the subset native_ir lowers raises native_ir.Unsupported; jit/portable.py then
+compiles it with numba and says so in one line. $LAGRANGE_GEN_NATIVE=0 turns native kernels off
+(every kernel compiled by numba, as before). Both give the same numbers to rounding
+(tests/test_native_kernels.py compares every kernel of the generated models).
+"""
+
+from __future__ import annotations
+
+import ast
+import functools
+import hashlib
+import json
+import os
+import tempfile
+import threading
+from pathlib import Path
+
+from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, function_source
+
+#: Environment variable that turns native kernels off ("0", "off", "no", "false").
+NATIVE_ENV = "LAGRANGE_GEN_NATIVE"
+
+#: Environment variable giving LLVM's optimization level of native kernels (0 to 3).
+OPT_ENV = "LAGRANGE_GEN_NATIVE_OPT"
+
+#: LLVM optimization level: level 1 compiles the big kernels several times faster than 2 or 3
+#: and costs little per call on straight-line code (docs/guides/first-run.md has the table).
+OPT_LEVEL = 1
+
+_OFF = ("0", "off", "no", "false")
+
+#: The exported symbol of a kernel in its LLVM module.
+EXPORT_PREFIX = "lagrange_gen_native_"
+
+#: What a kernel returns: a float, an int (a status), a bool, or nothing.
+_RETURN_KINDS = ("f", "i", "b", None)
+
+_LOCK = threading.Lock()
+_ENGINES: list = []          # every execution engine made: they own the compiled code
+_KERNELS: dict = {}          # (module file, kernel name, key) -> NativeKernel
+
+
+_WARNED: set = set()
+
+
+def warn_numba_compiles(module, name, reason) -> None:
+    """One warning line per kernel and process: kernel ``name`` of ``module`` is compiled by
+    numba because it could not be lowered (``reason``)."""
+    model = getattr(module, "NAME", module.__name__)
+    if (model, name) not in _WARNED:
+        _WARNED.add((model, name))
+        import warnings
+        warnings.warn(f"lagrange-gen: {model}.{name} compiled by numba (native kernels: "
+                      f"{reason})", RuntimeWarning, stacklevel=3)
+
+
+def enabled() -> bool:
+    """Whether native kernels are on ($LAGRANGE_GEN_NATIVE)."""
+    return os.environ.get(NATIVE_ENV, "1").strip().lower() not in _OFF
+
+
+def opt_level() -> int:
+    """LLVM's optimization level ($LAGRANGE_GEN_NATIVE_OPT, else OPT_LEVEL)."""
+    text = os.environ.get(OPT_ENV, "").strip()
+    if text in ("0", "1", "2", "3"):
+        return int(text)
+    return OPT_LEVEL
+
+
+@functools.lru_cache(maxsize=None)
+def _llvm():
+    """llvmlite's binding, with the native target initialized and the C library's math
+    functions the IR may call made known to the JIT's symbol lookup."""
+    import ctypes
+    import ctypes.util
+    import llvmlite.binding as llvm
+    llvm.initialize_native_target()
+    llvm.initialize_native_asmprinter()
+    libm_path = ctypes.util.find_library("m")
+    libm = ctypes.CDLL(libm_path) if libm_path else ctypes.CDLL(None)
+    for symbol in LIBM_SYMBOLS:
+        try:
+            llvm.add_symbol(symbol, ctypes.cast(getattr(libm, symbol), ctypes.c_void_p).value)
+        except AttributeError:        # not in this C library: a kernel calling it fails to link
+            pass
+    return llvm
+
+
+@functools.lru_cache(maxsize=None)
+def _target_machine(level: int):
+    llvm = _llvm()
+    target = llvm.Target.from_default_triple()
+    return target.create_target_machine(cpu=llvm.get_host_cpu_name(),
+                                        features=llvm.get_host_cpu_features().flatten(),
+                                        opt=level, codemodel="jitdefault")
+
+
+@functools.lru_cache(maxsize=None)
+def _writer_hash() -> str:
+    """sha256 of the IR writer and this module: a change to either is a new key."""
+    digest = hashlib.sha256()
+    for name in ("native_ir.py", "native.py"):
+        digest.update((Path(__file__).parent / name).read_bytes())
+    return digest.hexdigest()
+
+
+def _closure(fn):
+    """[(name, source, constants)] of ``fn`` and every function it calls by a global name,
+    each once: what a kernel's object code is made of. constants: the int/float/bool module
+    constants its names read."""
+    seen, out, todo = set(), [], [fn]
+    while todo:
+        f = todo.pop()
+        py = getattr(f, "py_func", f)
+        if id(py) in seen:
+            continue
+        seen.add(id(py))
+        source, node, globs = function_source(py)
+        constants = {}
+        names = {sub.id for sub in ast.walk(node) if isinstance(sub, ast.Name)}
+        for name in sorted(names & globs.keys()):
+            value = globs[name]
+            if isinstance(value, (bool, int, float)):
+                constants[name] = repr(value)
+            elif hasattr(value, "tobytes") and hasattr(value, "dtype"):
+                constants[name] = (str(value.dtype), value.shape,
+                                   hashlib.sha256(value.tobytes()).hexdigest())
+            elif callable(value) and (hasattr(value, "py_func") or hasattr(value, "__code__")):
+                todo.append(value)
+        out.append((f"{py.__module__}.{py.__qualname__}",
+                    hashlib.sha256(source.encode()).hexdigest(), sorted(constants.items())))
+    return out
+
+
+def kernel_key(fn, arg_kinds, level) -> str:
+    """The object cache key of kernel ``fn`` compiled for ``arg_kinds`` at ``level``."""
+    llvm = _llvm()
+    import llvmlite
+    digest = hashlib.sha256()
+    digest.update(repr((_writer_hash(), llvmlite.__version__, llvm.get_host_cpu_name(),
+                        llvm.get_host_cpu_features().flatten(), level, tuple(arg_kinds))).encode())
+    for item in _closure(fn):
+        digest.update(repr(item).encode())
+    return digest.hexdigest()[:32]
+
+
+def kernel_arg_types(fn):
+    """numba types of a kernel's arguments, from their names: t a float, the outputs that are
+    always 2-D (codegen.kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
+    C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
+    import inspect
+    from numba import types
+    from ..codegen.kernel_abi import ALWAYS_2D
+    names = list(inspect.signature(fn).parameters)
+    return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
+                 else types.float64[::1] for a in names)
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def lower_kernel(fn, arg_kinds, name="kernel"):
+    """(LLVM IR text, return kind) of kernel ``fn`` exported as EXPORT_PREFIX + name.
+    arg_kinds: per argument "t" (a double) or the array's number of dimensions."""
+    builder = ModuleBuilder(name)
+    ret = builder.export(fn, EXPORT_PREFIX + name, arg_kinds)
+    return str(builder.module), ret
+
+
+def _compile(ir_text, level):
+    """Object code of ``ir_text`` optimized at ``level`` for the host CPU."""
+    llvm = _llvm()
+    module = llvm.parse_assembly(ir_text)
+    module.verify()
+    tm = _target_machine(level)
+    if level > 0:
+        _optimize(llvm, module, tm, level)
+    return tm.emit_object(module)
+
+
+def _optimize(llvm, module, tm, level):
+    """LLVM's module pipeline at ``level``: the new pass manager where llvmlite has it, else
+    the legacy PassManagerBuilder (llvmlite < 0.44, with numba 0.59 and 0.60)."""
+    if hasattr(llvm, "create_pass_builder"):
+        pto = llvm.create_pipeline_tuning_options(speed_level=level)
+        pb = llvm.create_pass_builder(tm, pto)
+        pm = pb.getModulePassManager()
+        pm.run(module, pb)
+        return
+    pmb = llvm.create_pass_manager_builder()
+    pmb.opt_level = level
+    pm = llvm.create_module_pass_manager()
+    tm.add_analysis_passes(pm)
+    pmb.populate(pm)
+    pm.run(module)
+
+
+def _load_object(obj: bytes, symbol: str) -> int:
+    """Address of ``symbol`` in object code ``obj``, loaded into a new execution engine that
+    lives as long as the process."""
+    llvm = _llvm()
+    empty = llvm.parse_assembly("")
+    engine = llvm.create_mcjit_compiler(empty, _target_machine(0))
+    engine.add_object_file(llvm.ObjectFileRef.from_data(obj))
+    engine.finalize_object()
+    address = engine.get_function_address(symbol)
+    if not address:
+        raise Unsupported(f"the object code has no symbol {symbol}")
+    _ENGINES.append(engine)
+    return address
+
+
+@functools.lru_cache(maxsize=None)
+def _native_kernel_class():
+    from numba.experimental.function_type import WrapperAddressProtocol
+
+    class NativeKernel(WrapperAddressProtocol):
+        """A generated kernel compiled by llvmlite, as a numba first-class function: the
+        address of its function with numba's C-wrapper ABI, and its numba signature."""
+
+        def __init__(self, dispatcher, name, address, signature, key, seconds, cached):
+            # the generated kernel it was lowered from: the interpreted tier runs its Python
+            self.dispatcher = dispatcher
+            self.name, self.address, self.sig = name, address, signature
+            self.key, self.seconds, self.cached = key, seconds, cached
+
+        def __wrapper_address__(self):
+            return self.address
+
+        def signature(self):
+            return self.sig
+
+        def __repr__(self):
+            return f"<native kernel {self.name} at {self.address:#x}>"
+
+    return NativeKernel
+
+
+def _signature(ret, arg_types):
+    from numba import types
+    restype = {"f": types.float64, "i": types.int64, "b": types.boolean, None: types.none}[ret]
+    return restype(*arg_types)
+
+
+def native_kernel(module, name, folder: Path):
+    """The kernel ``name`` of generated ``module`` compiled natively (a NativeKernel), from the
+    object cache in ``folder`` when it holds it (jit.portable.native_dir). Raises
+    native_ir.Unsupported when the kernel is outside the subset, or llvmlite lacks what is used
+    (then the caller compiles it with numba)."""
+    import time
+    from numba import types
+    fn = getattr(module, name)
+    py = getattr(fn, "py_func", fn)
+    arg_types = kernel_arg_types(fn)
+    arg_kinds = tuple("t" if ty == types.float64 else ty.ndim for ty in arg_types)
+    level = opt_level()
+    try:
+        key = kernel_key(fn, arg_kinds, level)
+    except Unsupported:
+        raise
+    except Exception as exc:     # llvmlite's binding or a source missing: numba compiles
+        raise Unsupported(f"{type(exc).__name__}: {exc}".splitlines()[0]) from None
+    memo = (getattr(module, "__file__", None), name, key)
+    with _LOCK:
+        if memo in _KERNELS:
+            return _KERNELS[memo]
+        start = time.perf_counter()
+        obj_path, meta_path = folder / f"{key}.o", folder / f"{key}.json"
+        obj = ret = None
+        try:
+            meta = json.loads(meta_path.read_text())
+            obj, ret = obj_path.read_bytes(), meta["ret"]
+            # a truncated or foreign file must not reach LLVM's loader, which aborts the process
+            if hashlib.sha256(obj).hexdigest() != meta["sha256"] or ret not in _RETURN_KINDS:
+                obj = None
+        except (OSError, ValueError, KeyError, TypeError):
+            obj = None
+        cached = obj is not None
+        symbol = f"{EXPORT_PREFIX}{name}_{key[:16]}"
+        if not cached:
+            ir_text, ret = lower_kernel(py, arg_kinds, symbol[len(EXPORT_PREFIX):])
+            try:
+                obj = _compile(ir_text, level)
+            except Exception as exc:        # LLVM refused the IR: a bug here, numba compiles
+                raise Unsupported(f"LLVM: {exc}".splitlines()[0]) from None
+            try:
+                # the object first: a reader trusts an object only through its meta's hash
+                _write_atomic(obj_path, obj)
+                _write_atomic(meta_path, json.dumps({"ret": ret, "kernel": name,
+                                                     "sha256": hashlib.sha256(obj).hexdigest()}).encode())
+            except OSError:          # an unwritable cache: compiled again next time
+                pass
+        try:
+            address = _load_object(obj, symbol)
+        except Unsupported:
+            raise
+        except Exception as exc:
+            raise Unsupported(f"loading the object code: {exc}".splitlines()[0]) from None
+        kernel = _native_kernel_class()(fn, name, address, _signature(ret, arg_types), key,
+                                        time.perf_counter() - start, cached)
+        _KERNELS[memo] = kernel
+        return kernel

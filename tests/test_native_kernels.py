@@ -1,0 +1,203 @@
+"""Native kernels (lagrange_gen.jit.native): generated kernels lowered to LLVM IR and compiled by
+llvmlite, called by the portable glue in place of numba-compiled kernels.
+
+They must compute what the printed Python computes (the harness, tests/harness, checks them
+against an independent reference on random models of the whole grammar; here: every kernel of
+shipped models, planar and 3D, against the same source run as Python), have the signature numba
+gives the same kernel (or the portable glue would compile again), come back from the object
+cache, survive a corrupt cache file, and hand a kernel they cannot lower to numba with one line.
+"""
+
+import json
+import types
+import warnings
+
+import numpy as np
+import pytest
+
+from harness.check import _caller, pure_kernels
+from lagrange_gen.codegen.kernel_abi import argument_shapes, kernel_dimensions
+from lagrange_gen.jit import native, portable
+from lagrange_gen.jit.native_ir import Unsupported
+
+#: Shipped models whose kernels cover the kinds a model can have: planar (cart pendulum),
+#: rheonomic T1 and work (driven pendulum), holonomic constraints (slider crank, four bar),
+#: contacts with a constant mass matrix (bouncing ball, puck on a table: 3D friction),
+#: nonsmooth elements (prandtl), velocity constraints (chaplygin sleigh, the rolling disk),
+#: a 3D rigid body (heavy top) and a 3D robot built from bodies (UR5: recursive kernels).
+MODELS = ["cart_pendulum", "driven_pendulum", "slider_crank", "four_bar", "bouncing_ball",
+          "puck_on_table", "prandtl", "chaplygin_sleigh", "rolling_disk", "heavy_top", "ur5"]
+
+
+def _inputs(mod, name, rng):
+    """Arguments of kernel ``name`` of ``mod``: random states in [-1, 1], parameters near their
+    defaults, outputs filled with the same random numbers for both calls (a kernel that leaves
+    an entry unwritten leaves it equal)."""
+    shapes = argument_shapes(name, kernel_dimensions(vars(mod)))
+    args = []
+    for arg, shape in shapes:
+        if shape is None:
+            args.append(0.37)
+        elif arg == "p":
+            p = np.array([1.3 if d is None else d for d in mod.DEFAULTS], dtype=float)
+            args.append(p * rng.uniform(0.9, 1.1, p.shape))
+        else:
+            args.append(rng.uniform(-1.0, 1.0, shape))
+    return args
+
+
+def _kernel_names(mod):
+    return [k for k in (*mod.KERNELS, "forward_dynamics", "inverse_dynamics", "gravity_forces",
+                        "bias_forces", "forward_dynamics_torques")
+            if hasattr(mod, k) and argument_shapes(k, kernel_dimensions(vars(mod))) is not None]
+
+
+def _same(got, expected):
+    """Equal to rounding: the same operations in the same order give the same bits, but for
+    the C library's pow against repeated multiplication of an integer power."""
+    got, expected = np.asarray(got, dtype=float), np.asarray(expected, dtype=float)
+    assert np.array_equal(np.isnan(got), np.isnan(expected))
+    scale = max(1.0, float(np.nanmax(np.abs(expected)))) if expected.size else 1.0
+    assert np.nanmax(np.abs(got - expected), initial=0.0) <= 1e-13 * scale
+
+
+@pytest.mark.parametrize("stem", MODELS)
+def test_native_kernels_equal_the_printed_python(stem, generated):
+    mod = generated(stem)
+    python = pure_kernels(mod)
+    rng = np.random.default_rng(7)
+    names = _kernel_names(mod)
+    assert "forward_dynamics" in names
+    for name in names:
+        kernel = native.native_kernel(mod, name, portable.native_dir())
+        for _ in range(2):
+            args = _inputs(mod, name, rng)
+            mine = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+            theirs = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+            got = _caller(len(mine))(kernel, *mine)
+            expected = getattr(python, name)(*theirs)
+            if expected is None:
+                assert got is None, name
+            else:
+                _same(got, expected)
+            for a, b in zip(mine, theirs):
+                if isinstance(a, np.ndarray):
+                    _same(a, b)
+
+
+def test_native_signature_is_numbas(generated):
+    """The portable glue's type holds each kernel's signature: a native kernel typed otherwise
+    than numba types the same kernel would compile the glue again (or call it wrongly)."""
+    mod = generated("bouncing_ball")
+    function_kernel = portable._function_kernel_class()
+    for name in ("forward_dynamics", "energy", "contacts", "events", "mass_matrix"):
+        assert native.native_kernel(mod, name, portable.native_dir()).signature() == \
+            function_kernel(getattr(mod, name)).signature(), name
+
+
+def _fresh(monkeypatch, tmp_path):
+    """An empty object cache and no kernel remembered in this process."""
+    monkeypatch.setenv("LAGRANGE_GEN_PORTABLE_DIR", str(tmp_path))
+    monkeypatch.setattr(native, "_KERNELS", {})
+
+
+def test_object_cache_is_reused_and_a_corrupt_file_is_compiled_again(generated, monkeypatch,
+                                                                     tmp_path):
+    mod = generated("cart_pendulum")
+    _fresh(monkeypatch, tmp_path)
+    rng = np.random.default_rng(3)
+    args = _inputs(mod, "forward_dynamics", rng)
+
+    def run(kernel):
+        mine = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+        status = _caller(len(mine))(kernel, *mine)
+        return status, mine[-1]
+
+    first = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
+    assert not first.cached
+    objects = sorted(portable.native_dir().glob("*.o"))
+    assert len(objects) == 1
+    monkeypatch.setattr(native, "_KERNELS", {})
+    again = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
+    assert again.cached and again.key == first.key
+    expected = run(first)
+    assert run(again)[0] == expected[0] and np.array_equal(run(again)[1], expected[1])
+    # a truncated object (a process killed while copying a cache, a full disk) is not loaded
+    objects[0].write_bytes(objects[0].read_bytes()[:100])
+    monkeypatch.setattr(native, "_KERNELS", {})
+    repaired = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
+    assert not repaired.cached
+    assert np.array_equal(run(repaired)[1], expected[1])
+    meta = json.loads(objects[0].with_suffix(".json").read_text())
+    assert meta["kernel"] == "forward_dynamics" and meta["ret"] == "i"
+
+
+def test_a_changed_kernel_is_a_new_key(generated, monkeypatch, tmp_path):
+    """The key covers the kernel's source and the constants it reads: a module constant with
+    another value (MASS_FACTOR of other default parameters, SINGULAR_RTOL) is another object."""
+    mod = generated("bouncing_ball")
+    _fresh(monkeypatch, tmp_path)
+    before = native.native_kernel(mod, "forward_dynamics", portable.native_dir()).key
+    changed = types.ModuleType(mod.__name__ + "_changed")
+    changed.__dict__.update(vars(mod))
+    # the same function source, reading another constant factor
+    fn = mod.forward_dynamics.py_func
+    scope = dict(fn.__globals__, MASS_FACTOR=2.0 * mod.MASS_FACTOR)
+    changed.forward_dynamics = types.FunctionType(fn.__code__, scope, fn.__name__)
+    assert native.native_kernel(changed, "forward_dynamics", portable.native_dir()).key != before
+
+
+_OUTSIDE = '''
+import math
+
+
+def loop_kernel(q, t, p, out):
+    k = 0
+    while k < 2:
+        out[k] = math.sin(q[k]) * p[0]
+        k += 1
+'''
+
+
+def test_a_kernel_outside_the_subset_is_compiled_by_numba_with_one_line(tmp_path, monkeypatch):
+    """A construct native_ir does not lower (here a while loop) is refused by name and line,
+    and the portable table gets numba's kernel instead: the same numbers, one warning."""
+    import importlib.util
+    from lagrange_gen.jit import njit, KERNEL_OPTIONS
+    path = tmp_path / "outside_kernels.py"
+    path.write_text(_OUTSIDE)
+    spec = importlib.util.spec_from_file_location("outside_kernels", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod.NAME = "outside"
+    mod.loop_kernel = njit(**dict(KERNEL_OPTIONS, cache=False))(mod.loop_kernel)
+    with pytest.raises(Unsupported, match=r"loop_kernel, line 3 of its source: statement While"):
+        native.native_kernel(mod, "loop_kernel", portable.native_dir())
+    monkeypatch.setattr(native, "_WARNED", set())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        kernel = portable.table_kernel(mod, "loop_kernel")
+    lines = [str(w.message) for w in caught]
+    assert len(lines) == 1 and "outside.loop_kernel compiled by numba" in lines[0], lines
+    assert "\n" not in lines[0]
+    assert isinstance(kernel, portable._function_kernel_class())
+    q, out = np.array([0.3, -0.2]), np.zeros(2)
+    _caller(4)(kernel, q, 0.0, np.array([2.0]), out)
+    assert np.array_equal(out, 2.0 * np.sin(q))
+
+
+def test_native_off_uses_numba(generated, monkeypatch):
+    mod = generated("cart_pendulum")
+    monkeypatch.setenv(native.NATIVE_ENV, "0")
+    assert isinstance(portable.table_kernel(mod, "energy"), portable._function_kernel_class())
+    monkeypatch.setenv(native.NATIVE_ENV, "1")
+    assert portable.table_kernel(mod, "energy").__class__.__name__ == "NativeKernel"
+
+
+def test_portable_tables_hold_native_kernels(generated):
+    """The path a first run takes: the kernel table of the portable glue holds native kernels
+    (no numba compile of the model's kernels) for a method's every kernel."""
+    mod = generated("slider_crank")
+    table = portable.kernel_table(mod, "rattle")
+    kernels = [getattr(table, f) for f in table._fields if not f.isupper()]
+    assert kernels and all(k.__class__.__name__ == "NativeKernel" for k in kernels)
