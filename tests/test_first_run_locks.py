@@ -14,7 +14,7 @@ import warnings
 
 import pytest
 
-from lagrange_gen.jit import first_run
+from lagrange_gen.jit import first_run, native
 
 
 @pytest.mark.parametrize("variable", [first_run.BACKGROUND_ENV, first_run.INTERPRETED_ENV])
@@ -30,14 +30,15 @@ def test_the_documented_words_are_read_silently(variable, value, expected, monke
 
 @pytest.mark.parametrize("variable, read", [
     (first_run.BACKGROUND_ENV, first_run.background_enabled),
-    (first_run.INTERPRETED_ENV, first_run.interpreted_enabled)])
+    (first_run.INTERPRETED_ENV, first_run.interpreted_enabled),
+    (native.NATIVE_ENV, native.enabled)])
 @pytest.mark.parametrize("value", ["maybe", "2", "of", "nope", ""])
 def test_junk_is_one_warning_line_and_the_default(variable, read, value, monkeypatch):
     monkeypatch.setenv(variable, value)
     monkeypatch.setattr(first_run, "_WARNED", set())
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        assert read() is True                              # the default of both: on
+        assert read() is True                              # the default of each: on
         assert read() is True
     messages = [str(w.message) for w in caught]
     if value == "":

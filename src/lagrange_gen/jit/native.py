@@ -42,8 +42,6 @@ OPT_ENV = "LAGRANGE_GEN_NATIVE_OPT"
 #: and costs little per call on straight-line code (docs/guides/first-run.md has the table).
 OPT_LEVEL = 1
 
-_OFF = ("0", "off", "no", "false")
-
 #: The exported symbol of a kernel in its LLVM module.
 EXPORT_PREFIX = "lagrange_gen_native_"
 
@@ -71,7 +69,8 @@ def warn_numba_compiles(module, name, reason) -> None:
 
 def enabled() -> bool:
     """Whether native kernels are on ($LAGRANGE_GEN_NATIVE)."""
-    return os.environ.get(NATIVE_ENV, "1").strip().lower() not in _OFF
+    from .first_run import env_flag
+    return env_flag(NATIVE_ENV, True)
 
 
 def opt_level() -> int:
