@@ -1,4 +1,5 @@
-"""The switches and the lock of the background compile (lagrange_gen.jit.first_run).
+"""The switches (lagrange_gen.jit.env) and the lock of the background compile
+(lagrange_gen.jit.first_run).
 
 The boolean environment variables take the documented words (1/0, on/off, yes/no, true/false, in
 any case); anything else is one warning line naming the variable and the value, then the default.
@@ -14,7 +15,7 @@ import warnings
 
 import pytest
 
-from lagrange_gen.jit import first_run, native
+from lagrange_gen.jit import env, first_run, native
 
 
 @pytest.mark.parametrize("variable", [first_run.BACKGROUND_ENV, first_run.INTERPRETED_ENV])
@@ -25,7 +26,7 @@ def test_the_documented_words_are_read_silently(variable, value, expected, monke
     monkeypatch.setenv(variable, value)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert first_run.env_flag(variable, default=not expected) is expected
+        assert env.env_flag(variable, default=not expected) is expected
 
 
 @pytest.mark.parametrize("variable, read", [
@@ -35,7 +36,7 @@ def test_the_documented_words_are_read_silently(variable, value, expected, monke
 @pytest.mark.parametrize("value", ["maybe", "2", "of", "nope", ""])
 def test_junk_is_one_warning_line_and_the_default(variable, read, value, monkeypatch):
     monkeypatch.setenv(variable, value)
-    monkeypatch.setattr(first_run, "_WARNED", set())
+    monkeypatch.setattr(env, "_WARNED", set())
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         assert read() is True                              # the default of each: on
@@ -50,8 +51,8 @@ def test_junk_is_one_warning_line_and_the_default(variable, read, value, monkeyp
 
 def test_an_unset_variable_is_the_default(monkeypatch):
     monkeypatch.delenv(first_run.BACKGROUND_ENV, raising=False)
-    assert first_run.env_flag(first_run.BACKGROUND_ENV, default=True) is True
-    assert first_run.env_flag(first_run.BACKGROUND_ENV, default=False) is False
+    assert env.env_flag(first_run.BACKGROUND_ENV, default=True) is True
+    assert env.env_flag(first_run.BACKGROUND_ENV, default=False) is False
 
 
 def _start_ticks(pid):

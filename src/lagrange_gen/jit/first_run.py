@@ -17,7 +17,7 @@ library version at a time: a lock file beside the portable glue records the comp
 is gone or whose pid another process now has, or not a record at all) is taken over at once, with
 a note. The next process then finds the glue in numba's cache (the warm path, unchanged).
 $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off (tests and CI do); $LAGRANGE_GEN_INTERPRETED=0
-turns the interpreted tier off. Both read the words of ``env_flag``.
+turns the interpreted tier off. Both read the words of jit.env.env_flag.
 """
 
 from __future__ import annotations
@@ -31,6 +31,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from .env import env_flag
+
 #: Environment variable that turns the background compile off ("0", "off", "no" or "false").
 BACKGROUND_ENV = "LAGRANGE_GEN_BACKGROUND_COMPILE"
 
@@ -38,13 +40,6 @@ BACKGROUND_ENV = "LAGRANGE_GEN_BACKGROUND_COMPILE"
 #: foreground, as before it existed (the test suite does, so that which code ran does not depend
 #: on the order in which tests fill numba's cache; tests/test_interpreted.py turns it on).
 INTERPRETED_ENV = "LAGRANGE_GEN_INTERPRETED"
-
-#: The words of a boolean environment variable (env_flag), in any case.
-FLAG_WORDS = {"1": True, "on": True, "yes": True, "true": True,
-              "0": False, "off": False, "no": False, "false": False}
-
-#: (variable, value) pairs already warned about in this process (env_flag).
-_WARNED: set = set()
 
 #: CPU seconds a compile of a method's portable glue is expected to take before one was measured
 #: on this machine: the first use of the lighter methods (rk4) takes 4 to 5 s on a loaded
@@ -56,26 +51,6 @@ LOCK_STALE_S = 900.0
 
 #: The file of the recorded compile seconds, in the portable directory.
 ESTIMATES_FILE = "compile_seconds.json"
-
-
-def env_flag(name, default: bool) -> bool:
-    """The boolean environment variable ``name``: one of FLAG_WORDS (any case, spaces around
-    ignored); unset or empty: ``default``; anything else: ``default`` after one warning line
-    (once per process and value) naming the variable and the value. Every boolean variable of
-    the package is read here."""
-    raw = os.environ.get(name, "")
-    text = raw.strip().lower()
-    if not text:
-        return default
-    if text in FLAG_WORDS:
-        return FLAG_WORDS[text]
-    if (name, raw) not in _WARNED:
-        import warnings
-        _WARNED.add((name, raw))
-        warnings.warn(f"lagrange-gen: ${name}={raw!r} is not one of 1/0, on/off, yes/no, "
-                      f"true/false; taken as {'on' if default else 'off'} (the default)",
-                      RuntimeWarning, stacklevel=3)
-    return default
 
 
 def background_enabled() -> bool:

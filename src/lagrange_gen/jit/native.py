@@ -30,6 +30,7 @@ import tempfile
 import threading
 from pathlib import Path
 
+from .env import env_flag
 from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, function_source
 
 #: Environment variable that turns native kernels off ("0", "off", "no", "false").
@@ -69,7 +70,6 @@ def warn_numba_compiles(module, name, reason) -> None:
 
 def enabled() -> bool:
     """Whether native kernels are on ($LAGRANGE_GEN_NATIVE)."""
-    from .first_run import env_flag
     return env_flag(NATIVE_ENV, True)
 
 
