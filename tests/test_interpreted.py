@@ -240,17 +240,19 @@ def test_the_background_compile_honours_its_lock(generated, tmp_path, monkeypatc
     _FakePopen.started = []
     mod = generated("cart_pendulum")
     process = first_run.start_background_compile(mod, "rk4")
-    assert process is not None and lock.read_text() == str(process.pid)
+    assert process is not None and json.loads(lock.read_text())["pid"] == process.pid
     assert process.args[1:4] == ["-m", "lagrange_gen.jit.first_run", "rk4"]
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "run_rk4 in the background" in err
     assert first_run.BACKGROUND_ENV in err
-    lock.write_text(str(os.getpid()))                  # a live compile holds it
+    lock.write_text(json.dumps(first_run.lock_record(os.getpid())))    # a live compile holds it
     assert first_run.start_background_compile(mod, "rk4") is None
     assert len(_FakePopen.started) == 1
-    lock.write_text("999999999")                       # its process is gone: stale
+    lock.write_text(json.dumps(first_run.lock_record(999_999_999)))    # its process is gone
     assert first_run.start_background_compile(mod, "rk4") is not None
     assert len(_FakePopen.started) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "took over the stale lock" in err and "is gone" in err
 
 
 def test_the_background_compile_fills_the_cache_for_the_next_process(tmp_path):

@@ -105,7 +105,7 @@ def test_cli_animate_with_another_model_file(run, tmp_path, capsys):
     (["--out", "x.avi"], "x.avi: use a .gif or .mp4 file name"),
     (["--model", "MODELS/kepler.py"], "model kepler has coordinates r, phi, the trajectory th1, th2"),
     (["--frames", "0"], "animate: frames must be >= 1, got 0"),
-    (["--fps", "0"], "--fps 0: must be > 0"),
+    (["--fps", "0"], "--fps must be a finite number > 0, got 0.0"),
 ])
 def test_cli_animate_errors_are_one_line(run, tmp_path, capsys, args, message):
     run("pendulum").save(tmp_path / "dp.npz")

@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .simulate import check_output_path
-from ..viz.animate import SUFFIXES
+from ..viz.animate import SUFFIXES, check_positive
 
 
 def add_parser(subparsers):
@@ -46,8 +46,8 @@ def run(args) -> int:
         raise LagrangeGenError(f"{source}: no such trajectory file")
     out = args.out or str(source.with_suffix(".gif"))
     check_output_path("--out", out, SUFFIXES)
-    if args.fps <= 0:
-        raise LagrangeGenError(f"--fps {args.fps:g}: must be > 0")
+    check_positive("--fps", args.fps)
+    check_positive("--dpi", args.dpi, integer=True)
     traj = Trajectory.load(source)
     frames = traj.animate(out, model=args.model, frames=args.frames, fps=args.fps, dpi=args.dpi)
     print(f"wrote {out} ({frames} frames at {args.fps:g} fps)")

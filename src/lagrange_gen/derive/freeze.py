@@ -11,6 +11,7 @@ import copy
 import sympy as sp
 
 from ..errors import GenerationError
+from ..model.expressions import nonfinite_message
 
 
 def freeze_model(model, frozen):
@@ -35,7 +36,21 @@ def freeze_model(model, frozen):
     out.contacts = [_freeze_element(c, sub) for c in getattr(model, "contacts", ())]
     out.params = [p for p in model.params if p.name not in frozen]
     out.param_defaults = {k: v for k, v in model.param_defaults.items() if k not in frozen}
+    _check_finite(model, out, sub)
     return out
+
+
+def _check_finite(model, frozen_model, sub):
+    """GenerationError, one line, when a frozen value makes an expression of ``frozen_model``
+    non-finite (k = 0 in x**2 / (2 k)), naming the frozen values it uses and the term."""
+    originals = dict(model._all_expressions())
+    for where, expr in frozen_model._all_expressions():
+        problem = nonfinite_message(where, expr)
+        if problem:
+            used = [f"{p.name} = {value}" for p, value in sub.items()
+                    if p in getattr(originals.get(where), "free_symbols", ())]
+            values = ", ".join(used or [f"{p.name} = {value}" for p, value in sub.items()])
+            raise GenerationError(f"model {model.name}: freezing {values} makes {problem}")
 
 
 def _freeze_element(element, sub):

@@ -12,21 +12,26 @@ process at low priority, ``python -m lagrange_gen.jit.first_run <method> <module
 file> <lock>``, imports the generated module under the same name (numba's cache refers to it by
 name), compiles its kernels for the portable glue and the portable glue with a zero-step call of
 the argument types simulate passes, and records its CPU seconds. One process per method and
-library version at a time: a lock file beside the portable glue (a stale lock, older than
-LOCK_STALE_S or of a process that is gone, is taken over). The next process then finds the glue
-in numba's cache (the warm path, unchanged). $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off
-(tests and CI do); $LAGRANGE_GEN_INTERPRETED=0 turns the interpreted tier off.
+library version at a time: a lock file beside the portable glue records the compiling process
+(pid, host, start time: ``lock_record``); a stale lock (older than LOCK_STALE_S, of a process that
+is gone or whose pid another process now has, or not a record at all) is taken over at once, with
+a note. The next process then finds the glue in numba's cache (the warm path, unchanged).
+$LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off (tests and CI do); $LAGRANGE_GEN_INTERPRETED=0
+turns the interpreted tier off. Both read the words of jit.env.env_flag.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import socket
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from .env import env_flag
 
 #: Environment variable that turns the background compile off ("0", "off", "no" or "false").
 BACKGROUND_ENV = "LAGRANGE_GEN_BACKGROUND_COMPILE"
@@ -35,8 +40,6 @@ BACKGROUND_ENV = "LAGRANGE_GEN_BACKGROUND_COMPILE"
 #: foreground, as before it existed (the test suite does, so that which code ran does not depend
 #: on the order in which tests fill numba's cache; tests/test_interpreted.py turns it on).
 INTERPRETED_ENV = "LAGRANGE_GEN_INTERPRETED"
-
-_OFF = ("0", "off", "no", "false")
 
 #: CPU seconds a compile of a method's portable glue is expected to take before one was measured
 #: on this machine: the first use of the lighter methods (rk4) takes 4 to 5 s on a loaded
@@ -52,12 +55,12 @@ ESTIMATES_FILE = "compile_seconds.json"
 
 def background_enabled() -> bool:
     """Whether a background compile may start ($LAGRANGE_GEN_BACKGROUND_COMPILE)."""
-    return os.environ.get(BACKGROUND_ENV, "1").strip().lower() not in _OFF
+    return env_flag(BACKGROUND_ENV, True)
 
 
 def interpreted_enabled() -> bool:
     """Whether a first run may start interpreted ($LAGRANGE_GEN_INTERPRETED)."""
-    return os.environ.get(INTERPRETED_ENV, "1").strip().lower() not in _OFF
+    return env_flag(INTERPRETED_ENV, True)
 
 
 def _estimates_path() -> Path:
@@ -102,43 +105,125 @@ def lock_path(method) -> Path:
     return path.with_name(f".{path.stem}.compiling")
 
 
-def take_lock(lock: Path) -> bool:
-    """Create ``lock`` (False when another live compile holds it; a stale one is taken over)."""
-    for _ in range(2):
+def process_start(pid):
+    """When process ``pid`` started, in clock ticks since boot (/proc/<pid>/stat, field 22):
+    what tells a process from a later one with the same pid. None where it cannot be read (no
+    such process, no /proc)."""
+    try:
+        with open(f"/proc/{int(pid)}/stat", "rb") as f:
+            fields = f.read().rsplit(b")", 1)[1].split()
+        return int(fields[19])        # field 22; fields[0] is field 3 (the state)
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def lock_record(pid) -> dict:
+    """What a lock holds: the pid, host and start time (process_start) of the compiling
+    process."""
+    return {"pid": int(pid), "host": socket.gethostname(), "start": process_start(pid)}
+
+
+def take_lock(lock: Path, notes=None) -> bool:
+    """Create ``lock`` holding this process's record (False when a live compile holds it, or
+    when the directory cannot be written); a stale one (_stale) is taken over, and the reason
+    appended to ``notes`` (a list) when given."""
+    record = json.dumps(lock_record(os.getpid()))
+    for _ in range(3):
+        try:
+            if _create(lock, record):
+                return True
+        except OSError:          # a directory we may not write: no background compile
+            return False
+        reason = _stale(lock)
+        if reason is None:
+            return False
+        try:
+            lock.unlink()
+        except FileNotFoundError:
+            pass
+        except OSError:
+            return False
+        if notes is not None and reason:
+            notes.append(f"took over the stale lock {lock} ({reason})")
+    return False
+
+
+def _create(lock: Path, text: str) -> bool:
+    """Create ``lock`` holding ``text``, False when it exists: the text is written to a
+    temporary file first and linked in, so that no process ever reads the lock empty (where the
+    file system has no hard links: created exclusively, then written)."""
+    fd, tmp = tempfile.mkstemp(dir=lock.parent, prefix=f"{lock.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        try:
+            os.link(tmp, lock)
+            return True
+        except FileExistsError:
+            return False
+        except OSError:
+            pass
         try:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
         except FileExistsError:
-            if not _stale(lock):
-                return False
-            try:
-                lock.unlink()
-            except OSError:
-                return False
-            continue
-        except OSError:         # a directory we may not write: no background compile
             return False
-        os.write(fd, str(os.getpid()).encode())
-        os.close(fd)
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
         return True
-    return False
+    finally:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
 
 
-def _stale(lock: Path) -> bool:
+def _write_record(lock: Path, pid) -> None:
+    """Replace the record in ``lock`` by that of process ``pid`` (atomically: never empty)."""
+    fd, tmp = tempfile.mkstemp(dir=lock.parent, prefix=f"{lock.name}.", suffix=".tmp")
     try:
-        if time.time() - lock.stat().st_mtime > LOCK_STALE_S:
-            return True
-        pid = int(lock.read_text().strip() or 0)
-    except (OSError, ValueError):
-        return False           # being written right now: not stale
-    if pid <= 0 or os.name == "nt":      # (Windows' os.kill would end the process): age only
-        return False
+        with os.fdopen(fd, "w") as f:
+            json.dump(lock_record(pid), f)
+        os.replace(tmp, lock)
+    except OSError:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+
+
+def _stale(lock: Path):
+    """Why ``lock`` is stale (a short phrase; "" when it is gone already), or None while a live
+    compile may hold it: older than LOCK_STALE_S; not a lock record (junk, empty, the bare pid
+    of older versions); on this host, a process that is gone, or a live pid whose start time is
+    not the recorded one (another process got the pid). Another host's lock: its age only."""
+    try:
+        age = time.time() - lock.stat().st_mtime
+        text = lock.read_text()
+    except FileNotFoundError:
+        return ""
+    except OSError:
+        return None
+    if age > LOCK_STALE_S:
+        return f"{age / 60:.0f} minutes old"
+    try:
+        record = json.loads(text)
+        pid = record["pid"]
+        if isinstance(pid, bool) or not isinstance(pid, int) or not 0 < pid < 2**31:
+            raise TypeError
+    except (ValueError, TypeError, KeyError):
+        return f"not a lock record: {text.strip()[:40]!r}"
+    if record.get("host") != socket.gethostname() or os.name == "nt":
+        return None              # (Windows' os.kill would end the process): age only
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
-        return True
-    except OSError:            # alive, another user's
-        return False
-    return False
+        return f"process {pid} is gone"
+    except OSError:              # alive, another user's
+        pass
+    start, recorded = process_start(pid), record.get("start")
+    if start is not None and recorded is not None and start != recorded:
+        return f"process {pid} is another process now"
+    return None
 
 
 def release_lock(lock: Path) -> None:
@@ -155,7 +240,8 @@ def start_background_compile(module, method, stream=None):
     if not background_enabled():
         return None
     lock = lock_path(method)
-    if not take_lock(lock):
+    notes = []
+    if not take_lock(lock, notes):
         return None
     package_parent = str(Path(__file__).resolve().parents[2])
     env = dict(os.environ)
@@ -169,13 +255,11 @@ def start_background_compile(module, method, stream=None):
     except OSError:
         release_lock(lock)
         return None
-    try:
-        lock.write_text(str(process.pid))
-    except OSError:
-        pass
+    _write_record(lock, process.pid)
     stream = stream or sys.stderr
+    took_over = "".join(f"; {note}" for note in notes)
     stream.write(f"lagrange-gen: compiling run_{method} in the background for the next run "
-                 f"(process {process.pid}; {BACKGROUND_ENV}=0 turns this off)\n")
+                 f"(process {process.pid}; {BACKGROUND_ENV}=0 turns this off{took_over})\n")
     stream.flush()
     return process
 

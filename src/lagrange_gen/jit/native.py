@@ -31,6 +31,7 @@ import threading
 from pathlib import Path
 
 from . import native_ir
+from .env import env_flag
 from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, function_source
 
 #: Environment variable that turns native kernels off ("0", "off", "no", "false").
@@ -42,8 +43,6 @@ OPT_ENV = "LAGRANGE_GEN_NATIVE_OPT"
 #: LLVM optimization level: level 1 compiles the big kernels several times faster than 2 or 3
 #: and costs little per call on straight-line code (docs/guides/first-run.md has the table).
 OPT_LEVEL = 1
-
-_OFF = ("0", "off", "no", "false")
 
 #: The exported symbol of a kernel in its LLVM module.
 EXPORT_PREFIX = "lagrange_gen_native_"
@@ -72,7 +71,7 @@ def warn_numba_compiles(module, name, reason) -> None:
 
 def enabled() -> bool:
     """Whether native kernels are on ($LAGRANGE_GEN_NATIVE)."""
-    return os.environ.get(NATIVE_ENV, "1").strip().lower() not in _OFF
+    return env_flag(NATIVE_ENV, True)
 
 
 def opt_level() -> int:

@@ -39,7 +39,8 @@ import tempfile
 from pathlib import Path
 
 #: Environment variable naming the directory of the portable glue sources (default
-#: ~/.cache/lagrange_gen/portable, or a temporary directory when the home is not writable).
+#: ~/.cache/lagrange_gen/portable, or a per-user temporary directory when the home is not
+#: writable, or when the directory cannot be written: portable_dir).
 DIR_ENV = "LAGRANGE_GEN_PORTABLE_DIR"
 
 #: A library version's glue directory (portable_dir()/<library hash>) not used for this many days
@@ -66,13 +67,61 @@ def jit_mode(jit) -> str:
 
 
 def portable_dir() -> Path:
-    """Directory under which the portable glue sources are written."""
+    """Directory under which the portable glue sources are written: $LAGRANGE_GEN_PORTABLE_DIR,
+    else ~/.cache/lagrange_gen/portable (a per-user temporary directory when the home is not
+    writable); the per-user temporary directory instead once writing to that one failed in this
+    process (_use_fallback_dir)."""
+    configured = _configured_dir()
+    return _FALLBACK_DIRS.get(configured, configured)
+
+
+def _configured_dir() -> Path:
     if os.environ.get(DIR_ENV):
         return Path(os.environ[DIR_ENV])
     home = Path(os.path.expanduser("~"))
     if os.access(home, os.W_OK):
         return home / ".cache" / "lagrange_gen" / "portable"
-    return Path(tempfile.gettempdir()) / "lagrange_gen_portable"
+    return _temporary_dir()
+
+
+def _temporary_dir() -> Path:
+    """The per-user temporary glue directory: another user's is neither written nor imported."""
+    user = os.getuid() if hasattr(os, "getuid") else os.environ.get("USERNAME", "user")
+    return Path(tempfile.gettempdir()) / f"lagrange_gen_portable-{user}"
+
+
+#: {configured directory: the directory used instead}: a configured directory that could not be
+#: written (a file, read-only, no space) is replaced for the rest of the process, so that the
+#: glue, the compile estimates and the locks of jit.first_run stay together.
+_FALLBACK_DIRS: dict = {}
+
+
+def _use_fallback_dir(failed: Path, exc: OSError) -> Path:
+    """Switch from ``failed`` (the configured directory, which could not be written: ``exc``) to
+    the per-user temporary directory, with one warning line; SimulationError in one line when
+    that cannot be used either (or is not this user's). Returns the new directory."""
+    import warnings
+    from ..errors import SimulationError
+    configured = _configured_dir()
+    fallback = _temporary_dir()
+    why = exc.strerror or type(exc).__name__
+    if fallback == configured or fallback == failed:
+        raise SimulationError(f"cannot write the portable glue under {failed} ({why}); set "
+                              f"{DIR_ENV} to a writable directory") from None
+    try:
+        fallback.mkdir(mode=0o700, parents=True, exist_ok=True)
+        if hasattr(os, "getuid") and fallback.stat().st_uid != os.getuid():
+            raise PermissionError(0, "owned by another user")
+    except OSError as second:
+        raise SimulationError(
+            f"cannot write the portable glue under {failed} ({why}) nor under {fallback} "
+            f"({second.strerror or type(second).__name__}); set {DIR_ENV} to a writable "
+            f"directory") from None
+    _FALLBACK_DIRS[configured] = fallback
+    source = f"{DIR_ENV}={configured}" if os.environ.get(DIR_ENV) else str(configured)
+    warnings.warn(f"lagrange-gen: {source} cannot be written ({why}); the portable glue and "
+                  f"its compile records go to {fallback} instead", RuntimeWarning, stacklevel=4)
+    return fallback
 
 
 def _kernel_arg_types(fn):
@@ -185,24 +234,16 @@ def _library_hash(method: str) -> str:
 @functools.lru_cache(maxsize=None)
 def _glue_module(method: str):
     """The module of the portable glue of ``method``: its source is written (atomically, once
-    per library version) and imported under a unique module name."""
+    per library version) and imported under a unique module name. A directory that cannot be
+    written is replaced by the per-user temporary one (_use_fallback_dir); one that already
+    holds this version's glue is only read (a shared, read-only install)."""
     from ..codegen.glue import portable_glue_source
     digest = _library_hash(method)
     source = portable_glue_source(method, digest)
-    folder = portable_dir() / digest
-    path = folder / f"run_{method}.py"
-    if not folder.is_dir():
-        folder.mkdir(parents=True, exist_ok=True)
-        remove_unused_versions(folder)
     try:
-        os.utime(folder)               # marks the version used now (remove_unused_versions)
-    except OSError:                    # a shared directory we may not touch: it is only a mark
-        pass
-    if not path.exists() or path.read_text() != source:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".run_{method}.", suffix=".tmp")
-        with os.fdopen(fd, "w") as f:
-            f.write(source)
-        os.replace(tmp, path)
+        path = _write_glue(portable_dir() / digest, method, source)
+    except OSError as exc:
+        path = _write_glue(_use_fallback_dir(portable_dir(), exc) / digest, method, source)
     name = f"lagrange_gen_portable_{digest}_{method}"
     module = sys.modules.get(name)
     if module is None:
@@ -211,6 +252,32 @@ def _glue_module(method: str):
         sys.modules[name] = module
         spec.loader.exec_module(module)
     return module
+
+
+def _write_glue(folder: Path, method: str, source: str) -> Path:
+    """The file of ``method``'s glue in ``folder`` (a library version's directory), written
+    atomically unless it already holds ``source``; OSError when it cannot be."""
+    path = folder / f"run_{method}.py"
+    if not folder.is_dir():
+        folder.mkdir(parents=True, exist_ok=True)
+        remove_unused_versions(folder)
+    try:
+        os.utime(folder)               # marks the version used now (remove_unused_versions)
+    except OSError:                    # a shared directory we may not touch: it is only a mark
+        pass
+    if not path.is_file() or path.read_text() != source:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".run_{method}.", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(source)
+            os.replace(tmp, path)
+        except BaseException:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+            raise
+    return path
 
 
 def remove_unused_versions(current: Path) -> list:

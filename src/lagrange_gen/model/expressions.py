@@ -143,6 +143,38 @@ def _rayleigh_problem(D, velocities):
     return None
 
 
+#: sympy's numbers that no kernel can compute, and what makes them.
+NONFINITE = {sp.zoo: "complex infinity, e.g. from a division by zero such as x/0, or log(0)",
+             sp.oo: "infinity", -sp.oo: "minus infinity", sp.nan: "not a number, e.g. 0*oo"}
+
+
+def nonfinite_term(expr):
+    """(term, atom) of the first of sympy's zoo, oo, -oo, nan found in ``expr``: term is the
+    summand of ``expr`` that holds it (``expr`` itself when it is no sum); None when there is
+    none."""
+    has = getattr(expr, "has", None)
+    if has is None:
+        return None
+    for atom in NONFINITE:
+        if has(atom):
+            terms = expr.args if expr.is_Add else (expr,)
+            return next(t for t in terms if t.has(atom)), atom
+    return None
+
+
+def nonfinite_message(where, expr):
+    """'V = zoo*x: the term zoo*x holds zoo (complex infinity, ...); ...' for an expression that
+    holds a non-finite number (nonfinite_term), else None."""
+    found = nonfinite_term(expr)
+    if found is None:
+        return None
+    term, atom = found
+    text = str(expr)
+    shown = f"{where} = {text}" if len(text) <= 100 else where
+    return (f"{shown}: the term {term} holds {atom} ({NONFINITE[atom]}); the kernels would "
+            f"compute NaN: every expression of a model must be finite")
+
+
 def _vanishes_at_rest(expr, s):
     value = expr.subs(s, 0)
     if value.has(sp.nan, sp.zoo, sp.oo, -sp.oo):

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ..errors import ModelError
-from .expressions import check_rayleigh, settled_later, unknown_symbols_hint
+from .expressions import check_rayleigh, nonfinite_message, settled_later, unknown_symbols_hint
 from .intermediates import expand_intermediates
 from .symbols import Parameter, check_name, t
 
@@ -15,7 +15,8 @@ __all__ = ["check_model"]
 
 def check_model(model):
     """ModelError naming the model and the offending symbol or expression when ``model``'s
-    names clash, an expression uses an unknown symbol or an undefined function, V depends on
+    names clash, an expression uses an unknown symbol or an undefined function or holds
+    sympy's zoo, oo or nan (expressions.nonfinite_message), V depends on
     velocities, the dissipation is not a Rayleigh function of the velocities, a constraint is
     not holonomic, an element is malformed, or T has no velocity in it."""
     names = {}
@@ -37,6 +38,9 @@ def check_model(model):
             raise ModelError(f"model {model.name}: {where} uses symbol(s) {', '.join(unknown)} "
                              "that are neither coordinates, velocities, parameters nor t"
                              + unknown_symbols_hint(expr.free_symbols - allowed))
+        nonfinite = nonfinite_message(where, expr)
+        if nonfinite:
+            raise ModelError(f"model {model.name}: {nonfinite}")
         open_derivatives = [d for d in expr.atoms(sp.Derivative) if not settled_later(d)]
         if open_derivatives or expr.atoms(sp.core.function.AppliedUndef):
             raise ModelError(f"model {model.name}: {where} contains an undefined function or derivative: {expr}")

@@ -1,12 +1,15 @@
 """What simulate checks before it allocates or integrates; each failure is one SimulationError line.
 
-* The scalar and vector arguments (``check_scalars``, ``vector``).
+* The scalar and vector arguments (``check_scalars``, ``vector``: shape (n,), finite).
 * Element coefficients at the parameters of this run (``check_element_coefficients``): the model
   file checks them at its defaults only, and ``--param eta=-1`` or ``--freeze eta=0`` would
   otherwise run the return map with a non-positive threshold or stiffness into garbage.
   Likewise contact coefficients (``check_contact_coefficients``): restitution in [0, 1], friction
   >= 0 at this run's parameters (``params={"e": 1.5}`` would otherwise gain energy at each impact).
-* The step count (``check_step_count``): at most MAX_STEPS steps.
+* The method's settings (``method_settings``): their types and the method's limits, and
+  rtol < MAX_RTOL.
+* The step count (``check_step_count``): at most MAX_STEPS steps; a run that will take more
+  than LONG_RUN_S says so before it starts (``long_run_line``), it is not refused.
 * The resolution of the time grid (``check_time_resolution``): the stepper evaluates forces at
   t0 + k h, and the driver saves those times; they must resolve h (TIME_RESOLUTION).
 * Memory for the saved rows (``check_memory``), against the memory this process can still take
@@ -25,6 +28,7 @@ import time
 import numpy as np
 
 from ..errors import SimulationError
+from ..steppers.core.method_spec import make_settings
 from . import memory
 from .params import is_number
 
@@ -83,7 +87,9 @@ def check_t_eval(t_eval, t0, t_end):
 
 
 def vector(name, value, n, coords):
-    """value as a float64 vector (n,) (zeros when None), or a SimulationError naming ``name``."""
+    """value as a float64 vector (n,) (zeros when None), or a SimulationError naming ``name``:
+    a sequence of n finite numbers in one dimension (a (1, 2) or (2, 1) q0 is not flattened:
+    the message gives the shape meant and the coordinates)."""
     if value is None:
         return np.zeros(n)
     try:
@@ -93,7 +99,8 @@ def vector(name, value, n, coords):
     except (TypeError, ValueError):
         raise SimulationError(f"{name} must be a sequence of {n} numbers, got {value!r}") from None
     if arr.ndim != 1:
-        arr = np.ascontiguousarray(arr.reshape(-1))
+        raise SimulationError(f"{name} must have shape ({n},) ({', '.join(coords)}), got an "
+                              f"array of shape {arr.shape}")
     if arr.shape[0] != n:
         raise SimulationError(f"{name} has {arr.shape[0]} entries but the model has {n} "
                               f"coordinates ({', '.join(coords)})")
@@ -103,19 +110,6 @@ def vector(name, value, n, coords):
     if not math.isfinite(sum(arr.tolist())) and not np.all(np.isfinite(arr)):
         raise SimulationError(f"{name} contains a non-finite value: {arr.tolist()}")
     return arr
-
-
-def state_vector(name, value, n, coords):
-    """value as a float64 vector (n,) like ``vector``, refusing also an array of more than one
-    dimension (a (2, 2) q0 is not the 4 coordinates of a 4-coordinate model)."""
-    try:
-        ndim = 0 if value is None else np.ndim(value)
-    except ValueError:          # a ragged sequence: vector() names it
-        ndim = 1
-    if ndim > 1:
-        raise SimulationError(f"{name} must be a flat sequence of {n} numbers ({', '.join(coords)}), "
-                              f"got an array of shape {np.shape(value)}")
-    return vector(name, value, n, coords)
 
 
 #: A constrained run whose max|Phi| passes this fraction of max(1, max|q|) warns: a method
@@ -238,6 +232,59 @@ def _coefficient_source(module, p, coefficients, coef, e, col):
         return (f"it comes from the frozen parameters ({values}): regenerate with other "
                 f"--freeze values")
     return "it is a constant of the model file"
+
+
+#: rtol at or above this is refused: a local error allowed as large as the solution itself
+#: controls nothing. (The lower limits are the method's own, in its SPEC.limits: rtol >= 100
+#: eps, the bound below which scipy's solve_ivp raises rtol with a warning; atol > 0. scipy
+#: sets no upper limit on rtol, nor does Hairer's DOP853, but rtol >= 1 is never meant.)
+MAX_RTOL = 1.0
+
+
+def method_settings(spec, given):
+    """The method's settings record from simulate's keywords (method_spec.make_settings: each
+    checked against its type and the method's limits), refusing also rtol >= MAX_RTOL."""
+    settings = make_settings(spec, given)
+    rtol = getattr(settings, "rtol", None)
+    if rtol is not None and not rtol < MAX_RTOL:
+        raise SimulationError(f"rtol must be < {MAX_RTOL:g} (a relative error as large as the "
+                              f"solution controls nothing), got {given.get('rtol')!r}")
+    return settings
+
+
+#: A fixed-step run whose estimated time passes this many seconds says so before it starts
+#: (long_run_line; the estimate: run/fixed_driver.seconds_per_step).
+LONG_RUN_S = 60.0
+
+
+def long_run_line(model, method, n_steps, seconds_per_step, measured_steps):
+    """The line (lagrange-gen: ...) telling how long n_steps steps at ``seconds_per_step`` (as
+    measured on ``measured_steps`` steps) will take, when that passes LONG_RUN_S; else None."""
+    seconds = n_steps * seconds_per_step
+    if not seconds > LONG_RUN_S:
+        return None
+    return (f"lagrange-gen: {model}, {method}: {n_steps:.3g} steps at "
+            f"{_per_step(seconds_per_step)} per step (measured on {measured_steps} steps) will "
+            f"take {_duration(seconds)}; a larger h or a shorter run takes less (progress=True "
+            f"or --progress shows a bar)")
+
+
+def _per_step(seconds):
+    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):
+        if seconds >= scale:
+            return f"{seconds / scale:.3g} {unit}"
+    return f"{seconds / 1e-9:.3g} ns"
+
+
+def _duration(seconds):
+    """'about 3.3 minutes', 'about 5 hours', ... (two significant digits)."""
+    for unit, scale in (("years", 365.25 * 86400), ("days", 86400.0), ("hours", 3600.0),
+                        ("minutes", 60.0)):
+        if seconds >= scale:
+            value = float(f"{seconds / scale:.2g}")
+            text = f"{value:.0f}" if value >= 10 or value == int(value) else f"{value:g}"
+            return f"about {text} {unit[:-1] if text == '1' else unit}"
+    return f"about {seconds:.2g} seconds"
 
 
 def check_step_count(t0, t_end, h):

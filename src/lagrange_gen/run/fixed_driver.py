@@ -36,6 +36,17 @@ SPECIALIZE_AFTER_S = 60.0
 #: interpreted time; later interpreted chunks double, up to CHUNK_STEPS.
 PROBE_STEPS = 20
 
+#: A compiled run of at least this many steps measures its step (seconds_per_step) and, when
+#: it will take more than run.checks.LONG_RUN_S, says how long before it starts: below it, a run
+#: takes a minute only at 6 ms a step or more.
+ESTIMATE_AFTER_STEPS = 10_000
+
+#: The measurement: PROBE_MIN_STEPS steps, doubled until they take PROBE_S seconds, never more
+#: than PROBE_FRACTION of the run (nor PROBE_MIN_STEPS less); run on copies of the state.
+PROBE_MIN_STEPS = 64
+PROBE_S = 0.05
+PROBE_FRACTION = 0.01
+
 #: {method: seconds its runs spent interpreted in this process}: a program of many short runs
 #: compiles once their sum would pass the compile (_worth_compiling).
 _INTERPRETED_S: dict = {}
@@ -91,6 +102,8 @@ def integrate_fixed(task, q, v, out, progress):
         if run is None:
             run, compile_time = warm_up(lambda: task.glue(first), first, label)
             remember_glue(task, run)
+    if task.ran != "interpreted":
+        announce_duration(task, run, q, v, task.t0, out, task.n_steps)
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
     bar = ProgressBar(task.n_steps) if progress else None
     start = time.perf_counter()
@@ -141,6 +154,7 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
                 run, seconds, tier = _compile_after_interpreted(task, args, label, done)
                 compile_time += seconds
                 switch += seconds
+                announce_duration(task, run, q, v, t0 + done * h, out, task.n_steps - done)
                 since = (time.perf_counter() - start - switch, done)
                 continue
         code, steps, n_events = result
@@ -168,6 +182,7 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
                 run, seconds, tier = _compile_after_interpreted(task, args, label, done)
                 compile_time += seconds
                 switch += seconds
+                announce_duration(task, run, q, v, t0 + done * h, out, task.n_steps - done)
                 since = (time.perf_counter() - start - switch, done)
             elif not background:
                 background = True
@@ -182,6 +197,52 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
             task.ran = f"{task.ran}, then specialized from step {done}"
             tier = "specialized"
     return done, row, switch, compile_time
+
+
+def announce_duration(task, run, q, v, t, out, remaining, stream=None):
+    """Before ``remaining`` steps of a compiled run from (q, v) at t: when they are at least
+    ESTIMATE_AFTER_STEPS and will take more than run.checks.LONG_RUN_S at the measured step
+    (seconds_per_step), one line on ``stream`` (default stderr) says how long. Nothing is
+    refused."""
+    if remaining < ESTIMATE_AFTER_STEPS:
+        return
+    measured = seconds_per_step(task, run, q, v, out, remaining, t)
+    if measured is None:
+        return
+    from .checks import long_run_line
+    line = long_run_line(task.module.NAME, task.method, remaining, *measured)
+    if line:
+        stream = stream or sys.stderr
+        stream.write(line + "\n")
+        stream.flush()
+
+
+def seconds_per_step(task, run, q, v, out, remaining=None, t=None):
+    """(seconds per step, steps measured) of the compiled glue ``run`` from (q, v) at t (default
+    task.t0): steps run on
+    copies of the state into scratch rows (the run itself is untouched), PROBE_MIN_STEPS first,
+    doubled while they take less than PROBE_S and stay within PROBE_FRACTION of ``remaining``
+    (default task.n_steps). None when a measured call fails (the run itself will report it)."""
+    remaining = task.n_steps if remaining is None else remaining
+    t = task.t0 if t is None else t
+    n, extra = q.shape[0], out["extra"]
+    cap = max(PROBE_MIN_STEPS, int(PROBE_FRACTION * remaining))
+    steps = PROBE_MIN_STEPS
+    while True:
+        scratch = np.zeros((2, extra.shape[1]))
+        scratch[0] = extra[0]
+        began = time.perf_counter()
+        code, done, _ = run(q.copy(), v.copy(), t, task.h, steps, steps, task.p,
+                            task.settings, np.empty(2), np.empty((2, n)), np.empty((2, n)),
+                            np.zeros((2, N_STATS)), scratch,
+                            np.zeros(last_size(n, extra.shape[1], with_work=True)),
+                            out["events"][:0])
+        seconds = time.perf_counter() - began
+        if code != st.OK or done < 1:
+            return None
+        if seconds >= PROBE_S or 2 * steps > cap or done < steps:
+            return seconds / done, done
+        steps *= 2
 
 
 def _interpreted_glue(task, args):

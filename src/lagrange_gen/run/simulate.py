@@ -33,7 +33,6 @@ from ..errors import SimulationError
 from .fixed_driver import allocate, integrate_fixed, n_steps_to
 from ..jit.portable import choose, jit_mode
 from ..steppers.core import registry
-from ..steppers.core.method_spec import make_settings
 from .run_result import adaptive_trajectory, fixed_step_trajectory
 from .trajectory import Trajectory
 
@@ -142,7 +141,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     run = _runner(module, method)
     n = module.N_COORDS
     h = check_times(spec, h, t0, t_end, save_every, t_eval)
-    config = make_settings(spec, settings) if settings else plan.default_settings
+    config = run_checks.method_settings(spec, settings) if settings else plan.default_settings
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
     p, hook, data = run_params(plan, module, params, control, control_params, h, t0, q, v)

@@ -20,7 +20,7 @@ import importlib
 import math
 
 import numpy as np
-from .checks import state_vector
+from .checks import vector
 from .control import input_slots
 from ..errors import SimulationError
 from ..jit import njit
@@ -155,8 +155,8 @@ class Stepper:
         self.settings = make_settings(spec, settings)
         p = parameter_vector(module, params)
         # The compiled step indexes q and v up to n - 1 without bounds checks.
-        self.q = state_vector("q0", q0, n, module.COORDS).copy()
-        self.v = state_vector("v0", v0, n, module.COORDS).copy()
+        self.q = vector("q0", q0, n, module.COORDS).copy()
+        self.v = vector("v0", v0, n, module.COORDS).copy()
         self.p = p
         self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
         self._failure = None        # the message of the failure that ended this stepper

@@ -69,8 +69,27 @@ def point_positions(traj, model, frames):
     return times, positions_function(model)(q, [values[p.name] for p in model.params], times)
 
 
+def check_positive(name, value, integer=False):
+    """LagrangeGenError (one line naming ``name``) unless ``value`` is a finite number > 0 (an
+    integer >= 1 when ``integer``): a frame rate of nan, inf or 0 has no frame spacing."""
+    import math
+    import numbers
+    if integer:
+        ok = isinstance(value, numbers.Integral) and not isinstance(value, bool) and value >= 1
+        if not ok:
+            raise LagrangeGenError(f"{name} must be an integer >= 1, got {value!r}")
+        return
+    ok = (isinstance(value, numbers.Real) and not isinstance(value, bool)
+          and math.isfinite(value) and value > 0)
+    if not ok:
+        raise LagrangeGenError(f"{name} must be a finite number > 0, got {value!r}")
+
+
 def animate(traj, path, model=None, frames=None, fps=25, dpi=80):
-    """Write the animation of ``traj`` to ``path`` (.gif or .mp4); returns the frame count."""
+    """Write the animation of ``traj`` to ``path`` (.gif or .mp4); returns the frame count.
+    fps: frames per second, a finite number > 0; dpi: an integer >= 1."""
+    check_positive("fps", fps)
+    check_positive("dpi", dpi, integer=True)
     path = Path(path)
     writer = _writer(path, fps)
     frames = default_frames(traj, fps) if frames is None else int(frames)
