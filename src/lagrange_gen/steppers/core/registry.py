@@ -65,8 +65,9 @@ def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: i
         return ("nonholonomic constraints together with nonsmooth elements or contacts are not "
                 "supported by any method yet")
     if bool(n_nonholonomic) != flags.nonholonomic:
+        fits = [m for m in NONHOLONOMIC_METHODS if INFO[m].holonomic_too or not n_constraints]
         return (f"it ignores the model's nonholonomic constraints (use "
-                f"{', '.join(NONHOLONOMIC_METHODS)})" if n_nonholonomic
+                f"{', '.join(fits)})" if n_nonholonomic
                 else "it is for models with nonholonomic constraints and this model has none")
     if n_nonholonomic:
         both = [m for m in NONHOLONOMIC_METHODS if INFO[m].holonomic_too]
