@@ -105,8 +105,8 @@ class EnsembleResult:
         return dataframe(self)
 
 
-def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
-             save_every=None, t0=0.0, progress=False, out_dir=None, client=None,
+def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end=None,
+             h=None, save_every=None, t0=0.0, progress=False, out_dir=None, client=None,
              worker_threads=1, jit=None, device="cpu", dtype="float64", **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
@@ -132,9 +132,10 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     events; dtype "float64" or "float32" (GPU only: state, parameters and outputs in float32,
     returned as float64 arrays); no progress bar. Anything the GPU path cannot run, and a
     missing numba-cuda, driver or GPU, is one SimulationError line."""
-    from .simulate import check_times, element_method, load_module
+    from .simulate import check_required, check_times, element_method, load_module
+    check_required("ensemble", t_end=t_end, h=h)
     if method not in registry.METHODS:
-        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+        raise SimulationError(registry.unknown_method(method))
     jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method)
     method = element_method(module, method)
