@@ -16,13 +16,14 @@ from lagrange_gen.run.trajectory import Trajectory
     (["0:1:0.3"], [0, 0.3, 0.6, 0.9]),
     (["0.5", "1", "2:3:0.5"], [0.5, 1, 2, 2.5, 3]),
     (["1e-3"], [1e-3]),
+    (["2:2:0.1"], [2.0]),
 ])
 def test_times_and_ranges(values, expected):
     np.testing.assert_allclose(parse_times(values, "--t-eval"), expected, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize("junk", ["abc", "0:1", "0:1:0", "0:1:-0.1", "1:0:0.1", "0:1:x",
-                                  "nan", "0:inf:1", "0:1:1:1"])
+                                  "nan", "0:inf:1", "0:1:1:1", "0:10:100"])
 def test_junk_is_one_line_naming_the_option_and_item(junk):
     with pytest.raises(LagrangeGenError) as info:
         parse_times(["0", junk], "--t-eval")

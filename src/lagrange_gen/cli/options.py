@@ -77,6 +77,10 @@ def parse_times(values, option, error=LagrangeGenError):
         if step <= 0 or stop < start:
             raise error(f"{option} {item}: a range START:STOP:STEP needs STEP > 0 and "
                         f"STOP >= START, e.g. {option} 0:10:0.01")
+        if step > stop - start > 0:      # sweep's --grid reads START:STOP:COUNT
+            raise error(f"{option} {item}: STEP {parts[2]} is longer than the range; the third "
+                        f"number is a step (e.g. {option} {parts[0]}:{parts[1]}:"
+                        f"{(stop - start) / 100:g} for 101 times), not a count as in --grid")
         count = math.floor((stop - start) / step + 1e-9) + 1
         times.extend(start + step * np.arange(count))
     return np.array(times, dtype=float)

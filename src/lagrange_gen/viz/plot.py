@@ -1,4 +1,5 @@
-"""The figure of a Trajectory: what a run did, one quantity per axis.
+"""The figure of a Trajectory (and of an EnsembleResult: plot_ensemble): what a run did, one
+quantity per axis.
 
 Left column the coordinates, right column their velocities, one row per coordinate (an angle that
 winds up to 35 rad no longer flattens the others); below, panels for what the run has: the energy
@@ -21,6 +22,9 @@ MAX_ROWS = 8
 _ROW_HEIGHT = 1.6
 # an adaptive run's curve has about this many points over its time span, plus its rows
 CURVE_POINTS = 2000
+# an ensemble's figure draws at most this many members, and labels them when at most MAX_LEGEND
+MAX_MEMBERS = 50
+MAX_LEGEND = 8
 
 
 def plot_trajectory(traj, path=None):
@@ -57,12 +61,70 @@ def plot_trajectory(traj, path=None):
     for ax in bottom:
         ax.set_xlabel("t")
     fig.suptitle(f"{traj.model}: {traj.method}, {_steps(traj)}")
+    return _written(fig, path)
+
+
+def _written(fig, path):
+    """``fig``, or None after writing it to ``path`` (format from the suffix)."""
     if path is None:
         return fig
     from pathlib import Path
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     return None
+
+
+def plot_ensemble(result, path=None, members=None):
+    """The Figure of an EnsembleResult: one row per coordinate (the first MAX_ROWS), q left and
+    v right, one line per drawn member; below, each member's E - E0. ``members``: indices to
+    draw (default every member, or MAX_MEMBERS evenly spread); with at most MAX_LEGEND drawn,
+    each line is labelled by its member's parameters ("k=10, m=0.5", those that vary). Rows
+    after a member's failure are NaN and leave its line short. With ``path`` the figure is
+    written there and None returned."""
+    from matplotlib.figure import Figure
+    M = len(result.q)
+    if members is None:
+        members = np.unique(np.linspace(0, M - 1, min(M, MAX_MEMBERS)).round().astype(int))
+    members = [int(i) for i in members]
+    labels = _member_labels(result, members)
+    n = len(result.coords)
+    shown = min(n, MAX_ROWS)
+    fig = Figure(figsize=(10, 1.2 + _ROW_HEIGHT * (shown + 1)), layout="constrained")
+    grid = fig.add_gridspec(shown + 1, 2)
+    first = None
+    for i in range(shown):
+        for col, (values, suffix) in enumerate(((result.q, ""), (result.v, "_dot"))):
+            ax = fig.add_subplot(grid[i, col], sharex=first)
+            first = first or ax
+            for member, label in zip(members, labels):
+                ax.plot(result.t, values[member, :, i], lw=0.8, label=label)
+            ax.set_ylabel(result.coords[i] + suffix)
+            ax.tick_params(labelsize="small")
+    ax = fig.add_subplot(grid[shown, :], sharex=first)
+    for member, label in zip(members, labels):
+        ax.plot(result.t, result.energy[member] - result.energy[member, 0], lw=0.8, label=label)
+    ax.set_ylabel("E - E0")
+    ax.set_xlabel("t")
+    ax.tick_params(labelsize="small")
+    if len(members) <= MAX_LEGEND:
+        ax.legend(loc="upper right", fontsize="small", ncol=2)
+    what = f"{len(members)} of {M} members" if len(members) < M else f"{M} members"
+    coords = f", first {shown} of {n} coordinates" if shown < n else ""
+    failed = int(np.count_nonzero(~result.ok))
+    fig.suptitle(f"{result.model}: {result.method}, h = {result.h:g}, {what}{coords}"
+                 + (f" ({failed} failed)" if failed else ""))
+    return _written(fig, path)
+
+
+def _member_labels(result, members):
+    """One label per drawn member: its parameters that vary across the ensemble ("k=10"), or
+    "member i" when none vary."""
+    varying = [j for j in range(result.params.shape[1])
+               if np.ptp(result.params[:, j]) > 0] if len(result.params) else []
+    if not varying:
+        return [f"member {i}" for i in members]
+    return [", ".join(f"{result.param_names[j]}={result.params[i, j]:g}" for j in varying)
+            for i in members]
 
 
 def state_curve(traj, points=CURVE_POINTS):
