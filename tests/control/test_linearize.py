@@ -134,3 +134,17 @@ def test_constrained_acceleration_derivatives_off_rest(generated):
     fd = _fd_jacobian(kkt, np.concatenate((q, qd)))
     np.testing.assert_allclose(dq, fd[:, :n], rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(dqd, fd[:, n:], rtol=1e-6, atol=1e-6)
+
+
+def test_a_model_without_inputs_says_why_B_has_no_columns(generated):
+    """cart_pendulum declares no inputs: B (4, 0), and one warning line saying why and how to
+    declare one; a model with inputs linearizes without it."""
+    import warnings
+    with pytest.warns(UserWarning, match=r"^cart_pendulum declares no inputs, so B and D have 0 "
+                                         r"columns: .*inputs=\[u\].*models/cart_pole\.py") as got:
+        A, B, C, D = lg.linearize(generated("cart_pendulum"), [0.0, 0.0], [0.0, 0.0])
+    assert B.shape == (4, 0) and A.shape == (4, 4)
+    assert len(got) == 1 and "\n" not in str(got[0].message)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lg.linearize(generated("cart_pole"), [0.0, 0.0], [0.0, 0.0], u=[0.0])
