@@ -156,8 +156,8 @@ def no_inputs_line(module):
     x = module.COORDS[0] if module.COORDS else "x"
     return (f"{module.NAME} declares no inputs, so B and D have 0 columns: declare one in the "
             f"model file, u = lg.inputs(\"u\", defaults=0.0) and Model(..., inputs=[u], "
-            f"forces={{{x}: u}}) for a force on {x} (models/cart_pole.py does; an input frozen "
-            f"by freeze= is a constant)")
+            f"forces={{{x}: u}}) for a force on {x} (models/cart_pendulum_forced.py does; an "
+            f"input frozen by freeze= is a constant)")
 
 
 def equilibrium(module, q, u=None, t=0.0, params=None, tol=1e-12, max_iter=50):
