@@ -57,3 +57,15 @@ def test_the_rows_themselves_stay_in_the_trajectory(ball):
     """The curve is only drawn: the Trajectory keeps the rows the run wrote."""
     t, y = _line(ball.plot(), "y")
     assert set(ball.t) <= set(t) and len(t) > len(ball.t)
+
+
+def test_rows_with_an_impact_between_them_are_joined_straight(generated):
+    """With t_eval the rows around an impact are on two flights: the cubic through them would
+    dip below the floor; the plot joins them with a straight line instead (and draws the cubic
+    between rows of one flight)."""
+    traj = simulate(generated("bouncing_ball"), method="dop853_impacts", q0=[H0], v0=[0.0],
+                    t_end=3.0, params={"g": G, "e": E}, t_eval=np.linspace(0, 3, 13))
+    t, y = _line(traj.plot(), "y")
+    assert y.min() >= -1e-12
+    first = (t > 0) & (t < 0.25)                 # one flight: the free fall from rest
+    np.testing.assert_allclose(y[first], H0 - G * t[first] ** 2 / 2, atol=1e-12)
