@@ -47,3 +47,13 @@ def test_simulate_without_t_end_names_it():
 def test_ensemble_without_t_end_or_h_names_it(missing, kwargs):
     with pytest.raises(SimulationError, match=rf"^ensemble: {missing} .*required"):
         lg.ensemble(CART, "rk4", **kwargs)
+
+
+@pytest.mark.parametrize("command", ["simulate", "sweep"])
+def test_cli_misspelt_method_is_one_line_with_did_you_mean(command, capsys):
+    from lagrange_gen.cli.main import main
+    extra = ["--grid", "k=1:2:2", "--h", "1e-3"] if command == "sweep" else []
+    assert main([command, CART, "--method", "midpiont", "--t-end", "1", *extra]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("lagrange-gen: error: --method: unknown method 'midpiont'; did you "
+                          "mean 'midpoint'?") and "\n" not in err

@@ -1,5 +1,5 @@
 """What every subcommand parses alike: NAME=VALUE lists (--param, --freeze, --set), times and
-ranges START:STOP:STEP (--t-eval), velocity names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one
+ranges START:STOP:STEP (--t-eval), method names (--method), velocity names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one
 ``lagrange-gen: warning: ...`` line each."""
 
 from __future__ import annotations
@@ -84,6 +84,15 @@ def parse_times(values, option, error=LagrangeGenError):
         count = math.floor((stop - start) / step + 1e-9) + 1
         times.extend(start + step * np.arange(count))
     return np.array(times, dtype=float)
+
+
+def method_name(name, error=LagrangeGenError):
+    """``name`` (--method) when it is a method; else ``error``, one line with the closest names
+    (steppers/core/registry.py unknown_method)."""
+    from ..steppers.core.registry import METHODS, unknown_method
+    if name not in METHODS:
+        raise error(f"--method: {unknown_method(name)}")
+    return name
 
 
 def out_dir(model_path, given):

@@ -19,8 +19,8 @@ from pathlib import Path
 
 from ..errors import SimulationError
 from ..jit.portable import JIT_MODES
-from .options import (BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments, parse_times,
-                      velocity_names)
+from .options import (BUILD, NUMBER, method_name, one_line_warnings, out_dir, parse_assignments,
+                      parse_times, velocity_names)
 from ..steppers.core.method_spec import SETTING_HELP
 from ..steppers.core.registry import INFO, METHODS
 
@@ -39,8 +39,8 @@ def add_parser(subparsers):
                     "settings record; an option the method does not have is refused.",
         epilog="methods:\n" + methods, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("model", metavar="MODEL.py", help="model file or generated module")
-    p.add_argument("--method", default="midpoint", choices=METHODS,
-                   help="stepper (default: midpoint)")
+    p.add_argument("--method", default="midpoint",
+                   help="stepper (default: midpoint; the list below)")
     p.add_argument("--h", type=float,
                    help="step size (required by the fixed-step methods; adaptive: first step)")
     p.add_argument("--t-end", type=float, required=True, help="final time")
@@ -151,6 +151,7 @@ def check_output_path(option, path, suffixes):
 def run(args) -> int:
     """Run the subcommand; returns the exit status."""
     from ..run.simulate import load_module, simulate
+    method_name(args.method, SimulationError)
     if args.out:
         check_output_path("--out", args.out, OUT_SUFFIXES)
     if args.plot:
