@@ -8,9 +8,10 @@ non-conservative forces), |Phi| and |J v| and the multipliers of a constrained r
 states of a nonsmooth run. An adaptive run (dop853, dop853_impacts) saves a row per step, and its
 steps are long where the motion is smooth (a free flight of the bouncing ball is one or two
 steps): its coordinates and velocities are drawn along each step as the cubic Hermite curve
-through (q, v) at the step's ends (``state_curve``), not as chords; the rows a switch writes twice
-(before and after an impact) draw the jump at its time. Built on matplotlib.figure.Figure (no pyplot, no backend switch), so it
-also works inside a notebook, where the returned Figure displays itself.
+through (q, v) at the step's ends (``state_curve``), not as chords; the rows a switch writes
+twice (before and after an impact) draw the jump at its time. Built on matplotlib.figure.Figure
+(no pyplot, no backend switch), so it also works inside a notebook, where the returned Figure
+displays itself.
 """
 
 from __future__ import annotations
@@ -151,11 +152,12 @@ def state_curve(traj, points=CURVE_POINTS):
     h = dt[start][:, None]
     s = s[:, None]
     q0, q1, v0, v1 = q[start], q[start + 1], v[start], v[start + 1]
-    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, 3 * s**2 - 2 * s**3, s**3 - s**2
+    # the cubic Hermite basis on [0, 1]: q = h00 q0 + h10 h v0 + h01 q1 + h11 h v1
+    h00, h10 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s
+    h01, h11 = 3 * s**2 - 2 * s**3, s**3 - s**2
     curve_q = h00 * q0 + h10 * h * v0 + h01 * q1 + h11 * h * v1
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(h > 0, (q1 - q0) / np.where(h > 0, h, 1.0), 0.0)
-    # dq/dt of the cubic, written around the chord's slope (no division by h = 0)
+    # dq/dt of the cubic, written around the chord's slope (h = 0 rows: no division by 0)
+    slope = (q1 - q0) / np.where(h > 0, h, 1.0)
     curve_v = (6 * s - 6 * s**2) * slope + (3 * s**2 - 4 * s + 1) * v0 + (3 * s**2 - 2 * s) * v1
     straight = ~smooth[start]
     curve_q[straight], curve_v[straight] = q0[straight], v0[straight]
