@@ -138,6 +138,8 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
              worker_threads=1, jit=None, device="cpu", dtype="float64", **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
 
+    t_end and the step h are required (each missing one is a SimulationError line naming it).
+
     q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
     array} (see grid), or an (M, n_params) table in PARAMS order; settings: the method's settings
     by name (as simulate), shared. M comes from the per-member inputs, which must agree.

@@ -89,6 +89,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
         nonholonomic_rk4, nonholonomic_midpoint. (steppers/core/registry.py METHODS; which fit
         which model: docs/guides/choosing-a-method.md, ``lagrange-gen simulate --help``.)
     q0, v0: initial coordinates and velocities (n,), default zeros.
+    t_end: the time the run ends (required).
     h: the step of a fixed-step method (required); for an adaptive method (dop853) only the
         first step tried (default: chosen automatically).
     params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
