@@ -154,10 +154,11 @@ def linearize(module, q, qd=None, u=None, t=0.0, params=None, coordinates=None,
 def no_inputs_line(module):
     """The one line linearize warns with on a model that declares no inputs (B (N, 0))."""
     x = module.COORDS[0] if module.COORDS else "x"
-    return (f"{module.NAME} declares no inputs, so B and D have 0 columns: declare one in the "
+    frozen = ", ".join(getattr(module, "FROZEN", {}))
+    return (f"{module.NAME} has no inputs, so B and D have 0 columns: declare one in the "
             f"model file, u = lg.inputs(\"u\", defaults=0.0) and Model(..., inputs=[u], "
-            f"forces={{{x}: u}}) for a force on {x} (models/cart_pendulum_forced.py does; an "
-            f"input frozen by freeze= is a constant)")
+            f"forces={{{x}: u}}) for a force on {x} (models/cart_pendulum_forced.py does)"
+            + (f"; frozen in this module, so constants: {frozen}" if frozen else ""))
 
 
 def equilibrium(module, q, u=None, t=0.0, params=None, tol=1e-12, max_iter=50):
