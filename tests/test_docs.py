@@ -33,3 +33,22 @@ def test_every_public_name_is_in_the_api_reference():
         documented.add("t")
     missing = sorted(set(lagrange_gen.__all__) - documented)
     assert not missing, f"docs/reference/api.md does not document {missing}"
+
+
+def test_every_name_in_the_api_reference_is_importable_from_the_package():
+    """The page says everything on it is ``lg.<name>``: each documented object is reachable as
+    an attribute of the package, and is the object documented."""
+    import importlib
+
+    import lagrange_gen
+    page = (ROOT / "docs" / "reference" / "api.md").read_text()
+    targets = [line.split()[1] for line in page.splitlines() if line.startswith("::: ")]
+    unreachable = []
+    for target in targets:
+        if target == "lagrange_gen.errors":
+            continue
+        where, name = target.rsplit(".", 1)
+        defined = getattr(importlib.import_module(where), name)
+        if getattr(lagrange_gen, name, None) is not defined:
+            unreachable.append(name)
+    assert not unreachable, f"documented but not lagrange_gen.<name>: {unreachable}"

@@ -104,7 +104,9 @@ def test_frozen_input_is_a_constant(gen_dir):
     mod = import_generated(generate_model(root / "models" / "cart_pole.py", out, methods=["rk4"],
                                           freeze={"u": 0.4}).path)
     assert mod.INPUTS == () and "u" not in mod.PARAMS and mod.OUTPUTS == ("cart", "tip_x")
-    A, B, C, D = lg.linearize(mod, [0, 0], [0, 0])
+    with pytest.warns(UserWarning, match=r"^cart_pole has no inputs, .*; frozen in this "
+                                         r"module, so constants: u$"):
+        A, B, C, D = lg.linearize(mod, [0, 0], [0, 0])
     assert B.shape == (4, 0) and C.shape == (2, 4)
     H, rhs = np.zeros((2, 2)), np.zeros(2)
     mod.dynamics(np.zeros(2), np.zeros(2), 0.0, mod.DEFAULT_PARAMS, H, rhs)

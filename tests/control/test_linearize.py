@@ -134,3 +134,38 @@ def test_constrained_acceleration_derivatives_off_rest(generated):
     fd = _fd_jacobian(kkt, np.concatenate((q, qd)))
     np.testing.assert_allclose(dq, fd[:, :n], rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(dqd, fd[:, n:], rtol=1e-6, atol=1e-6)
+
+
+def test_a_model_without_inputs_says_why_B_has_no_columns(generated):
+    """cart_pendulum declares no inputs: B (4, 0), and one warning line saying why and how to
+    declare one; a model with inputs linearizes without it."""
+    import warnings
+    expected = (r"^cart_pendulum has no inputs, so B and D have 0 columns: "
+                r".*inputs=\[u\].*models/cart_pendulum_forced\.py")
+    with pytest.warns(UserWarning, match=expected) as got:
+        A, B, C, D = lg.linearize(generated("cart_pendulum"), [0.0, 0.0], [0.0, 0.0])
+    assert B.shape == (4, 0) and A.shape == (4, 4)
+    message = str(got[0].message)
+    assert len(got) == 1 and "\n" not in message and "frozen" not in message
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lg.linearize(generated("cart_pole"), [0.0, 0.0], [0.0, 0.0], u=[0.0])
+
+
+def test_forced_cart_pendulum_is_the_cart_pendulum_with_a_force_input(generated):
+    """models/cart_pendulum_forced.py: the energies of models/cart_pendulum.py, and at the
+    hanging equilibrium H = [[M+m, m l], [m l, m l^2]], stiffness diag(k, m g l), force (u, 0):
+    A = [[0, I], [-H^-1 K, 0]], B = [0; H^-1 (1, 0)] = [0, 0, 1/M, -1/(M l)]."""
+
+    from lagrange_gen.model.model_file import load_model
+    from lg_test_support import MODELS_DIR
+    plain = load_model(MODELS_DIR / "cart_pendulum.py")
+    forced = load_model(MODELS_DIR / "cart_pendulum_forced.py")
+    assert (str(plain.T), str(plain.V)) == (str(forced.T), str(forced.V))
+    M, m, l, k, g = 1.0, 0.5, 1.0, 10.0, 9.81
+    A, B, C, D = lg.linearize(generated("cart_pendulum_forced"), [0.0, 0.0], [0.0, 0.0], u=[0.0])
+    H = np.array([[M + m, m * l], [m * l, m * l**2]])
+    lower = -np.linalg.solve(H, np.diag([k, m * g * l]))
+    np.testing.assert_allclose(A, np.block([[np.zeros((2, 2)), np.eye(2)],
+                                            [lower, np.zeros((2, 2))]]), atol=1e-13)
+    np.testing.assert_allclose(B, [[0], [0], [1 / M], [-1 / (M * l)]], atol=1e-14)

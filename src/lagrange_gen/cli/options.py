@@ -1,5 +1,5 @@
-"""What every subcommand parses alike: NAME=VALUE lists (--param, --freeze, --set), velocity
-names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one
+"""What every subcommand parses alike: NAME=VALUE lists (--param, --freeze, --set), times and
+ranges START:STOP:STEP (--t-eval), method names (--method), velocity names (--keep), the folder of generated modules (-o, --gen-dir), and warnings turned into one
 ``lagrange-gen: warning: ...`` line each."""
 
 from __future__ import annotations
@@ -53,6 +53,46 @@ def _convert(name, value, kind, option, item, error):
         # Worded as the run checks word a non-finite parameter given through the Python API.
         raise error(f"{option} {item}: parameter {name!r} = {value} is not finite")
     return number
+
+
+def parse_times(values, option, error=LagrangeGenError):
+    """``['0.5', '1', '2:3:0.5']`` (--t-eval) -> array([0.5, 1, 2, 2.5, 3]): numbers and ranges
+    START:STOP:STEP, STOP included when a step lands on it (to 1e-9 of a step, so 0:0.3:0.1 ends
+    at 0.3). A malformed item is ``error`` naming ``option`` and the item."""
+    import numpy as np
+    times = []
+    for item in values or ():
+        parts = item.split(":")
+        try:
+            numbers = [float(part) for part in parts]
+        except ValueError:
+            numbers = None
+        if numbers is None or len(numbers) not in (1, 3) or not all(map(math.isfinite, numbers)):
+            raise error(f"{option} {item}: expected a finite time or START:STOP:STEP, "
+                        f"e.g. {option} 0:10:0.01")
+        if len(numbers) == 1:
+            times.append(numbers[0])
+            continue
+        start, stop, step = numbers
+        if step <= 0 or stop < start:
+            raise error(f"{option} {item}: a range START:STOP:STEP needs STEP > 0 and "
+                        f"STOP >= START, e.g. {option} 0:10:0.01")
+        if step > stop - start > 0:      # sweep's --grid reads START:STOP:COUNT
+            raise error(f"{option} {item}: STEP {parts[2]} is longer than the range; the third "
+                        f"number is a step (e.g. {option} {parts[0]}:{parts[1]}:"
+                        f"{(stop - start) / 100:g} for 101 times), not a count as in --grid")
+        count = math.floor((stop - start) / step + 1e-9) + 1
+        times.extend(start + step * np.arange(count))
+    return np.array(times, dtype=float)
+
+
+def method_name(name, error=LagrangeGenError):
+    """``name`` (--method) when it is a method; else ``error``, one line with the closest names
+    (steppers/core/registry.py unknown_method)."""
+    from ..steppers.core.registry import METHODS, unknown_method
+    if name not in METHODS:
+        raise error(f"--method: {unknown_method(name)}")
+    return name
 
 
 def out_dir(model_path, given):

@@ -19,7 +19,8 @@ from pathlib import Path
 
 from ..errors import SimulationError
 from ..jit.portable import JIT_MODES
-from .options import BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments, velocity_names
+from .options import (BUILD, NUMBER, method_name, one_line_warnings, out_dir, parse_assignments,
+                      parse_times, velocity_names)
 from ..steppers.core.method_spec import SETTING_HELP
 from ..steppers.core.registry import INFO, METHODS
 
@@ -38,8 +39,8 @@ def add_parser(subparsers):
                     "settings record; an option the method does not have is refused.",
         epilog="methods:\n" + methods, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("model", metavar="MODEL.py", help="model file or generated module")
-    p.add_argument("--method", default="midpoint", choices=METHODS,
-                   help="stepper (default: midpoint)")
+    p.add_argument("--method", default="midpoint",
+                   help="stepper (default: midpoint; the list below)")
     p.add_argument("--h", type=float,
                    help="step size (required by the fixed-step methods; adaptive: first step)")
     p.add_argument("--t-end", type=float, required=True, help="final time")
@@ -57,8 +58,10 @@ def add_parser(subparsers):
                    help="constrained models: velocities (e.g. theta_dot) whose v0 is kept when "
                         "v0 is projected onto J v = 0; the others are solved for")
     p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
-    p.add_argument("--t-eval", type=float, nargs="+", metavar="T",
-                   help="adaptive methods: save the states at these times (default: every step)")
+    p.add_argument("--t-eval", nargs="+", metavar="T",
+                   help="adaptive methods: save the states at these times, each a number or a "
+                        "range START:STOP:STEP (STOP included), e.g. 0:10:0.01 (default: every "
+                        "step)")
     p.add_argument("--out", metavar="FILE", help="write the trajectory (.npz or .csv)")
     p.add_argument("--plot", metavar="FILE.png",
                    help="plot coordinates and energy error (.png, .pdf or .svg)")
@@ -148,11 +151,14 @@ def check_output_path(option, path, suffixes):
 def run(args) -> int:
     """Run the subcommand; returns the exit status."""
     from ..run.simulate import load_module, simulate
+    method_name(args.method, SimulationError)
     if args.out:
         check_output_path("--out", args.out, OUT_SUFFIXES)
     if args.plot:
         check_output_path("--plot", args.plot, PLOT_SUFFIXES)
     params = parse_params(args.param)
+    t_eval = None if args.t_eval is None else parse_times(args.t_eval, "--t-eval",
+                                                          SimulationError)
     options = parse_assignments(args.options, "--set", BUILD, SimulationError)
     keep = velocity_names(args.keep)
     gen_dir = out_dir(args.model, args.gen_dir)
@@ -162,7 +168,7 @@ def run(args) -> int:
             model = load_module(model, gen_dir, args.method, args.force, options=options)
         traj = simulate(model, args.method, args.q0, args.v0, t_end=args.t_end,
                         h=args.h, params=params, save_every=args.save_every,
-                        t_eval=args.t_eval, t0=args.t0, progress=args.progress,
+                        t_eval=t_eval, t0=args.t0, progress=args.progress,
                         out_dir=gen_dir, force=args.force, keep=keep, jit=args.jit,
                         **given_settings(args))
     _summary(traj)

@@ -21,10 +21,9 @@ import time
 import numpy as np
 
 from ..errors import SimulationError
-from .options import BUILD, one_line_warnings, out_dir, parse_assignments
+from .options import BUILD, method_name, one_line_warnings, out_dir, parse_assignments
 from .simulate import (add_setting_options, given_settings, parse_params,
                            check_output_path)
-from ..steppers.core.registry import METHODS
 
 #: The scalars a sweep can picture: name -> (help, function of (ensemble result, coord index)).
 SCALARS = {
@@ -43,7 +42,9 @@ def add_parser(subparsers):
         description="Run one model over the Cartesian product of parameter axes "
                     "(lagrange_gen.ensemble, all cores) and picture a scalar over the grid.")
     p.add_argument("model", metavar="MODEL.py", help="model file or generated module")
-    p.add_argument("--method", default="rk4", choices=METHODS, help="fixed-step method")
+    p.add_argument("--method", default="rk4",
+                   help="fixed-step method (default: rk4; lagrange-gen simulate --help lists "
+                        "them)")
     p.add_argument("--grid", action="append", required=True, metavar="NAME=START:STOP:COUNT",
                    help="a parameter axis (COUNT values from START to STOP), or NAME=A,B,C; "
                         "repeat for more axes")
@@ -99,6 +100,7 @@ def run(args) -> int:
     """Run the subcommand; returns the exit status (0, also when some members failed)."""
     from ..run.ensemble import ensemble
     from ..run.ensemble_inputs import grid
+    method_name(args.method, SimulationError)
     axes = dict(parse_axis(text) for text in args.grid)
     if len(axes) != len(args.grid):
         raise SimulationError("--grid: each parameter may be given once")

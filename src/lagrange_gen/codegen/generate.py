@@ -103,14 +103,16 @@ def resolve_methods(requested, model, drop_inapplicable=False):
     nonsmooth_euler on a model with elements as in simulate. GenerationError for an unknown
     method, and for one that does not apply (one line naming it and why) unless
     ``drop_inapplicable`` (load(): simulate then refuses it with its own message)."""
-    from ..steppers.core.registry import METHODS, applicable_methods, inapplicable, runs_as
+    from ..steppers.core.registry import (METHODS, applicable_methods, inapplicable, runs_as,
+                                          unknown_method)
     counts = model_counts(model)
     n_elements = counts[1]
     if requested is None:
         return list(applicable_methods(*counts))
     unknown = [m for m in requested if m not in METHODS]
     if unknown:
-        raise GenerationError(f"unknown method(s) {', '.join(unknown)}; known: {', '.join(METHODS)}")
+        raise GenerationError(unknown_method(unknown[0]) if len(unknown) == 1 else
+                              f"unknown methods {', '.join(unknown)}; known: {', '.join(METHODS)}")
     wanted = {runs_as(m, n_elements) for m in requested}
     for method in (m for m in METHODS if m in wanted):
         why = inapplicable(method, *counts)

@@ -24,6 +24,7 @@ equilibrium or a steady motion; the shared argument handling is linear/arguments
 
 from __future__ import annotations
 
+import warnings
 from typing import NamedTuple
 
 import numpy as np
@@ -119,7 +120,8 @@ def constraint_basis(module, q, params=None, t=0.0):
 def linearize(module, q, qd=None, u=None, t=0.0, params=None, coordinates=None,
               speeds=None) -> Linearization:
     """A, B, C, D of the model at (q, qd, u, t) (see the module docstring); ``module`` a
-    generated module or a model file. C, D have 0 rows for a model without outputs.
+    generated module or a model file. C, D have 0 rows for a model without outputs; B, D have
+    0 columns for a model without inputs (Model(inputs=)), with one warning line saying so.
 
     A model with nonholonomic constraints is linearized in minimal coordinates and minimal
     speeds (state (z, u), lagrange_gen.linear.nonholonomic; ``coordinates`` and ``speeds``
@@ -127,6 +129,8 @@ def linearize(module, q, qd=None, u=None, t=0.0, params=None, coordinates=None,
     second-order form M du' + C du + K dz as well."""
     from ..run.simulate import load_module
     module = load_module(module)
+    if not getattr(module, "INPUTS", ()):
+        warnings.warn(no_inputs_line(module), stacklevel=2)
     if getattr(module, "N_NONHOLONOMIC", 0):
         lin = linearize_nonholonomic(module, q, qd, u, t, params, coordinates, speeds)
         return Linearization(lin.A, lin.B, lin.C, lin.D)
@@ -145,6 +149,16 @@ def linearize(module, q, qd=None, u=None, t=0.0, params=None, coordinates=None,
     A = np.block([[np.zeros((r, r)), np.eye(r)], [N.T @ dq @ N, N.T @ dqd @ N]])
     B = np.vstack((np.zeros((r, du.shape[1])), N.T @ du))
     return Linearization(A, B, np.hstack((Cq @ N, Cqd @ N)), Du)
+
+
+def no_inputs_line(module):
+    """The one line linearize warns with on a model that declares no inputs (B (N, 0))."""
+    x = module.COORDS[0] if module.COORDS else "x"
+    frozen = ", ".join(getattr(module, "FROZEN", {}))
+    return (f"{module.NAME} has no inputs, so B and D have 0 columns: declare one in the "
+            f"model file, u = lg.inputs(\"u\", defaults=0.0) and Model(..., inputs=[u], "
+            f"forces={{{x}: u}}) for a force on {x} (models/cart_pendulum_forced.py does)"
+            + (f"; frozen in this module, so constants: {frozen}" if frozen else ""))
 
 
 def equilibrium(module, q, u=None, t=0.0, params=None, tol=1e-12, max_iter=50):

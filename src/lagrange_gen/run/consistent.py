@@ -273,7 +273,10 @@ def check_method(module, method):
                                 getattr(module, "N_NONHOLONOMIC", 0))
     if not why:
         return
-    if m and not registry.spec(method).constraints and not registry.spec(method).contacts:
+    # the list of constrained methods is the advice only where they apply (velocity
+    # constraints beside holonomic ones need a nonholonomic method: ``why`` names it)
+    if (m and not getattr(module, "N_NONHOLONOMIC", 0) and not registry.spec(method).constraints
+            and not registry.spec(method).contacts):
         names = "; ".join(constraint_label(module, i) for i in range(m))
         about = "; ".join(f"{s.name}: order {s.order}, {s.summary}"
                           for s in map(registry.spec, registry.CONSTRAINED_METHODS))

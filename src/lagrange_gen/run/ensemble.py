@@ -6,6 +6,7 @@
     ens.q            # (M, S, n)
     ens.failures()   # ["member 17: cart_pendulum, explicit_euler: step 312 of 1000 ..."]
     ens.to_dataframe()   # pandas: one row per member and saved state
+    ens.params_by_name["k"]   # (M,); ens.plot("ens.png"); ens.save("ens.npz"); EnsembleResult.load
 
 Without save_every, every step is saved unless that would hold more than OUTPUT_BUDGET_BYTES
 (or a quarter of the memory available): then the smallest save_every that fits is chosen and
@@ -31,7 +32,8 @@ import numpy as np
 from . import checks as run_checks
 from ..codegen.keys import regeneration_command_for
 from .ensemble_inputs import grid, member_count, member_params, member_states
-from .ensemble_outputs import allocate_outputs, dataframe, member_args, run_members
+from .ensemble_outputs import (allocate_outputs, dataframe, member_args, read_ensemble,
+                               run_members, write_ensemble)
 from ..errors import LagrangeGenError, SimulationError
 from .failures import raise_for_status
 from .fixed_driver import ProgressBar, n_steps_to
@@ -98,17 +100,45 @@ class EnsembleResult:
         """["member i: <the message simulate would raise>", ...] for the failed members."""
         return [f"member {i}: {self.messages[i]}" for i in sorted(self.messages)]
 
+    @property
+    def params_by_name(self) -> dict:
+        """{parameter name: (M,) its value per member}, in param_names order (views of
+        ``params``)."""
+        return {name: self.params[:, j] for j, name in enumerate(self.param_names)}
+
     def to_dataframe(self):
         """A long (tidy) pandas.DataFrame, one row per member and saved state (M S rows):
         member, the parameters (param_names), t, the coordinates, their velocities (name_dot)
         and energy. pandas is the optional extra ``lagrange-gen[dataframe]``."""
         return dataframe(self)
 
+    def save(self, path):
+        """Write every field to a .npz file (the layout of Trajectory.save);
+        EnsembleResult.load reads it back."""
+        write_ensemble(self, path)
 
-def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end, h,
-             save_every=None, t0=0.0, progress=False, out_dir=None, client=None,
+    @classmethod
+    def load(cls, path) -> "EnsembleResult":
+        """The EnsembleResult written by save; one LagrangeGenError line for a file that is not
+        one (a Trajectory's file included)."""
+        return read_ensemble(cls, path)
+
+    def plot(self, path=None, members=None):
+        """Every member's coordinates and velocities (one axis each, one line per member,
+        labelled by its parameters when few) and energy error E - E0 (viz/plot.py
+        plot_ensemble). ``members``: the indices to draw (default all, at most
+        viz.plot.MAX_MEMBERS evenly chosen). Writes ``path`` (.png, .pdf, .svg) or returns the
+        Figure."""
+        from ..viz.plot import plot_ensemble
+        return plot_ensemble(self, path, members)
+
+
+def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None, t_end=None,
+             h=None, save_every=None, t0=0.0, progress=False, out_dir=None, client=None,
              worker_threads=1, jit=None, device="cpu", dtype="float64", **settings):
     """Integrate M members of one model with a fixed-step method; an EnsembleResult.
+
+    t_end and the step h are required (each missing one is a SimulationError line naming it).
 
     q0, v0: (n,) shared or (M, n) per member (default zeros); params: dict {name: value or (M,)
     array} (see grid), or an (M, n_params) table in PARAMS order; settings: the method's settings
@@ -132,9 +162,10 @@ def ensemble(module_or_path, method="midpoint", *, q0=None, v0=None, params=None
     events; dtype "float64" or "float32" (GPU only: state, parameters and outputs in float32,
     returned as float64 arrays); no progress bar. Anything the GPU path cannot run, and a
     missing numba-cuda, driver or GPU, is one SimulationError line."""
-    from .simulate import check_times, element_method, load_module
+    from .simulate import check_required, check_times, element_method, load_module
+    check_required("ensemble", t_end=t_end, h=h)
     if method not in registry.METHODS:
-        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+        raise SimulationError(registry.unknown_method(method))
     jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method)
     method = element_method(module, method)

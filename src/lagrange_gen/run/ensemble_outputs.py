@@ -1,6 +1,6 @@
 """The output arrays of an ensemble and the call of the glue ``ensemble_<method>`` on a slice of
 its members: what a local run (ensemble) and a Dask worker (ensemble_dask) share; the finished
-result as a pandas frame."""
+result as a pandas frame and as a .npz file (the layout of a Trajectory's, run/trajectory_io.py)."""
 
 from __future__ import annotations
 
@@ -51,3 +51,31 @@ def dataframe(result):
         columns[f"{name}_dot"] = result.v[:, :, i].ravel()
     columns["energy"] = result.energy.ravel()
     return pd.DataFrame(columns)
+
+
+def write_ensemble(result, path):
+    """Write every field of an EnsembleResult to ``path`` (.npz; read_ensemble reads it back)."""
+    from .trajectory_io import ENSEMBLE, field_arrays, save_fields
+    arrays, meta = field_arrays(result, ENSEMBLE)
+    save_fields(path, meta, arrays)
+
+
+def read_ensemble(cls, path):
+    """The EnsembleResult (class ``cls``) written by write_ensemble; LagrangeGenError naming the
+    file when it cannot be read, holds a Trajectory, or its fields are damaged."""
+    from .trajectory_io import ENSEMBLE, from_fields, load_fields
+    data = load_fields(path, ENSEMBLE)
+    try:
+        result = from_fields(cls, data)
+        # JSON keys are text: the failure messages are keyed by member index
+        result.messages = {int(i): text for i, text in result.messages.items()}
+    except (ValueError, KeyError, TypeError, IndexError, AttributeError) as exc:
+        first = (str(exc).splitlines() or [""])[0]
+        raise LagrangeGenError(f"{path}: not an ensemble written by lagrange-gen (its metadata "
+                               f"or arrays are damaged: {type(exc).__name__}: {first})") from None
+    M, S = len(result.params), len(result.t)
+    for name in ("q", "v", "energy"):
+        if np.shape(getattr(result, name))[:2] != (M, S):
+            raise LagrangeGenError(f"{path}: {name} has shape {np.shape(getattr(result, name))}"
+                                   f", not ({M}, {S}, ...) for {M} members and {S} times")
+    return result

@@ -73,8 +73,8 @@ def _runner(module, method):
     return run
 
 
-def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=None, params=None,
-             save_every=1, t_eval=None, t0=0.0, progress=False, out_dir=None,
+def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None, h=None,
+             params=None, save_every=1, t_eval=None, t0=0.0, progress=False, out_dir=None,
              element_state0=None, force=False, keep=None, control=None, control_params=None,
              jit=None, **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
@@ -82,8 +82,13 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
         into out_dir, default the model's own place, when missing or stale; see load_module, and
         ``force`` there).
-    method: one of steppers.registry.METHODS.
+    method: explicit_euler, symplectic_euler, verlet, midpoint, implicit_euler, rk4, dop853,
+        composition, composition6, nonsmooth_euler, rattle, constrained_midpoint,
+        constrained_implicit_euler, spook, index1, moreau_jean, spook_contacts, dop853_impacts,
+        nonholonomic_rk4, nonholonomic_midpoint. (steppers/core/registry.py METHODS; which fit
+        which model: docs/guides/choosing-a-method.md, ``lagrange-gen simulate --help``.)
     q0, v0: initial coordinates and velocities (n,), default zeros.
+    t_end: the time the run ends (required).
     h: the step of a fixed-step method (required); for an adaptive method (dop853) only the
         first step tried (default: chosen automatically).
     params: dict {name: value} overriding the defaults, or a full sequence in PARAMS order; a
@@ -132,8 +137,9 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     energy_check.ENERGY_FRACTION of its energy scale warns (EnergyWarning, the line also in
     Trajectory.warnings).
     """
+    check_required("simulate", t_end=t_end)
     if method not in registry.METHODS:
-        raise SimulationError(f"unknown method {method!r}; known: {', '.join(registry.METHODS)}")
+        raise SimulationError(registry.unknown_method(method))
     jit = jit_mode(jit)
     module = load_module(module_or_path, out_dir, method, force)
     plan = method_plan(module, method)      # element_method, check_method, spec: once each
@@ -211,6 +217,19 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
 def _with_data(run, data):
     """The glue signature of a run with an input hook (control.controlled_run): data bound."""
     return lambda *args: run(*args, data)
+
+
+#: What each argument check_required asks for is, in the words of its line.
+_REQUIRED = {"t_end": "the time the run ends, e.g. t_end=10.0",
+             "h": "the step of the fixed-step method, e.g. h=1e-3"}
+
+
+def check_required(function, **values):
+    """SimulationError naming the first of ``values`` (argument name: value) that is None, in
+    one line: "simulate: t_end (the time the run ends, e.g. t_end=10.0) is required"."""
+    for name, value in values.items():
+        if value is None:
+            raise SimulationError(f"{function}: {name} ({_REQUIRED[name]}) is required")
 
 
 def check_times(spec, h, t0, t_end, save_every, t_eval):

@@ -136,8 +136,7 @@ class Stepper:
                  **settings):
         from .simulate import load_module
         if method not in registry.METHODS:
-            raise SimulationError(f"Stepper: unknown method {method!r}; known: "
-                                  f"{', '.join(registry.METHODS)}")
+            raise SimulationError(f"Stepper: {registry.unknown_method(method)}")
         module = load_module(module, method=method)
         spec = registry.spec(method)
         if (spec.adaptive or spec.constraints or spec.contacts or spec.nonholonomic

@@ -154,8 +154,10 @@ class Trajectory:
 
     def plot(self, path=None):
         """Coordinates and velocities (one axis each), energy (balance), and the constraint
-        errors and multipliers or element states when the run has them (viz/plot.py). Writes
-        ``path`` (format from the suffix: .png, .pdf, .svg) or returns the Figure."""
+        errors and multipliers or element states when the run has them (viz/plot.py). An
+        adaptive run's coordinates and velocities are drawn along each step (the cubic Hermite
+        curve through its end states, viz.plot.state_curve), not as chords between its rows.
+        Writes ``path`` (format from the suffix: .png, .pdf, .svg) or returns the Figure."""
         from ..viz.plot import plot_trajectory
         return plot_trajectory(self, path)
 

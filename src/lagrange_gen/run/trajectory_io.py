@@ -1,4 +1,5 @@
-"""Trajectory <-> files and tables: npz (every field, loaded back by Trajectory.load), csv, pandas.
+"""Trajectory <-> files and tables: npz (every field, loaded back by Trajectory.load), csv, pandas;
+the same npz layout for an EnsembleResult (field_arrays, save_fields, load_fields, from_fields).
 
 The npz holds each array field under its name (t, q, v, energy, ..., events as a structured array
 when the run located any), each saved field under its own name (a width-1 field as (S,), as the
@@ -21,26 +22,16 @@ import numpy as np
 from ..errors import LagrangeGenError
 
 FORMAT = 1
+#: The kinds of file save_fields writes, and the reader of each (named in a refusal).
+TRAJECTORY, ENSEMBLE = "trajectory", "ensemble"
+READERS = {TRAJECTORY: "Trajectory.load", ENSEMBLE: "EnsembleResult.load"}
 # what the CLI's readers (and older files) expect even when the method saved none
 _ALWAYS = ("element_state", "multipliers")
 
 
 def write_npz(traj, path):
     """Write every field of ``traj`` to ``path`` (.npz)."""
-    arrays, meta = {}, {"format": FORMAT, "dict_arrays": {}}
-    for f in dataclasses.fields(traj):
-        value = getattr(traj, f.name)
-        if f.name == "saved":
-            meta["saved"] = [[name, a.shape[1]] for name, a in value.items()]
-            arrays.update({name: a[:, 0] if a.shape[1] == 1 else a for name, a in value.items()})
-        elif isinstance(value, np.ndarray):
-            arrays[f.name] = value
-        elif value and isinstance(value, dict) and all(isinstance(a, np.ndarray)
-                                                         for a in value.values()):
-            meta["dict_arrays"][f.name] = list(value)
-            arrays.update({f"{f.name}.{k}": a for k, a in value.items()})
-        else:
-            meta[f.name] = value
+    arrays, meta = field_arrays(traj)
     for name in _ALWAYS:
         arrays.setdefault(name, getattr(traj, name))
     # the keys older readers use
@@ -50,8 +41,36 @@ def write_npz(traj, path):
                   coords=np.array(traj.coords, dtype=str),
                   element_names=np.array(traj.element_names, dtype=str),
                   constraint_names=np.array(traj.constraint_names, dtype=str))
+    save_fields(path, meta, {**legacy, **arrays})
+
+
+def field_arrays(obj, kind=TRAJECTORY):
+    """(arrays, meta) of a dataclass ``obj`` (a Trajectory, an EnsembleResult): each array field
+    under its name; ``saved`` ({name: (..., width)}) each under its own name, a width-1 field
+    without its last axis; a dict of arrays as "field.key"; every other field in ``meta`` (JSON),
+    with the saved fields' names and widths and the ``kind`` of file."""
+    arrays, meta = {}, {"format": FORMAT, "kind": kind, "dict_arrays": {}}
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if f.name == "saved":
+            meta["saved"] = [[name, a.shape[-1]] for name, a in value.items()]
+            arrays.update({name: a[..., 0] if a.shape[-1] == 1 else a
+                           for name, a in value.items()})
+        elif isinstance(value, np.ndarray):
+            arrays[f.name] = value
+        elif value and isinstance(value, dict) and all(isinstance(a, np.ndarray)
+                                                         for a in value.values()):
+            meta["dict_arrays"][f.name] = list(value)
+            arrays.update({f"{f.name}.{k}": a for k, a in value.items()})
+        else:
+            meta[f.name] = value
+    return arrays, meta
+
+
+def save_fields(path, meta, arrays):
+    """The .npz of field_arrays' (arrays, meta); its folder made when missing."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    np.savez(path, meta=json.dumps(meta, default=_plain), **legacy, **arrays)
+    np.savez(path, meta=json.dumps(meta, default=_plain), **arrays)
 
 
 def _plain(value):
@@ -63,10 +82,10 @@ def _plain(value):
     raise TypeError(f"{type(value).__name__} is not JSON serializable")
 
 
-def read_npz(cls, path):
-    """The Trajectory (class ``cls``) written by write_npz; LagrangeGenError naming the file
-    when it is not one: unreadable, truncated or corrupted (zip, compression), metadata that is
-    not the writer's, or arrays whose lengths disagree."""
+def load_fields(path, kind):
+    """{name: array} of a .npz; LagrangeGenError naming the file when it cannot be read
+    (unreadable, truncated or corrupted: zip, compression) or when its metadata says it holds
+    another kind of file (a trajectory's has no kind: files of older writers)."""
     try:
         # Opened here so that it is closed whatever np.load makes of it (a file that is not a
         # zip is left open by numpy, and a ResourceWarning line follows later).
@@ -74,10 +93,28 @@ def read_npz(cls, path):
             data = {k: data[k] for k in data.files}
     except (OSError, ValueError, EOFError, TypeError, AttributeError, zipfile.BadZipFile,
             zlib.error) as exc:        # TypeError: a .npy (an array, not an archive)
-        raise LagrangeGenError(f"{path}: cannot read as a trajectory .npz "
-                               f"({type(exc).__name__}: {_first_line(exc)})") from None
+        raise LagrangeGenError(f"{path}: cannot read as {'an' if kind == ENSEMBLE else 'a'} "
+                               f"{kind} .npz ({type(exc).__name__}: {_first_line(exc)})") from None
+    written = TRAJECTORY
+    if "meta" in data:
+        try:
+            written = json.loads(str(data["meta"])).get("kind", TRAJECTORY)
+        except (ValueError, AttributeError):
+            written = kind            # damaged metadata: the reader says so
+    if written != kind:
+        raise LagrangeGenError(f"{path}: holds {'an' if written == ENSEMBLE else 'a'} {written}, "
+                               f"not {'an' if kind == ENSEMBLE else 'a'} {kind}: "
+                               f"{READERS.get(written, 'its writer')} reads it")
+    return data
+
+
+def read_npz(cls, path):
+    """The Trajectory (class ``cls``) written by write_npz; LagrangeGenError naming the file
+    when it is not one: unreadable, truncated or corrupted (zip, compression), metadata that is
+    not the writer's, or arrays whose lengths disagree."""
+    data = load_fields(path, TRAJECTORY)
     try:
-        traj = _read_legacy(cls, path, data) if "meta" not in data else _read_meta(cls, data)
+        traj = _read_legacy(cls, path, data) if "meta" not in data else from_fields(cls, data)
     except LagrangeGenError:
         raise
     except (ValueError, KeyError, TypeError, IndexError, AttributeError) as exc:
@@ -92,14 +129,15 @@ def _first_line(exc):
     return (str(exc).splitlines() or [""])[0]
 
 
-def _read_meta(cls, data):
+def from_fields(cls, data):
+    """The dataclass ``cls`` from the arrays and meta of field_arrays (load_fields' dict)."""
     meta = json.loads(str(data["meta"]))
     if not isinstance(meta, dict):
         raise TypeError(f"meta is a {type(meta).__name__}, not a dict")
     kwargs = {}
     for f in dataclasses.fields(cls):
         if f.name == "saved":
-            kwargs["saved"] = {name: data[name].reshape(len(data[name]), width)
+            kwargs["saved"] = {name: data[name][..., None] if width == 1 else data[name]
                                for name, width in meta["saved"]}
         elif f.name in meta["dict_arrays"]:
             kwargs[f.name] = {k: data[f"{f.name}.{k}"] for k in meta["dict_arrays"][f.name]}

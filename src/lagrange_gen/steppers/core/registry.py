@@ -45,10 +45,19 @@ GPU_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint", "impl
 ON_ELEMENTS = {asked: m for m in NONSMOOTH_METHODS for asked in INFO[m].stands_in_for}
 
 
+def unknown_method(method) -> str:
+    """The one line for a method name that is not in METHODS: the closest names ("did you mean
+    'midpoint'?") when some are close, and the known ones."""
+    import difflib
+    close = difflib.get_close_matches(str(method), METHODS, n=3, cutoff=0.6)
+    guess = f"; did you mean {' or '.join(repr(m) for m in close)}? K" if close else "; k"
+    return f"unknown method {method!r}{guess}nown: {', '.join(METHODS)}"
+
+
 def spec(method: str):
     """The Spec of a method; KeyError naming the known ones."""
     if method not in INFO:
-        raise KeyError(f"unknown stepper method {method!r}; known: {', '.join(METHODS)}")
+        raise KeyError(unknown_method(method))
     return INFO[method]
 
 
@@ -65,8 +74,9 @@ def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: i
         return ("nonholonomic constraints together with nonsmooth elements or contacts are not "
                 "supported by any method yet")
     if bool(n_nonholonomic) != flags.nonholonomic:
+        fits = [m for m in NONHOLONOMIC_METHODS if INFO[m].holonomic_too or not n_constraints]
         return (f"it ignores the model's nonholonomic constraints (use "
-                f"{', '.join(NONHOLONOMIC_METHODS)})" if n_nonholonomic
+                f"{', '.join(fits)})" if n_nonholonomic
                 else "it is for models with nonholonomic constraints and this model has none")
     if n_nonholonomic:
         both = [m for m in NONHOLONOMIC_METHODS if INFO[m].holonomic_too]
