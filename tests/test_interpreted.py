@@ -12,6 +12,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -170,6 +171,17 @@ def test_a_run_goes_on_compiled_once_its_interpreted_time_would_pass_the_compile
     _assert_close(switched, compiled, _tolerance("verlet"))
 
 
+def test_a_run_waits_for_the_compile_running_elsewhere(generated, first_use, monkeypatch):
+    """Worth compiling, but a compile of the same glue holds its lock (the background one this
+    run started): the run goes on interpreted instead of compiling the glue a second time
+    beside it (twice the memory, half the speed each on two cores)."""
+    mod = generated("double_pendulum")
+    monkeypatch.setattr(first_run, "expected_compile_seconds", lambda method: 0.0)
+    monkeypatch.setattr(first_run, "compile_running", lambda method: True)
+    run = simulate(mod, "verlet", [0.3, 0.2], None, t_end=0.1, h=1e-3)
+    assert run.jit == "interpreted" and len(run.t) == 101
+
+
 def test_a_run_whose_interpreted_time_stays_below_the_compile_stays_interpreted(
         generated, first_use):
     run = simulate(generated("double_pendulum"), "verlet", [0.3, 0.2], None, t_end=0.1, h=1e-3)
@@ -214,45 +226,65 @@ def test_expected_compile_seconds_default_and_record(tmp_path, monkeypatch):
     assert first_run.expected_compile_seconds("rk4") == first_run.DEFAULT_COMPILE_S
 
 
-class _FakePopen:
+class _FakeSpawn:
+    """first_run.spawn_detached without a process: records the command, returns a pid no
+    process has."""
     started = []
 
-    def __init__(self, args, **kwargs):
-        self.args, self.pid = args, 999_999_999
-        _FakePopen.started.append(args)
+    def __call__(self, argv, env):
+        _FakeSpawn.started.append(argv)
+        return 999_999_999
 
 
 def test_the_background_compile_can_be_turned_off(generated, tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(first_run, "lock_path", lambda method: tmp_path / "lock")
-    monkeypatch.setattr(subprocess, "Popen", _FakePopen)
-    _FakePopen.started = []
+    monkeypatch.setattr(first_run, "spawn_detached", _FakeSpawn())
+    _FakeSpawn.started = []
     monkeypatch.setenv(first_run.BACKGROUND_ENV, "0")
     assert first_run.start_background_compile(generated("cart_pendulum"), "rk4") is None
-    assert _FakePopen.started == [] and not (tmp_path / "lock").exists()
+    assert _FakeSpawn.started == [] and not (tmp_path / "lock").exists()
     assert capsys.readouterr().err == ""
 
 
 def test_the_background_compile_honours_its_lock(generated, tmp_path, monkeypatch, capsys):
     lock = tmp_path / "lock"
     monkeypatch.setattr(first_run, "lock_path", lambda method: lock)
-    monkeypatch.setattr(subprocess, "Popen", _FakePopen)
+    monkeypatch.setattr(first_run, "spawn_detached", _FakeSpawn())
     monkeypatch.setenv(first_run.BACKGROUND_ENV, "1")
-    _FakePopen.started = []
+    _FakeSpawn.started = []
     mod = generated("cart_pendulum")
-    process = first_run.start_background_compile(mod, "rk4")
-    assert process is not None and json.loads(lock.read_text())["pid"] == process.pid
-    assert process.args[1:4] == ["-m", "lagrange_gen.jit.first_run", "rk4"]
+    pid = first_run.start_background_compile(mod, "rk4")
+    assert pid is not None and json.loads(lock.read_text())["pid"] == pid
+    assert _FakeSpawn.started[0][1:4] == ["-m", "lagrange_gen.jit.first_run", "rk4"]
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "run_rk4 in the background" in err
     assert first_run.BACKGROUND_ENV in err
     lock.write_text(json.dumps(first_run.lock_record(os.getpid())))    # a live compile holds it
     assert first_run.start_background_compile(mod, "rk4") is None
-    assert len(_FakePopen.started) == 1
+    assert first_run.compile_running("rk4")
+    assert len(_FakeSpawn.started) == 1
     lock.write_text(json.dumps(first_run.lock_record(999_999_999)))    # its process is gone
+    assert not first_run.compile_running("rk4")
     assert first_run.start_background_compile(mod, "rk4") is not None
-    assert len(_FakePopen.started) == 2
+    assert len(_FakeSpawn.started) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "took over the stale lock" in err and "is gone" in err
+
+
+def test_a_detached_process_is_no_child_of_ours(tmp_path):
+    """spawn_detached: the process runs on (it writes its file), but it is not this process's
+    child, so nothing is left for Python to report as still running when this one exits."""
+    marker = tmp_path / "ran"
+    code = f"import pathlib, time; time.sleep(0.5); pathlib.Path({str(marker)!r}).write_text('ok')"
+    pid = first_run.spawn_detached([sys.executable, "-c", code], dict(os.environ))
+    assert pid > 0
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)
+    for _ in range(200):
+        if marker.exists():
+            break
+        time.sleep(0.05)
+    assert marker.read_text() == "ok"
 
 
 def test_the_background_compile_fills_the_cache_for_the_next_process(tmp_path):

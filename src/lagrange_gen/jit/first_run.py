@@ -236,7 +236,7 @@ def release_lock(lock: Path) -> None:
 def start_background_compile(module, method, stream=None):
     """Start the detached compile of ``method``'s portable glue and ``module``'s kernels for the
     next process (module docstring) unless it is turned off or another holds the lock; one line
-    on ``stream`` (default stderr) says so. Returns the process (subprocess.Popen) or None."""
+    on ``stream`` (default stderr) says so. Returns the process id, or None."""
     if not background_enabled():
         return None
     lock = lock_path(method)
@@ -248,20 +248,58 @@ def start_background_compile(module, method, stream=None):
     env["PYTHONPATH"] = os.pathsep.join(
         [package_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
     try:
-        process = subprocess.Popen(
+        pid = spawn_detached(
             [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            start_new_session=True, env=env, close_fds=True)
-    except OSError:
+            env)
+    except (OSError, ValueError):
         release_lock(lock)
         return None
-    _write_record(lock, process.pid)
+    _write_record(lock, pid)
     stream = stream or sys.stderr
     took_over = "".join(f"; {note}" for note in notes)
     stream.write(f"lagrange-gen: compiling run_{method} in the background for the next run "
-                 f"(process {process.pid}; {BACKGROUND_ENV}=0 turns this off{took_over})\n")
+                 f"(process {pid}; {BACKGROUND_ENV}=0 turns this off{took_over})\n")
     stream.flush()
-    return process
+    return pid
+
+
+#: The launcher of a detached process: it forks, the child starts a session of its own and
+#: becomes the command, the launcher prints the child's pid and exits.
+_LAUNCHER = (
+    "import os, sys\n"
+    "pid = os.fork()\n"
+    "if pid == 0:\n"
+    "    os.setsid()\n"
+    "    null = os.open(os.devnull, os.O_RDWR)\n"
+    "    for fd in (0, 1, 2):\n"
+    "        os.dup2(null, fd)\n"
+    "    os.execv(sys.argv[1], sys.argv[1:])\n"
+    "print(pid, flush=True)\n")
+
+
+def spawn_detached(argv, env) -> int:
+    """Start ``argv`` as a process of its own session, not a child of this one, and return its
+    pid. The launcher in between is waited for, so this process never exits with a child still
+    running (Python's "subprocess N is still running" at exit) and the compile outlives it.
+    Where there is no fork (Windows): a detached child."""
+    if not hasattr(os, "fork"):
+        process = subprocess.Popen(argv, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL, env=env, close_fds=True,
+                                   creationflags=getattr(subprocess, "DETACHED_PROCESS", 0))
+        process.returncode = 0        # not ours to wait for: it outlives this process
+        return process.pid
+    launcher = subprocess.run([sys.executable, "-c", _LAUNCHER, *argv], env=env,
+                              stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                              timeout=60, check=True)
+    return int(launcher.stdout.split()[0])
+
+
+def compile_running(method) -> bool:
+    """Whether a live compile of ``method``'s portable glue holds its lock (another process, or
+    the background compile this one started): a caller waits for it rather than compiling the
+    same glue beside it (twice the memory, half the speed on two cores)."""
+    lock = lock_path(method)
+    return lock.exists() and _stale(lock) is None
 
 
 def zero_step_args(module, method):

@@ -123,7 +123,8 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
     """The chunk loop of integrate_fixed (args(): the arguments of a warm-up call); returns
     (steps done, last row, seconds spent compiling between chunks, compile seconds). An
     interpreted run (task.ran "interpreted") goes on compiled once it is worth it
-    (_worth_compiling) or once the cache holds its glue (the background compile finished), or
+    (_worth_compiling) and no other compile of the glue is running (first_run.compile_running),
+    or once the cache holds its glue (the background compile finished), or
     when Python cannot run a chunk (then that chunk runs again compiled)."""
     m, n, h, t0 = task.module, task.module.N_COORDS, task.h, task.t0
     done, row, switch = 0, 0, 0.0
@@ -177,8 +178,11 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
             bar.update(done)
         elapsed = time.perf_counter() - start - switch - since[0]
         if tier == "interpreted":
-            if done < task.n_steps and (portable.portable_cached(m, task.method) or _worth_compiling(
-                    task.method, elapsed, done - since[1], task.n_steps - done)):
+            # a compile of this glue running elsewhere (the background one): wait for it here,
+            # interpreted, rather than compile the same glue beside it
+            if done < task.n_steps and (portable.portable_cached(m, task.method) or (
+                    _worth_compiling(task.method, elapsed, done - since[1], task.n_steps - done)
+                    and not first_run.compile_running(task.method))):
                 run, seconds, tier = _compile_after_interpreted(task, args, label, done)
                 compile_time += seconds
                 switch += seconds
