@@ -105,6 +105,7 @@ def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypa
     mod = generated("double_pendulum")
     monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
     monkeypatch.setattr(fixed_run, "SPECIALIZE_AFTER_S", 0.0)
+    monkeypatch.setattr(fixed_run, "SPECIALIZED_PER_NATIVE_S", 0.0)
     monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
     monkeypatch.setattr(fixed_run, "_READY", {})     # no choice remembered from another test
     auto = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3)
@@ -112,6 +113,45 @@ def test_auto_switches_to_the_specialized_loop_on_a_long_run(generated, monkeypa
     specialized = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3,
                            jit="specialized")
     _assert_same(auto, specialized)
+
+
+def test_auto_keeps_portable_when_the_specialized_compile_cannot_pay(generated, monkeypatch):
+    """A model whose native kernels took long to compile (a large robot) keeps the portable loop
+    on a run whose saving (SPECIALIZED_GAIN of it) stays below numba's compile of the same
+    kernels (SPECIALIZED_PER_NATIVE_S times the native seconds): minutes and gigabytes for a
+    few per cent per step."""
+    mod = generated("double_pendulum")
+    monkeypatch.setattr(fixed_run, "CHUNK_STEPS", 100)
+    monkeypatch.setattr(fixed_run, "SPECIALIZE_AFTER_S", 0.0)
+    monkeypatch.setattr(portable, "specialized_ready", lambda dispatcher, args: False)
+    monkeypatch.setattr(portable, "native_compile_seconds", lambda module, method: 30.0)
+    monkeypatch.setattr(fixed_run, "_READY", {})
+    run = simulate(mod, "symplectic_euler", [0.3, 0.2], None, t_end=0.5, h=1e-3)
+    assert run.jit == "portable"
+
+
+def test_the_specialized_compile_is_weighed_by_the_native_one():
+    worth = fixed_run._worth_specializing
+    # 100 of 10,000 steps in 1 s: 99 s to go
+    assert worth(1.0, 100, 10_000, None)                    # not known: the time alone
+    assert worth(1.0, 100, 10_000, 0.5)                     # 9.9 s saved > 5 s of numba
+    assert not worth(1.0, 100, 10_000, 20.0)                # a humanoid: 200 s of numba
+    assert not worth(0.1, 100, 10_000, 0.0)                 # 9.9 s to go: below a minute
+    assert worth(1.0, 100, 1_000_000, 20.0)                 # 2.8 hours to go
+
+
+def test_native_compile_seconds_are_recorded(generated, monkeypatch, tmp_path):
+    """The seconds LLVM took come back with the object code: a later process weighs the
+    specialized compile by them without compiling anything."""
+    from lagrange_gen.jit import native
+    monkeypatch.setenv("LAGRANGE_GEN_PORTABLE_DIR", str(tmp_path))
+    monkeypatch.setattr(native, "_KERNELS", {})
+    mod = generated("cart_pendulum")
+    first = native.native_kernel(mod, "energy", portable.native_dir())
+    monkeypatch.setattr(native, "_KERNELS", {})
+    again = native.native_kernel(mod, "energy", portable.native_dir())
+    assert again.cached and first.compile_seconds > 0
+    assert again.compile_seconds == pytest.approx(first.compile_seconds, abs=1e-4)
 
 
 def test_auto_keeps_portable_on_a_short_run(generated, monkeypatch):

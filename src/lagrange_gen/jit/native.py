@@ -253,6 +253,11 @@ def _native_kernel_class():
         """A generated kernel compiled by llvmlite, as a numba first-class function: the
         address of its function with numba's C-wrapper ABI, and its numba signature."""
 
+        #: CPU seconds its lowering and LLVM compile took (when it was compiled, in this
+        #: process or the one that filled the cache): what the same kernel would cost numba
+        #: several times over (run/fixed_driver.py weighs the specialized compile by it)
+        compile_seconds = 0.0
+
         def __init__(self, dispatcher, name, address, signature, key, seconds, cached):
             # the generated kernel it was lowered from: the interpreted tier runs its Python
             self.dispatcher = dispatcher
@@ -302,9 +307,11 @@ def native_kernel(module, name, folder: Path):
         start = time.perf_counter()
         obj_path, meta_path = folder / f"{key}.o", folder / f"{key}.json"
         obj = ret = None
+        compile_seconds = 0.0
         try:
             meta = json.loads(meta_path.read_text())
             obj, ret = obj_path.read_bytes(), meta["ret"]
+            compile_seconds = float(meta.get("seconds", 0.0))
             # a truncated or foreign file must not reach LLVM's loader, which aborts the process
             if hashlib.sha256(obj).hexdigest() != meta["sha256"] or ret not in _RETURN_KINDS:
                 obj = None
@@ -313,16 +320,19 @@ def native_kernel(module, name, folder: Path):
         cached = obj is not None
         symbol = f"{EXPORT_PREFIX}{name}_{key[:16]}"
         if not cached:
+            cpu = time.process_time()
             ir_text, ret = lower_kernel(py, arg_kinds, symbol[len(EXPORT_PREFIX):])
             try:
                 obj = _compile(ir_text, level)
             except Exception as exc:        # LLVM refused the IR: a bug here, numba compiles
                 raise Unsupported(f"LLVM: {exc}".splitlines()[0]) from None
+            compile_seconds = time.process_time() - cpu
             try:
                 # the object first: a reader trusts an object only through its meta's hash
                 _write_atomic(obj_path, obj)
-                _write_atomic(meta_path, json.dumps({"ret": ret, "kernel": name,
-                                                     "sha256": hashlib.sha256(obj).hexdigest()}).encode())
+                _write_atomic(meta_path, json.dumps({
+                    "ret": ret, "kernel": name, "sha256": hashlib.sha256(obj).hexdigest(),
+                    "seconds": round(compile_seconds, 4)}).encode())
             except OSError:          # an unwritable cache: compiled again next time
                 pass
         try:
@@ -333,5 +343,6 @@ def native_kernel(module, name, folder: Path):
             raise Unsupported(f"loading the object code: {exc}".splitlines()[0]) from None
         kernel = _native_kernel_class()(fn, name, address, _signature(ret, arg_types), key,
                                         time.perf_counter() - start, cached)
+        kernel.compile_seconds = compile_seconds
         _KERNELS[memo] = kernel
         return kernel

@@ -201,6 +201,21 @@ def kernel_table(module, method):
     return tables[method]
 
 
+def native_compile_seconds(module, method):
+    """CPU seconds LLVM took to compile the native kernels of ``method``'s table on ``module``
+    (recorded with their object code), or None when a kernel of the table is numba's."""
+    table = kernel_table(module, method)
+    total = 0.0
+    for field in table._fields:
+        kernel = getattr(table, field)
+        if field.isupper():
+            continue
+        if not hasattr(kernel, "compile_seconds"):
+            return None
+        total += kernel.compile_seconds
+    return total
+
+
 def native_dir() -> Path:
     """Where native kernels' object code is kept (jit/native.py): beside the portable glue."""
     return portable_dir() / "native"

@@ -32,6 +32,16 @@ CHUNK_STEPS = 200_000
 #: and on large models it may not pay at all (then it costs one compile in a run of minutes).
 SPECIALIZE_AFTER_S = 60.0
 
+#: The specialized compile of a model's kernels (numba, inlined into the loop) against their
+#: native compile (jit/native.py): numba's front end costs several to tens of times LLVM's
+#: (4x on the UR5's forward dynamics, 7x on a 12-link chain's, 28x on a 12-link inverse-dynamics
+#: Jacobian), and the loop is compiled around them.
+SPECIALIZED_PER_NATIVE_S = 10.0
+
+#: What the specialized loop takes off a step of a large model (reports/speed.md: 3 to 6 % on
+#: the 16-link chain): the gain that must pay for its compile.
+SPECIALIZED_GAIN = 0.1
+
 #: Steps of a run's first interpreted chunk (jit/interpreted.py), whose time projects the run's
 #: interpreted time; later interpreted chunks double, up to CHUNK_STEPS.
 PROBE_STEPS = 20
@@ -194,7 +204,8 @@ def _chunks(task, run, q, v, out, last, args, label, bar, chunk, start, compile_
         if done >= task.n_steps:
             break
         if tier == "portable" and task.jit == "auto" and _worth_specializing(
-                elapsed, done - since[1], task.n_steps - since[1]):
+                elapsed, done - since[1], task.n_steps - since[1],
+                portable.native_compile_seconds(m, task.method)):
             run, seconds = warm_up(lambda: task.run, args(), label + ", specialized for this long run")
             compile_time += seconds
             switch += seconds
@@ -347,11 +358,23 @@ def warm_up(glue, args, label="run"):
     return run, time.perf_counter() - start
 
 
-def _worth_specializing(elapsed, done, n_steps):
+def _worth_specializing(elapsed, done, n_steps, native_seconds=None):
     """Whether a portable run (jit="auto") that took ``elapsed`` seconds for ``done`` of its
     n_steps steps should compile the specialized glue now: its projected remaining time passes
-    SPECIALIZE_AFTER_S."""
-    return done > 0 and elapsed * (n_steps - done) / done > SPECIALIZE_AFTER_S
+    SPECIALIZE_AFTER_S, and, given the CPU seconds the model's native kernels took to compile
+    (portable.native_compile_seconds; None: not known), the part of that time the specialized
+    loop would save (SPECIALIZED_GAIN) passes what numba would take to compile it
+    (SPECIALIZED_PER_NATIVE_S times the native seconds). A large model's kernels compiled by
+    numba take minutes and gigabytes for a few per cent per step: then only a very long run
+    compiles them."""
+    if done <= 0:
+        return False
+    remaining = elapsed * (n_steps - done) / done
+    if remaining <= SPECIALIZE_AFTER_S:
+        return False
+    if native_seconds is None:
+        return True
+    return remaining * SPECIALIZED_GAIN > SPECIALIZED_PER_NATIVE_S * native_seconds
 
 
 class ProgressBar:
