@@ -47,12 +47,12 @@ docs: $(DOCS_STAMP)
 
 # The smoke job on the lowest numba pyproject.toml allows (and the numpy it supports), in a venv
 # and caches of its own: generate, every method once (against the portable glue), the jit
-# layer's tests (the interpreted tier included), the import rules.
+# layer's tests (the interpreted tier and native kernels included), the import rules.
 LOWEST_VENV := .venv-lowest-numba
 SMOKE_TESTS := tests/test_portable.py tests/test_jit_cache.py tests/test_jit_callee.py \
 	tests/test_jit_speedups.py tests/test_numba_inline_copy.py tests/test_numba_typing_memo.py \
 	tests/test_compile_gc.py tests/test_compile_message.py tests/test_interpreted.py \
-	tests/test_architecture.py
+	tests/test_native_kernels.py tests/test_architecture.py
 
 $(LOWEST_VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(LOWEST_VENV)

@@ -89,6 +89,10 @@ def _llvm():
     import ctypes
     import ctypes.util
     import llvmlite.binding as llvm
+    try:
+        llvm.initialize()        # needed before llvmlite 0.45, refused (deprecated) after
+    except RuntimeError:
+        pass
     llvm.initialize_native_target()
     llvm.initialize_native_asmprinter()
     libm_path = ctypes.util.find_library("m")
