@@ -47,6 +47,13 @@ LCP_PER_CONTACT = 11
 #: Facet directions of the 3D friction cone (the octagon inscribed in the disk).
 CONE_FACETS = 8
 
+#: Added to M's diagonal, relative to its largest entry: redundant rows (two corners of one
+#: slider on a wall, a bilateral normal or a sticking tangent split in two) make M singular, and
+#: Lemke's pivots on a singular M can end on a ray where a solution exists; M + eps I has one
+#: solution when M is positive semidefinite (the minimum-norm one as eps -> 0), and the
+#: impulses change by O(eps) relative.
+LCP_REGULARIZATION = 1e-10
+
 #: Lemke's outcomes.
 LCP_SOLVED = 0
 LCP_RAY = 1             # secondary ray: no solution (for the contact LCPs here)
@@ -214,7 +221,11 @@ def build_lcp(c, active, law, coef, un, uf, D, slide, B, C, T):
             for i in range(k):
                 if C[i, a] != 0.0:
                     T[i, K + j] += C[i, a] * B_dj
+    diag = 0.0
     for i in range(k):
+        diag = max(diag, abs(T[i, K + i]))
+    for i in range(k):
+        T[i, K + i] += LCP_REGULARIZATION * diag
         for j in range(k):
             T[i, K + j] = -T[i, K + j]
         for a in range(R):
