@@ -8,7 +8,7 @@ guide of height d = 2 (b + c): no holonomic constraint, the slider's centre is
 corners 1, 2 (at -a, +a along the slider, +b across) the upper wall y = d / 2, corners 3, 4
 (at -a, +a, -b) the lower wall y = -d / 2. Gravity along -y. Started from q = 0 with the crank
 at 150 rad/s and the rod at -75 rad/s; the Siconos example runs it to t = 0.2 with
-restitution 0.4 (the paper's) or 0.1, frictionless or mu = 0.01.
+restitution 0.4 or 0.1, frictionless or mu = 0.01 (the defaults here: e = 0.4, mu = 0.01).
 
 Near the crank's dead centres the slider crosses the clearance and two corners on one wall
 touch together: the hard case of the contact solver (two nearly dependent rows)."""
@@ -20,7 +20,7 @@ q1, q2, q3 = coordinates("q1 q2 q3")
 l1, l2, a, b, c, m1, m2, m3, J1, J2, J3, g, e, mu = parameters(
     "l1 l2 a b c m1 m2 m3 J1 J2 J3 g e mu",
     defaults=(0.153, 0.306, 0.05, 0.025, 0.001, 0.038, 0.038, 0.076, 7.4e-5, 5.9e-4, 2.7e-6,
-              9.81, 0.4, 0.0))
+              9.81, 0.4, 0.01))
 
 v = sp.Matrix([q1.d, q2.d, q3.d])
 coupling = (m2 / 2 + m3) * l1 * l2 * sp.cos(q2 - q1)

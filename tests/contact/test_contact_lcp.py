@@ -128,14 +128,12 @@ def test_degenerate_two_corners_where_gauss_seidel_stalls():
     assert not converged
     status, sweeps, r = _solve(c, (np.ones(2), law, coef, np.zeros(2), uf, D))
     assert status == OK and sweeps == -1
-    # tolerance: the rows' near-dependence (eigenvalue 2 eps^2 = 2e-8 of D) times rounding and
-    # the LCP's regularization (1e-10 of its diagonal): measured -4.7e-7 on u_N
     u = uf + D @ r
-    assert r[:2].min() >= -1e-12 and u[:2].min() >= -1e-6 and abs(r[:2] @ u[:2]) <= 1e-6
+    assert r[:2].min() >= -1e-12 and u[:2].min() >= -1e-9 and abs(r[:2] @ u[:2]) <= 1e-9
     for a in range(2):
         pn, pt, ut = r[a], r[2 + a], u[2 + a]
         assert abs(pt) <= mu * pn + 1e-9
-        if abs(ut) > 1e-6:
+        if abs(ut) > 1e-9:
             assert np.isclose(pt, -np.sign(ut) * mu * pn)
 
 
@@ -163,3 +161,26 @@ def test_3d_faceted_cone_slides_along_a_facet_direction(facet):
     problem = _problem(c, np.eye(3), [-1.0, *(3 * d)], [[0.0, mu]])
     status, _, r = _lcp_only(c, problem)
     assert status == OK and np.isclose(r[0], 1.0) and np.allclose(r[1:], -mu * d)
+
+
+def test_slider_crank_with_clearance_runs_to_its_end(generated):
+    """models/slider_crank_clearance.py (Flores, Leine, Glocker 2010; e = 0.4, mu = 0.01) from
+    q = 0, crank at 150 rad/s, rod at -75 rad/s: dop853_impacts stopped at t = 0.0341 (two
+    lower corners on the wall near the crank's dead centre, Gauss-Seidel stalling on the
+    persistent contacts' forces) before the exact fallback; now it reaches t = 0.2 with its gaps
+    above -1e-6 (measured -6.2e-7: the drift of contacts held at the acceleration level, 6e-4
+    of the clearance) and q1 = 18.08 rad at the end."""
+    from lagrange_gen.run.simulate import simulate
+    module = generated("slider_crank_clearance")
+    traj = simulate(module, method="dop853_impacts", q0=[0.0, 0.0, 0.0], v0=[150.0, -75.0, 0.0],
+                    t_end=0.2)
+    assert traj.t[-1] == 0.2
+    p = np.array([traj.params[name] for name in module.PARAMS], dtype=float)
+    gaps = np.empty((len(traj.t), 4))
+    for i, q in enumerate(traj.q):
+        g, WN, WT, coef = np.empty(4), np.empty((4, 3)), np.empty((8, 3)), np.empty((4, 2))
+        module.contacts(np.ascontiguousarray(q), traj.t[i], p, g, WN, WT, coef)
+        gaps[i] = g
+    assert gaps.min() >= -1e-6
+    assert abs(traj.q[-1, 0] - 18.08) <= 0.05
+    assert traj.saved["impacts"][-1, 0] > 0
