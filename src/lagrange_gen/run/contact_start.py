@@ -19,7 +19,9 @@ velocities only). So simulate checks the gaps of q0 before a contact method runs
   The velocity change adds no kinetic energy and nothing launches the body; moving q0 changes
   the potential energy by what the warning reports (that is the user's q0 moved, not energy
   that appears during the run).
-* "refuse": ContactPenetration, one line naming the contact and its gap.
+* "refuse": ContactPenetration, one line naming the contact and its gap;
+* "keep": the warning only, (q0, v0) unchanged (to watch a method's own handling of a
+  penetration, e.g. spook_contacts' stabilization, which may launch the body).
 
 Arrays: q, v (n,), g (c,), W_N (c, n), H (n, n), J (m, n), Phi (m,).
 """
@@ -33,7 +35,7 @@ import numpy as np
 from ..errors import SimulationError
 
 #: simulate(penetration=...): what a q0 inside a contact does.
-PENETRATION_MODES = ("project", "refuse")
+PENETRATION_MODES = ("project", "refuse", "keep")
 
 #: A gap below -GAP_TOL max(1, |q0|) counts as a start inside the contact (rounding above it).
 GAP_TOL = 1e-9
@@ -145,8 +147,9 @@ def inelastic_velocity(module, q, v0, p, t0=0.0, tol=GAP_TOL):
 
 def contact_start(module, q0, v0, p, t0=0.0, penetration="project", stacklevel=2):
     """(q, v) for a contact method: (q0, v0) when no gap is negative; else refused
-    (penetration="refuse": ContactPenetration) or projected out with one warning
-    (penetration="project", the default; see the module docstring). q0, v0 (n,)."""
+    (penetration="refuse": ContactPenetration), projected out with one warning
+    (penetration="project", the default) or kept with the warning (penetration="keep"; see the
+    module docstring). q0, v0 (n,)."""
     if penetration not in PENETRATION_MODES:
         raise SimulationError(f"penetration={penetration!r}: expected one of "
                               f"{', '.join(map(repr, PENETRATION_MODES))}")
@@ -162,6 +165,10 @@ def contact_start(module, q0, v0, p, t0=0.0, penetration="project", stacklevel=2
     if penetration == "refuse":
         raise ContactPenetration(f"{where}; penetration='refuse': give a q0 with every gap >= 0, "
                                  f"or penetration='project' to move it out")
+    if penetration == "keep":
+        warnings.warn(f"{where}; kept there (penetration='keep'): the method's own response "
+                      f"to a penetration acts, which may launch it", stacklevel=stacklevel)
+        return q0, v0
     q = project_positions_out(module, q0, p, t0)
     v = inelastic_velocity(module, q, v0, p, t0)
     dE = float(module.energy(q, v, float(t0), p) - module.energy(q0, v0, float(t0), p))

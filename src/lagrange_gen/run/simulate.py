@@ -129,8 +129,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     A contact method whose q0 lies inside a contact (a gap < 0) warns in one line naming the
     contact and its gap, then by ``penetration``: "project" (default) moves q0 to the nearest
     point with every gap >= 0 and removes the approaching normal velocity there (an inelastic
-    impulse: no kinetic energy added), "refuse" raises ContactPenetration
-    (lagrange_gen.run.contact_start).
+    impulse: no kinetic energy added), "refuse" raises ContactPenetration, "keep" leaves it
+    there (lagrange_gen.run.contact_start).
     A fixed-step run ends at t0 + n_steps h with n_steps = (t_end - t0) / h rounded up.
     Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
     SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
