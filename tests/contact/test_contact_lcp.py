@@ -184,3 +184,23 @@ def test_slider_crank_with_clearance_runs_to_its_end(generated):
     assert gaps.min() >= -1e-6
     assert abs(traj.q[-1, 0] - 18.08) <= 0.05
     assert traj.saved["impacts"][-1, 0] > 0
+
+
+def test_painleve_rod_is_reported_in_one_line(generated):
+    """models/painleve_rod.py at th = 30 degrees, the end on the floor sliding towards -x at
+    1 m/s, mu = 3 > (1 + 3 cos^2 th) / (3 sin th cos th) = 2.5: the sliding contact's force
+    problem has no solution; dop853_impacts stops at the start saying so. With mu = 0.3 it has
+    one and the rod slides on (to t = 0.05)."""
+    import math
+
+    from lagrange_gen import SimulationError
+    from lagrange_gen.run.simulate import simulate
+    th, l = math.pi / 6, 0.5
+    start = dict(q0=[0.0, l * math.sin(th), th], v0=[-1.0, 0.0, 0.0], t_end=0.05)
+    with pytest.raises(SimulationError, match=r"t = 0\b.*contact problem has no solution.*"
+                                              r"Painleve") as info:
+        simulate(generated("painleve_rod"), method="dop853_impacts", **start)
+    assert "\n" not in str(info.value)
+    traj = simulate(generated("painleve_rod"), method="dop853_impacts", params={"mu": 0.3},
+                    **start)
+    assert traj.t[-1] == 0.05
