@@ -184,6 +184,10 @@ def test_slider_crank_with_clearance_runs_to_its_end(generated):
     assert gaps.min() >= -1e-6
     assert abs(traj.q[-1, 0] - 18.08) <= 0.05
     assert traj.saved["impacts"][-1, 0] > 0
+    # moreau_jean (the same solver behind its impulses) runs it to the end too
+    mj = simulate(module, method="moreau_jean", q0=[0.0, 0.0, 0.0], v0=[150.0, -75.0, 0.0],
+                  t_end=0.2, h=1e-4, save_every=100)
+    assert mj.t[-1] == pytest.approx(0.2) and np.isfinite(mj.q).all()
 
 
 def test_painleve_rod_is_reported_in_one_line(generated):

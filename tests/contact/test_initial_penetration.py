@@ -85,3 +85,20 @@ def test_metric_projection_hand_derived():
     x, lam = metric_projection(np.eye(2), np.array([[1.0, 0.0], [1.0, 0.0]]),
                                np.array([-2.0, -1.0]))
     assert np.allclose(x, [2.0, 0.0]) and lam.min() >= 0.0
+
+
+def test_cli_penetration_option(generated, capsys):
+    """lagrange-gen simulate --penetration refuse: exit status 1 and the one line; the default
+    warns in one line and runs from the projected start."""
+    from lagrange_gen.cli.main import main
+    path = generated("bouncing_ball").__file__
+    common = ["simulate", path, "--method", "moreau_jean", "--h", "1e-3", "--t-end", "0.01",
+              "--q0", "-0.5"]
+    assert main(common + ["--penetration", "refuse"]) != 0
+    err = capsys.readouterr().err
+    assert "inside contact 'floor' (gap = -0.5 < 0); penetration='refuse'" in err
+    assert main(common) == 0
+    captured = capsys.readouterr()
+    lines = [line for line in (captured.err + captured.out).splitlines()
+             if "inside contact 'floor'" in line]
+    assert len(lines) == 1 and "projected onto g(q) >= 0" in lines[0]
