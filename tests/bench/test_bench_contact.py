@@ -70,7 +70,7 @@ def test_woodpecker_row_compares_with_siconos_reference(gen_dir):
     """The woodpecker case: Siconos' reference sleeve height at t = 0.29998 (the last row of
     Woodpecker.ref, -0.04134818676833654), and the sweep's dop853_impacts (rtol 1e-8) and
     moreau_jean (h = t_end / 15000 = 2e-5, Siconos' step) runs end within 1e-4 of it
-    (measured 2.5e-5 and 4.4e-6: a descent of 41 mm over 7 jam-slip cycles)."""
+    (measured 2.5e-5 and 3.0e-6 on a descent of 41 mm)."""
     from lagrange_gen.analysis import runs
     from lagrange_gen.bench import common
     from lagrange_gen.bench.contact import CASES, SICONOS_WOODPECKER_Y, Settings, sweep
