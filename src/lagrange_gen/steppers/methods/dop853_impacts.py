@@ -31,7 +31,8 @@ from there after ``classify``:
    u_N = W_N v + dg/dt the velocity relative to the surface) take part; if one approaches
    (u_N < -rest_velocity), Newton's impact law with Coulomb friction (interval or disk) at the
    velocity level, u_N+ + e min(u_N-, 0) >= 0 _|_ p_N >= 0 (several
-   simultaneous contacts: one problem, the same projected Gauss-Seidel as moreau_jean), and
+   simultaneous contacts: one problem, the same projected Gauss-Seidel as moreau_jean, with
+   Lemke's method behind it, core/contact_lcp.py, for every contact problem here), and
    v+ = v- + M^-1 W^T p.
    Zeno guard: a contact whose previous impact was less than zeno_interval ago gets e = 0 in
    this impact (an accumulation of impacts, t_k -> t_inf, ends there in a plastic one).

@@ -31,7 +31,9 @@ solved by projected Gauss-Seidel (core/contact_problem.py, shared with dop853_im
 by contact:
 p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then the tangent impulse projected onto
 the interval (2D) or the disk (3D), until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
-(CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
+and, when the sweeps do not converge, Lemke's method on the same problem's LCP
+(core/contact_lcp.py; CONTACT_NO_SOLUTION when it has none, CONTACT_NOT_CONVERGED when Lemke
+cycles too: never a silent unconverged impulse). A sticking contact gets the exact
 impulse that zeroes u_T: no creep.
 
 Holonomic constraints Phi(q) = 0 (m rows, J = dPhi/dq) join the step as rigid equality rows of

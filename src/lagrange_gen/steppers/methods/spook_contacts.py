@@ -28,7 +28,7 @@ Newton's impact law on the approaching velocity (restitution e): the row takes w
 the two asks for the larger separating velocity, so an impact leaves with -e u_N- and a
 resting contact is held by the stabilization alone. Solved by projected Gauss-Seidel on the
 regularized Delassus matrix D + Sigma I (core/contact_problem.py), with moreau_jean's stopping
-rule (CONTACT_NOT_CONVERGED at max_sweeps).
+rule and its fallback (Lemke's method when max_sweeps pass, core/contact_lcp.py).
 
 Order 1. Resting contact is stable for any h (the stabilized row has spook's step matrix, the
 spectral radius below 1 for every d > 0): a box or a stack at rest stays at rest with a
