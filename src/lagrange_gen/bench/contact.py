@@ -14,7 +14,24 @@ Three cases, each with an error measured against a closed form:
 
 * puck on a table (models/puck_on_table.py, the 3D friction cone: mu = 0.3, launched at 2 m/s
   at 0.6 rad from the x axis) at t_end = 1, at rest since V0 / (mu g) = 0.68: the distance of
-  (x, y) from the stop point V0^2 / (2 mu g) along the launch direction.
+  (x, y) from the stop point V0^2 / (2 mu g) along the launch direction;
+* slider-crank with clearance (models/slider_crank_clearance.py, Flores, Leine, Glocker 2010,
+  e = 0.4, mu = 0.01, the crank at 150 rad/s) at t_end = 0.2: no closed form, so the
+  difference of the crank's revolutions q1 / (2 pi) at t_end from Siconos' published reference
+  run (siconos/siconos, examples/Mechanics/SliderCrank/
+  SliderCrankMoreauJeanDirectProjectionOSI.ref, last row: 3.064804887294570 revolutions;
+  Moreau-Jean with position projection at h = 1e-4 and a randomized contact solver). Not a
+  convergence error: the motion after the first impacts depends on the impact sequence (with
+  both corners of a wall hit at once the slider stays untilted in our runs, Siconos' run tilts
+  it), so the row says how far apart two methods end, not which is right.
+* woodpecker toy (models/woodpecker.py, Glocker; Siconos' example, constants of
+  siconos/siconos-tutorials examples/mechanics/Woodpecker/WoodPeckerConsts.h) at
+  t_end = 0.29998: the sleeve's height y against the last row of Siconos' published reference
+  run Woodpecker.ref (Moreau-Jean, theta = 1/2, h = 2e-5): y = -0.04134818676833654. The
+  reference is itself a numerical solution (its own error unknown), so the row is a distance
+  between two methods; the descent over 0.3 s is a cumulative quantity, robust to the phase
+  of the jam-slip cycle. Its start lies 8.8e-7 inside the sleeve's upper contact (the
+  example's phi_M_0 = -0.1036 rounded), which simulate projects out with a warning.
 
 Methods: the fixed-step moreau_jean and spook_contacts (h = t_end / (n0 2^k) each) and
 dop853_impacts (rtol sweep, atol = rtol / 100).
@@ -107,6 +124,26 @@ def _puck_error(traj):
                       traj.q[-1, 1] - reach * math.sin(PUCK_ANGLE))
 
 
+#: Siconos' reference run of the slider-crank with clearance (the module docstring): crank
+#: revolutions at t = 0.2.
+SICONOS_SLIDER_CRANK_REVOLUTIONS = 3.064804887294570
+
+
+def _slider_crank_difference(traj):
+    return abs(traj.q[-1, 0] / (2 * math.pi) - SICONOS_SLIDER_CRANK_REVOLUTIONS)
+
+
+#: Siconos' woodpecker reference (the module docstring): its start and the sleeve's height
+#: in its last row.
+WOODPECKER_START = ((0.0, -0.1036, -0.2788), (-0.3411, 4.8572e-15, -7.4583))
+WOODPECKER_T_END = 0.29998
+SICONOS_WOODPECKER_Y = -4.134818676833654e-02
+
+
+def _woodpecker_difference(traj):
+    return abs(traj.q[-1, 0] - SICONOS_WOODPECKER_Y)
+
+
 CASES = (
     Case("bouncing_ball", "Bouncing ball (e = 0.8), t = 3 after 6 impacts", (1.0,), (0.0,), 3.0,
          (("g", G), ("e", 0.8)), _ball_error, "max(|y - y_exact|, |v - v_exact|) at t_end"),
@@ -118,6 +155,16 @@ CASES = (
          (0.0, 0.0, 0.0), (PUCK_SPEED * math.cos(PUCK_ANGLE), PUCK_SPEED * math.sin(PUCK_ANGLE),
                            0.0), 1.0, (("g", G), ("mu", PUCK_MU)), _puck_error,
          "distance of (x, y) at t_end from the stop point V0^2 / (2 mu g) along v0"),
+    Case("slider_crank_clearance", "Slider-crank with clearance (Flores et al. 2010), t = 0.2",
+         (0.0, 0.0, 0.0), (150.0, -75.0, 0.0), 0.2, (("e", 0.4), ("mu", 0.01)),
+         _slider_crank_difference,
+         "|q1 / (2 pi) - 3.0648| at t_end, the crank's revolutions against Siconos' reference "
+         "run (SliderCrankMoreauJeanDirectProjectionOSI.ref; a difference between two "
+         "methods on a motion sensitive to its impact sequence, not an error)"),
+    Case("woodpecker", "Woodpecker toy (Glocker; Siconos' example), t = 0.29998",
+         *WOODPECKER_START, WOODPECKER_T_END, (), _woodpecker_difference,
+         "|y - y_Siconos| at t_end, the sleeve's height against Siconos' reference run "
+         "(Woodpecker.ref, Moreau-Jean at h = 2e-5: y = -0.0413482)"),
 )
 
 

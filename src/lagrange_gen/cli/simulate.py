@@ -57,6 +57,10 @@ def add_parser(subparsers):
     p.add_argument("--keep", action="append", metavar="NAME,...",
                    help="constrained models: velocities (e.g. theta_dot) whose v0 is kept when "
                         "v0 is projected onto J v = 0; the others are solved for")
+    p.add_argument("--penetration", choices=("project", "refuse", "keep"), default="project",
+                   help="contact methods, q0 inside a contact (a gap < 0): project it out "
+                        "(default, no energy added), refuse, or keep it there; warned in one "
+                        "line either way")
     p.add_argument("--save-every", type=int, default=1, metavar="K", help="keep every K-th state")
     p.add_argument("--t-eval", nargs="+", metavar="T",
                    help="adaptive methods: save the states at these times, each a number or a "
@@ -170,7 +174,7 @@ def run(args) -> int:
                         h=args.h, params=params, save_every=args.save_every,
                         t_eval=t_eval, t0=args.t0, progress=args.progress,
                         out_dir=gen_dir, force=args.force, keep=keep, jit=args.jit,
-                        **given_settings(args))
+                        penetration=args.penetration, **given_settings(args))
     _summary(traj)
     _write_outputs(traj, args.out, args.plot)
     return 0

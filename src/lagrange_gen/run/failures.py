@@ -61,9 +61,15 @@ def raise_for_status(code, module, method, step, n_steps, last, max_iter, h, p):
         raise SimulationError(f"{where}: max_steps step attempts without reaching the end, at "
                               f"{state}; raise max_steps or loosen rtol/atol", **kwargs)
     if code == st.CONTACT_NOT_CONVERGED:
-        raise SimulationError(f"{where}: the contact problem (projected Gauss-Seidel) did not "
-                              f"converge (last sweep's impulse change {resid:.3g}) from {state}; "
-                              f"raise max_sweeps or contact_tol, or reduce h", **kwargs)
+        raise SimulationError(f"{where}: the contact problem did not converge (projected "
+                              f"Gauss-Seidel's last sweep changed the impulses by {resid:.3g}, "
+                              f"and Lemke's method cycled) from {state}; raise max_sweeps or "
+                              f"contact_tol, or reduce h", **kwargs)
+    if code == st.CONTACT_NO_SOLUTION:
+        raise SimulationError(f"{where}: the contact problem has no solution (Lemke's method "
+                              f"ends on a ray: no impulses or forces meet the contact laws, as "
+                              f"in Painleve's paradox of sliding friction) at {state}; lower the "
+                              f"friction, or model the contact as compliant", **kwargs)
     if code == st.UNSTABLE:
         raise BlowUp(f"{where}: the state grew past the blow-up bound (unstable at this h?): "
                      f"{state}", **kwargs)

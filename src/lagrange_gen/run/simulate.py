@@ -76,7 +76,7 @@ def _runner(module, method):
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None, h=None,
              params=None, save_every=1, t_eval=None, t0=0.0, progress=False, out_dir=None,
              element_state0=None, force=False, keep=None, control=None, control_params=None,
-             jit=None, **settings) -> Trajectory:
+             jit=None, penetration="project", **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -130,6 +130,11 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
     with a warning (lagrange_gen.run.consistent), and the Trajectory carries the multipliers and
     max|Phi|, max|J v| per saved state. ``keep``: names of velocities (``theta_dot``, or the
     coordinate ``theta``) whose v0 the projection keeps; the others are solved from J v = 0.
+    A contact method whose q0 lies inside a contact (a gap < 0) warns in one line naming the
+    contact and its gap, then by ``penetration``: "project" (default) moves q0 to the nearest
+    point with every gap >= 0 and removes the approaching normal velocity there (an inelastic
+    impulse: no kinetic energy added), "refuse" raises ContactPenetration, "keep" leaves it
+    there (lagrange_gen.run.contact_start).
     A fixed-step run ends at t0 + n_steps h with n_steps = (t_end - t0) / h rounded up.
     Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
     SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
@@ -168,6 +173,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
         q, v, initial = _constrained_start(module, q, v, p, t0,
                                            getattr(config, "newton_tol", 1e-12), keep)
     elif spec.contacts:          # (its prepare fills row 0; the contact work starts at 0)
+        from .contact_start import contact_start
+        q, v = contact_start(module, q, v, p, t0, penetration, stacklevel=3)
         initial = np.zeros(n_saved)
         if constrained:          # the constrained fields come last (contact_kkt.CONTACT_SAVED)
             q, v, start = _constrained_start(module, q, v, p, t0, 1e-12, keep)

@@ -30,7 +30,8 @@ from ...jit.cache import njit
 from .options import FAST
 from .status import OK
 
-from .contact_problem import contact_row, delassus, gauss_seidel
+from .contact_problem import contact_row, delassus
+from .contact_lcp import contact_solve
 from .constrained import max_abs_jv
 
 #: The saved fields of a contact method (see the module docstring; width "m1": 1 with
@@ -103,18 +104,22 @@ def row_dot(k, c, WN, WT, v, n):
 
 @njit(inline="always")
 def solve_contacts(c, N, tol, max_sweeps, active, law, coef, un, uf, WNp, WTp, K, piv, scratch,
-                   Y, D, reg, r):
+                   Y, D, reg, r, lcp):
     """The impulses r (n_rows,) of the active contacts: the Delassus operator D = W K^-1 W^T
     (K LU-factored with pivots piv; Y (n_rows, N) the rows K^-1 [W_k^T; 0]; scratch (N,)), reg
     added to the diagonal of every active row (spook's compliance term, 0 for rigid rows),
     then projected Gauss-Seidel from r = 0 with the free local velocities uf (n_rows,) and the
-    approach velocities un (c,) of Newton's impact law. Returns (converged, sweeps, change)."""
+    approach velocities un (c,) of Newton's impact law, and Lemke's method when Gauss-Seidel
+    does not converge (contact_lcp.contact_solve; lcp = its arrays, contact_lcp.lcp_arrays).
+    Returns (status: OK, CONTACT_NOT_CONVERGED or CONTACT_NO_SOLUTION, sweeps, change)."""
     n_rows = r.shape[0]
     delassus(c, N, active, WNp, WTp, K, piv, scratch, Y, D)
     for k in range(n_rows):
         if active[k % c] != 0.0:
             D[k, k] += reg
-    return gauss_seidel(c, tol, max_sweeps, active, law, coef, un, uf, D, r)
+    status, sweeps, change = contact_solve(c, tol, max_sweeps, active, law, coef, un, uf, D, r,
+                                           un[:0], lcp[0], lcp[1], lcp[2], lcp[3], lcp[4])
+    return status, max_sweeps if sweeps < 0 else sweeps, change
 
 
 @njit(inline="always")

@@ -31,7 +31,8 @@ from there after ``classify``:
    u_N = W_N v + dg/dt the velocity relative to the surface) take part; if one approaches
    (u_N < -rest_velocity), Newton's impact law with Coulomb friction (interval or disk) at the
    velocity level, u_N+ + e min(u_N-, 0) >= 0 _|_ p_N >= 0 (several
-   simultaneous contacts: one problem, the same projected Gauss-Seidel as moreau_jean), and
+   simultaneous contacts: one problem, the same projected Gauss-Seidel as moreau_jean, with
+   Lemke's method behind it, core/contact_lcp.py, for every contact problem here), and
    v+ = v- + M^-1 W^T p.
    Zeno guard: a contact whose previous impact was less than zeno_interval ago gets e = 0 in
    this impact (an accumulation of impacts, t_k -> t_inf, ends there in a plastic one).
@@ -80,11 +81,12 @@ from ...jit.cache import njit
 
 from ..core import events
 from ..core.contact_problem import (BILATERAL, SLIDE, SLIDE_NEGATIVE, SLIDE_POSITIVE, STICK,
-                                    contact_row, delassus, gauss_seidel_sliding)
+                                    contact_row, delassus)
+from ..core.contact_lcp import contact_solve, lcp_arrays
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.options import FAST
-from ..core.status import CONTACT_NOT_CONVERGED, OK, SINGULAR_MASS
+from ..core.status import OK, SINGULAR_MASS
 from . import dop853
 
 #: Contact modes (saved as contact_mode); STICK, SLIDE_* as the tangent laws.
@@ -134,12 +136,14 @@ class Settings(NamedTuple):
 #: time a free contact was last touching (-inf: not since the step it cleared gap_tol);
 #: bias (3c,) (contact_bias); slide_ref (2c,) the slip direction of a SLIDE contact at the
 #: step's start (pairs (slide_ref[a], slide_ref[c + a])), slide (2c,) the force's direction at
-#: the last evaluation.
+#: the last evaluation; lcp_B, lcp_C, lcp_T, lcp_z, lcp_basis the exact fallback's scratch
+#: (core/contact_lcp.lcp_arrays).
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
                                     "v_old span pk w w_new w_old dense_w pw M f s piv acc g WN WT coef rate r uf zero un "
                                     "mode law impact_law persistent touching coef_impact "
                                     "last_impact Y D sw power contact_stages stage_at quad_F "
-                                    "quad_ends solver left_at bias slide slide_ref")
+                                    "quad_ends solver left_at bias slide slide_ref lcp_B lcp_C "
+                                    "lcp_T lcp_z lcp_basis")
 
 
 @njit
@@ -161,7 +165,7 @@ def workspace(kern, n):
                      np.full(c, -np.inf), np.zeros((3 * c, n)), np.zeros((3 * c, 3 * c)), sw,
                      np.zeros(2), np.zeros((nd, 1)), np.zeros(1, np.int64), np.zeros((7, 1)),
                      np.zeros(2), np.zeros(4), np.full(c, -np.inf), np.zeros(3 * c),
-                     np.zeros(2 * c), np.zeros(2 * c))
+                     np.zeros(2 * c), np.zeros(2 * c), *lcp_arrays(c))
 
 
 @njit(inline="always")
@@ -240,6 +244,16 @@ def _set_slide_ref(ws, a, c, d1, d2):
 
 
 @njit(inline="always")
+def _solve(ws, c, tol, max_sweeps, flags, law, coef, un):
+    """The contact problem on ws.D, ws.uf into ws.r: projected Gauss-Seidel, then Lemke's
+    method when it stalls (core/contact_lcp.contact_solve). Returns the status."""
+    status, _, _ = contact_solve(c, tol, max_sweeps, flags, law, coef, un, ws.uf, ws.D, ws.r,
+                                 ws.slide, ws.lcp_B, ws.lcp_C, ws.lcp_T, ws.lcp_z,
+                                 ws.lcp_basis)
+    return status
+
+
+@njit(inline="always")
 def _apply(ws, c, flags, r, x):
     """x (n,) += sum_k Y_k r_k over the rows of the contacts flagged."""
     for k in range(3 * c):
@@ -251,7 +265,7 @@ def _apply(ws, c, flags, r, x):
 @njit(**FAST)
 def contact_acceleration(kern, ws, q, v, t, p, a):
     """a (n,) = M^-1 (f + W^T lambda) with lambda (ws.r) the persistent contacts' forces under
-    ws.law; ws.power[0] <- lambda . (W v). OK, SINGULAR_MASS or CONTACT_NOT_CONVERGED."""
+    ws.law; ws.power[0] <- lambda . (W v). OK, SINGULAR_MASS, CONTACT_NOT_CONVERGED or CONTACT_NO_SOLUTION."""
     n, c = kern.N_COORDS, kern.N_CONTACTS
     if not _mass_and_rhs(kern, ws, q, v, t, p):
         return SINGULAR_MASS
@@ -271,11 +285,10 @@ def contact_acceleration(kern, ws, q, v, t, p, a):
         ws.r[k] = 0.0
         ws.uf[k] = _local(ws, k, c, a) + ws.rate[k] if ws.persistent[k % c] != 0.0 else 0.0
     _slide_directions(ws, c, v)
-    converged, _, _ = gauss_seidel_sliding(c, ws.solver[0], int(ws.solver[1]), ws.persistent,
-                                           ws.law, ws.coef, ws.zero, ws.uf, ws.D, ws.r,
-                                           ws.slide)
-    if not converged:
-        return CONTACT_NOT_CONVERGED
+    status = _solve(ws, c, ws.solver[0], int(ws.solver[1]), ws.persistent, ws.law, ws.coef,
+                    ws.zero)
+    if status != OK:
+        return status
     _apply(ws, c, ws.persistent, ws.r, a)
     power = 0.0
     for k in range(3 * c):
@@ -488,11 +501,10 @@ def _impact(kern, ws, v, t, settings, extra):
     for k in range(3 * c):
         ws.r[k] = 0.0
         ws.uf[k] = _relative(ws, k, c, v) if ws.touching[k % c] != 0.0 else 0.0
-    converged, _, _ = gauss_seidel_sliding(c, settings.contact_tol, settings.max_sweeps,
-                                           ws.touching, ws.impact_law, ws.coef_impact, ws.un,
-                                           ws.uf, ws.D, ws.r, ws.slide)
-    if not converged:
-        return CONTACT_NOT_CONVERGED
+    status = _solve(ws, c, settings.contact_tol, settings.max_sweeps, ws.touching,
+                    ws.impact_law, ws.coef_impact, ws.un)
+    if status != OK:
+        return status
     _record_impulses(kern, ws, ws.touching, v, extra)
     for a in range(c):
         if ws.touching[a] != 0.0 and ws.r[a] > 0.0:
@@ -609,11 +621,10 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
             ws.r[k] = 0.0
             ws.uf[k] = _relative(ws, k, c, v) if ws.persistent[k % c] != 0.0 else 0.0
         _slide_directions(ws, c, v)
-        converged, _, _ = gauss_seidel_sliding(c, settings.contact_tol, settings.max_sweeps,
-                                               ws.persistent, ws.law, ws.coef, ws.zero, ws.uf,
-                                               ws.D, ws.r, ws.slide)
-        if not converged:
-            return CONTACT_NOT_CONVERGED
+        status = _solve(ws, c, settings.contact_tol, settings.max_sweeps, ws.persistent,
+                        ws.law, ws.coef, ws.zero)
+        if status != OK:
+            return status
         _record_impulses(kern, ws, ws.persistent, v, extra)
     if ws.solver[3] != 0.0:        # row 0 is the state after this: the work counts from it
         extra[_work_at(c)] = work_before

@@ -31,7 +31,9 @@ solved by projected Gauss-Seidel (core/contact_problem.py, shared with dop853_im
 by contact:
 p_N <- max(0, p_N - (u_N + e min(u_N-, 0)) / D_NN), then the tangent impulse projected onto
 the interval (2D) or the disk (3D), until the largest change of a sweep is at most contact_tol max|r| or max_sweeps sweeps
-(CONTACT_NOT_CONVERGED: never a silent unconverged impulse). A sticking contact gets the exact
+and, when the sweeps do not converge, Lemke's method on the same problem's LCP
+(core/contact_lcp.py; CONTACT_NO_SOLUTION when it has none, CONTACT_NOT_CONVERGED when Lemke
+cycles too: never a silent unconverged impulse). A sticking contact gets the exact
 impulse that zeroes u_T: no creep.
 
 Holonomic constraints Phi(q) = 0 (m rows, J = dPhi/dq) join the step as rigid equality rows of
@@ -68,10 +70,11 @@ from ..core.constrained import constraint_rate
 from ..core.contact_kkt import (CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
                                 contact_prepare, impulse_work, pad_rows,
                                 record_constraints, record_contacts, row_dot, solve_contacts)
+from ..core.contact_lcp import lcp_arrays
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.solve import failed_solve_status
-from ..core.status import CONTACT_NOT_CONVERGED, OK
+from ..core.status import OK
 
 #: Scratch of one run (n coordinates, m constraints, c contacts, N = n + m, R = 3c rows). x the
 #: unknown (v+ - v, nu), then (v+, nu) (N,); solver scratch s and pivots piv (N,); the
@@ -81,10 +84,11 @@ from ..core.status import CONTACT_NOT_CONVERGED, OK
 #: columns WNp, WTp; coef (c, 2) = (e, mu); (R,): impulses r = (p_N, p_T1, p_T2), free local
 #: velocities uf, law (every contact UNILATERAL / COULOMB, core/contact_problem.py), the surface
 #: terms b at t (bias) and t + h (bias_end); Y (R, N) the rows K^-1 [W^T; 0]; D (R, R) the
-#: Delassus matrix.
+#: Delassus matrix; lcp_B, lcp_C, lcp_T, lcp_z, lcp_basis the exact fallback's scratch
+#: (core/contact_lcp.lcp_arrays).
 Workspace = namedtuple("Workspace",
                        "x s piv K f H Jq Jqd phi gam G g un active WN WT WNp WTp coef r uf law Y D "
-                       "bias bias_end")
+                       "bias bias_end lcp_B lcp_C lcp_T lcp_z lcp_basis")
 
 
 class MoreauJeanSettings(NamedTuple):
@@ -108,7 +112,7 @@ def workspace(kern, n):
                      np.zeros(c), np.zeros((c, n)), np.zeros((T, n)), np.zeros((c, N)),
                      np.zeros((T, N)), np.zeros((c, 2)), np.zeros(R), np.zeros(R),
                      np.zeros(R, np.int64), np.zeros((R, N)), np.zeros((R, R)), np.zeros(R),
-                     np.zeros(R))
+                     np.zeros(R), *lcp_arrays(c))
 
 
 #: Row 0 of the saved fields (core/contact_kkt.py), shared with the other contact method.
@@ -162,11 +166,12 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         ws.r[k] = 0.0
     sweeps, change = 0, 0.0
     if n_active > 0:
-        converged, sweeps, change = solve_contacts(
+        status, sweeps, change = solve_contacts(
             c, N, settings.contact_tol, settings.max_sweeps, ws.active, ws.law, ws.coef, ws.un,
-            ws.uf, ws.WNp, ws.WTp, K, ws.piv, ws.s, ws.Y, ws.D, 0.0, ws.r)
-        if not converged:
-            return CONTACT_NOT_CONVERGED, sweeps, change
+            ws.uf, ws.WNp, ws.WTp, K, ws.piv, ws.s, ws.Y, ws.D, 0.0, ws.r,
+            (ws.lcp_B, ws.lcp_C, ws.lcp_T, ws.lcp_z, ws.lcp_basis))
+        if status != OK:
+            return status, sweeps, change
         apply_impulses(c, ws.active, ws.Y, ws.r, x)
     work = impulse_work(c, n, WN, WT, v, x, ws.r)
     for i in range(n):

@@ -28,7 +28,7 @@ Newton's impact law on the approaching velocity (restitution e): the row takes w
 the two asks for the larger separating velocity, so an impact leaves with -e u_N- and a
 resting contact is held by the stabilization alone. Solved by projected Gauss-Seidel on the
 regularized Delassus matrix D + Sigma I (core/contact_problem.py), with moreau_jean's stopping
-rule (CONTACT_NOT_CONVERGED at max_sweeps).
+rule and its fallback (Lemke's method when max_sweeps pass, core/contact_lcp.py).
 
 Order 1. Resting contact is stable for any h (the stabilized row has spook's step matrix, the
 spectral radius below 1 for every d > 0): a box or a stack at rest stays at rest with a
@@ -58,10 +58,11 @@ from ..core.constrained import constraint_rate
 from ..core.contact_kkt import (CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
                                 contact_prepare, impulse_work, pad_rows,
                                 record_constraints, record_contacts, row_dot, solve_contacts)
+from ..core.contact_lcp import lcp_arrays
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
 from ..core.solve import failed_solve_status
-from ..core.status import CONTACT_NOT_CONVERGED, OK
+from ..core.status import OK
 
 #: Scratch of one run (n coordinates, m constraints, c contacts, N = n + m, R = n_rows): x the
 #: unknown (v+, nu) (N,); xs solver scratch (N,); piv (N,); K (N, N); f rhs (n,); H (n, n);
@@ -69,10 +70,11 @@ from ..core.status import CONTACT_NOT_CONVERGED, OK
 #: WTp (N columns); coef (c, 2) = (e, mu); zero (c,) (Newton's law is folded into uf, so the
 #: solver's approach velocities are zeros); (R,): impulses r, free local velocities uf, law
 #: (every row UNILATERAL / COULOMB), the surface terms b at t (bias) and t + h (bias_end);
-#: active (c,); Y (R, N); D (R, R).
+#: active (c,); Y (R, N); D (R, R); lcp_B, lcp_C, lcp_T, lcp_z, lcp_basis the exact fallback's
+#: scratch (core/contact_lcp.lcp_arrays).
 Workspace = namedtuple("Workspace",
                        "x xs piv K f H phi gam G g WN WT WNp WTp coef zero r uf law active Y D "
-                       "bias bias_end")
+                       "bias bias_end lcp_B lcp_C lcp_T lcp_z lcp_basis")
 
 
 class SpookContactSettings(NamedTuple):
@@ -96,7 +98,8 @@ def workspace(kern, n):
                      np.zeros((m, n)), np.zeros(c), np.zeros((c, n)), np.zeros((T, n)),
                      np.zeros((c, N)), np.zeros((T, N)), np.zeros((c, 2)), np.zeros(c),
                      np.zeros(R), np.zeros(R), np.zeros(R, np.int64), np.zeros(c),
-                     np.zeros((R, N)), np.zeros((R, R)), np.zeros(R), np.zeros(R))
+                     np.zeros((R, N)), np.zeros((R, R)), np.zeros(R), np.zeros(R),
+                     *lcp_arrays(c))
 
 
 #: Row 0 of the saved fields (core/contact_kkt.py), shared with the other contact method.
@@ -147,11 +150,12 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         ws.r[k] = 0.0
     sweeps, change = 0, 0.0
     if n_active > 0:
-        converged, sweeps, change = solve_contacts(
+        status, sweeps, change = solve_contacts(
             c, N, settings.contact_tol, settings.max_sweeps, ws.active, ws.law, ws.coef, ws.zero,
-            ws.uf, ws.WNp, ws.WTp, K, ws.piv, ws.xs, ws.Y, ws.D, sigma, ws.r)
-        if not converged:
-            return CONTACT_NOT_CONVERGED, sweeps, change
+            ws.uf, ws.WNp, ws.WTp, K, ws.piv, ws.xs, ws.Y, ws.D, sigma, ws.r,
+            (ws.lcp_B, ws.lcp_C, ws.lcp_T, ws.lcp_z, ws.lcp_basis))
+        if status != OK:
+            return status, sweeps, change
         apply_impulses(c, ws.active, ws.Y, ws.r, x)
     work = impulse_work(c, n, ws.WN, ws.WT, v, x, ws.r)
     for i in range(n):
