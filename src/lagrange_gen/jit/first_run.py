@@ -95,11 +95,12 @@ def record_compile_seconds(method, seconds) -> None:
         pass
 
 
-def lock_path(method) -> Path:
-    """The lock file of a background compile of ``method`` (beside its portable glue)."""
+def lock_path(method, controlled=False) -> Path:
+    """The lock file of a background compile of ``method``'s portable glue (controlled: its
+    controlled glue), beside the glue."""
     from .portable import glue_path
     path = glue_path(method)
-    return path.with_name(f".{path.stem}.compiling")
+    return path.with_name(f".{path.stem}{'_controlled' if controlled else ''}.compiling")
 
 
 def take_lock(lock: Path) -> bool:
@@ -148,13 +149,14 @@ def release_lock(lock: Path) -> None:
         pass
 
 
-def start_background_compile(module, method, stream=None):
-    """Start the detached compile of ``method``'s portable glue and ``module``'s kernels for the
-    next process (module docstring) unless it is turned off or another holds the lock; one line
-    on ``stream`` (default stderr) says so. Returns the process (subprocess.Popen) or None."""
+def start_background_compile(module, method, stream=None, controlled=False):
+    """Start the detached compile of ``method``'s portable glue (controlled: the portable
+    controlled glue, portable.controlled_runner) and ``module``'s kernels for the next process
+    (module docstring) unless it is turned off or another holds the lock; one line on
+    ``stream`` (default stderr) says so. Returns the process (subprocess.Popen) or None."""
     if not background_enabled():
         return None
-    lock = lock_path(method)
+    lock = lock_path(method, controlled)
     if not take_lock(lock):
         return None
     package_parent = str(Path(__file__).resolve().parents[2])
@@ -163,7 +165,8 @@ def start_background_compile(module, method, stream=None):
         [package_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
     try:
         process = subprocess.Popen(
-            [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)],
+            [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)]
+            + (["controlled"] if controlled else []),
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
             start_new_session=True, env=env, close_fds=True)
     except OSError:
@@ -174,7 +177,8 @@ def start_background_compile(module, method, stream=None):
     except OSError:
         pass
     stream = stream or sys.stderr
-    stream.write(f"lagrange-gen: compiling run_{method} in the background for the next run "
+    glue = f"run_{method}_controlled" if controlled else f"run_{method}"
+    stream.write(f"lagrange-gen: compiling {glue} in the background for the next run "
                  f"(process {process.pid}; {BACKGROUND_ENV}=0 turns this off)\n")
     stream.flush()
     return process
@@ -196,19 +200,26 @@ def zero_step_args(module, method):
             np.zeros((0, events_size(n))))
 
 
-def compile_for_next_time(method, name, path) -> float:
+def compile_for_next_time(method, name, path, controlled=False) -> float:
     """In the background process: import the generated module at ``path`` as ``name``, compile
     its kernels and the portable glue of ``method`` (nothing when numba's cache has it), record
-    the CPU seconds. Returns them (0 when nothing was compiled)."""
+    the CPU seconds. controlled: the portable controlled glue instead, with a hook that writes
+    nothing (portable.no_inputs_hook: its type is every hook's), seconds not recorded (the
+    estimate is the uncontrolled glue's). Returns the seconds (0 when nothing was compiled)."""
     import importlib.util
-    from .portable import portable_cached, runner
+    import numpy as np
+    from .portable import controlled_runner, no_inputs_hook, portable_cached, runner
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     spec.loader.exec_module(module)
-    if portable_cached(module, method):
+    if portable_cached(module, method, controlled):
         return 0.0
     start = time.process_time()
+    if controlled:
+        controlled_runner(module, method, no_inputs_hook(), np.zeros(0))(
+            *zero_step_args(module, method))
+        return time.process_time() - start
     runner(module, method)(*zero_step_args(module, method))
     seconds = time.process_time() - start
     record_compile_seconds(method, seconds)
@@ -216,13 +227,13 @@ def compile_for_next_time(method, name, path) -> float:
 
 
 def main(argv) -> int:
-    method, name, path, lock = argv
+    method, name, path, lock = argv[:4]
     try:
         try:
             os.nice(10)
         except (AttributeError, OSError):      # no os.nice (Windows), or not allowed
             pass
-        compile_for_next_time(method, name, path)
+        compile_for_next_time(method, name, path, controlled=argv[4:] == ["controlled"])
     finally:
         release_lock(Path(lock))
     return 0
