@@ -182,14 +182,25 @@ def make_apply(controller, with_params=False):
     _check_arity(controller, with_params)
     key = (controller, with_params)
     if key not in _APPLY:
+        # An exception raised by the controller cannot leave a hook called through a pointer
+        # (numba prints it and goes on): the hook writes NaN into the last input instead, which
+        # ends the run at that step with one line naming the controller (blame_inputs).
         if with_params:
             @njit(error_model="numpy")
             def apply(c, t, q, v, p):
-                return _write_inputs(controller(t, q, v, p, c), p)
+                try:
+                    return _write_inputs(controller(t, q, v, p, c), p)
+                except Exception:
+                    p[p.shape[0] - 1] = np.nan
+                    return True
         else:
             @njit(error_model="numpy")
             def apply(c, t, q, v, p):
-                return _write_inputs(controller(t, q, v, p), p)
+                try:
+                    return _write_inputs(controller(t, q, v, p), p)
+                except Exception:
+                    p[p.shape[0] - 1] = np.nan
+                    return True
         _APPLY[key] = apply
     return _APPLY[key]
 
@@ -234,20 +245,43 @@ def control_params_vector(control, values):
     return c
 
 
-def blame_inputs(error, module, p, control):
-    """``error`` (a SimulationError of a run with inputs from ``control``) as one line that also
-    names the inputs when the last values written to p (n_params,) are not finite: the failure
-    (NaN state, singular matrix) then comes from them, not from the model. Else ``error``."""
+def blame_inputs(error, module, p, control, data=None):
+    """``error`` (a SimulationError of a run with inputs from ``control``; data: its
+    control_params c, None without) as one line that also names the inputs when the last values written to p
+    (n_params,) are not finite: the failure (NaN state, singular matrix) then comes from them,
+    not from the model; and, when the controller raises an exception at the failure's time and
+    state (its hook then writes NaN, make_apply), that exception. Else ``error``."""
     first, k = input_slots(module)
     bad = [f"{name} = {value!r}" for name, value in zip(module.PARAMS[first:], p[first:].tolist())
            if not math.isfinite(value)]
     if not bad:
         return error
-    source = (f"the controller {control.__name__}" if not isinstance(control, Signal)
-              else "the Signal")
+    if isinstance(control, Signal):
+        source = "the Signal"
+    else:
+        source = f"the controller {control.__name__}"
+        raised = _raised(control, error, module, p, data)
+        if raised:
+            source += f" (which raises {raised} at t = {error.time:g})"
     return type(error)(f"{error}; the input {', '.join(bad)} from {source} is not finite there",
                        step=error.step, time=error.time, state=error.state,
                        residual=error.residual)
+
+
+def _raised(controller, error, module, p, data):
+    """'ValueError: text' when ``controller`` called from Python at the time and state of
+    ``error`` raises an exception, else None."""
+    n = module.N_COORDS
+    state = getattr(error, "state", None)
+    if state is None or error.time is None or len(state) != 2 * n:
+        return None
+    q, v = np.ascontiguousarray(state[:n]), np.ascontiguousarray(state[n:])
+    args = (float(error.time), q, v, p.copy())
+    try:
+        controller(*args) if data is None else controller(*args, data.copy())
+    except Exception as exc:            # the user's exception, reported in the line
+        return f"{type(exc).__name__}: {exc}".splitlines()[0]
+    return None
 
 
 def input_slots(module):

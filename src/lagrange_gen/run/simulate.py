@@ -200,7 +200,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end, h=No
     except SimulationError as exc:
         if hook is None:
             raise
-        raise blame_inputs(exc, module, task.p, control) from None
+        raise blame_inputs(exc, module, task.p, control,
+                           None if control_params is None else data) from None
     traj = fixed_step_trajectory(task, out, wall, compile_time)
     if overshoot:
         traj.warnings.insert(0, overshoot)
