@@ -14,7 +14,9 @@ name), compiles its kernels for the portable glue and the portable glue with a z
 the argument types simulate passes, and records its CPU seconds. One process per method and
 library version at a time: a lock file beside the portable glue (a stale lock, older than
 LOCK_STALE_S or of a process that is gone, is taken over). The next process then finds the glue
-in numba's cache (the warm path, unchanged). $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off
+in numba's cache (the warm path, unchanged). A controlled run that compiled its specialized loop
+because the portable controlled glue was not cached asks for that glue the same way (argument
+``controlled``; its own lock). $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off
 (tests and CI do); $LAGRANGE_GEN_INTERPRETED=0 turns the interpreted tier off.
 """
 
