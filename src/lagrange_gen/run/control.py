@@ -247,10 +247,11 @@ def control_params_vector(control, values):
 
 def blame_inputs(error, module, p, control, data=None):
     """``error`` (a SimulationError of a run with inputs from ``control``; data: its
-    control_params c, None without) as one line that also names the inputs when the last values written to p
-    (n_params,) are not finite: the failure (NaN state, singular matrix) then comes from them,
-    not from the model; and, when the controller raises an exception at the failure's time and
-    state (its hook then writes NaN, make_apply), that exception. Else ``error``."""
+    control_params c, None without) as one line that also names the inputs when the last values
+    written to p (n_params,) are not finite: the failure (NaN state, singular matrix) then comes
+    from them, not from the model; and, when the controller raises an exception at the
+    failure's time and state (its hook then writes NaN, make_apply), that exception. Else
+    ``error``."""
     first, k = input_slots(module)
     bad = [f"{name} = {value!r}" for name, value in zip(module.PARAMS[first:], p[first:].tolist())
            if not math.isfinite(value)]
