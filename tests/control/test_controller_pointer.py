@@ -89,6 +89,29 @@ def test_the_controlled_glue_equals_the_specialized_loop_bit_for_bit(cart_pole, 
     assert np.ptp(pointer.saved["input_u"]) > 0.1          # the inputs do change
 
 
+def test_the_controlled_glue_of_a_model_with_events_equals_the_specialized_loop(gen_dir):
+    """run_<method>_controlled_events: the zero crossings of x located under a Signal and a
+    controller equal the specialized loop's bit for bit."""
+    from lagrange_gen.codegen import generate_model
+    from lagrange_gen.run.loader import import_generated
+    mod = import_generated(generate_model(Path(__file__).resolve().parent /
+                                          "forced_oscillator_events.py", gen_dir).path)
+    assert mod.N_EVENTS == 1 and mod.N_INPUTS == 1
+
+    @numba.njit
+    def push(t, q, qd, p):
+        return 0.5 * np.sin(3.0 * t) - 0.2 * qd[0]
+
+    for ctl in (push, Signal([0.0, 1.0, 2.5], [0.5, -1.0, 2.0])):
+        runs = [lg.simulate(mod, "verlet", q0=[0.3], t_end=4.0, h=0.01, control=ctl, jit=jit)
+                for jit in ("portable", "specialized")]
+        assert [r.jit for r in runs] == ["portable", "specialized"]
+        assert len(runs[0].events) >= 2
+        for field in ("q", "v", "events"):
+            np.testing.assert_array_equal(getattr(runs[0], field), getattr(runs[1], field))
+        np.testing.assert_array_equal(runs[0].saved["input_u"], runs[1].saved["input_u"])
+
+
 _CHILD = '''
 import json, sys
 import numba
