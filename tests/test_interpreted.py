@@ -237,7 +237,7 @@ class _FakeSpawn:
 
 
 def test_the_background_compile_can_be_turned_off(generated, tmp_path, monkeypatch, capsys):
-    monkeypatch.setattr(first_run, "lock_path", lambda method: tmp_path / "lock")
+    monkeypatch.setattr(first_run, "lock_path", lambda method, controlled=False: tmp_path / "lock")
     monkeypatch.setattr(first_run, "spawn_detached", _FakeSpawn())
     _FakeSpawn.started = []
     monkeypatch.setenv(first_run.BACKGROUND_ENV, "0")
@@ -248,7 +248,7 @@ def test_the_background_compile_can_be_turned_off(generated, tmp_path, monkeypat
 
 def test_the_background_compile_honours_its_lock(generated, tmp_path, monkeypatch, capsys):
     lock = tmp_path / "lock"
-    monkeypatch.setattr(first_run, "lock_path", lambda method: lock)
+    monkeypatch.setattr(first_run, "lock_path", lambda method, controlled=False: lock)
     monkeypatch.setattr(first_run, "spawn_detached", _FakeSpawn())
     monkeypatch.setenv(first_run.BACKGROUND_ENV, "1")
     _FakeSpawn.started = []

@@ -36,21 +36,25 @@ def test_balance_with_a_controller_closes_at_the_method_order(torque_pendulum):
     assert abs(slope - 2) < 0.3, (slope, errors)
 
 
-def test_new_gains_run_the_compiled_loop(torque_pendulum):
-    """Three gain vectors, one compile: the loop of (model, method, controller) is compiled by
-    the first run only, and each run applies its own gains (the saved input is the
-    controller's value at each saved state)."""
+@pytest.mark.parametrize("jit", ["specialized", "portable"])
+def test_new_gains_run_the_compiled_loop(torque_pendulum, jit):
+    """Three gain vectors, one compile: the loop (the specialized one of model, method and
+    controller, or the portable controlled glue) is compiled by the first run only, and each
+    run applies its own gains (the saved input is the controller's value at each saved
+    state), also when the loop's choice was made by an earlier run."""
     run = controlled_run(torque_pendulum, "midpoint", make_apply(damp_and_drive, True))
+    loops = len(run.overloads)
     before = None
     for gains in ([0.5, 0.0], [2.0, 0.3], [0.0, -1.0]):
         tr = lg.simulate(torque_pendulum, "midpoint", Q0, V0, t_end=0.2, h=0.01,
-                         control=damp_and_drive, control_params=gains)
+                         control=damp_and_drive, control_params=gains, jit=jit)
+        assert tr.jit == jit
         expected = -gains[0] * tr.v[:, 1] + gains[1] * np.sin(3.0 * tr.t)
         np.testing.assert_allclose(tr.saved["input_u"][:, 0], expected, rtol=1e-14, atol=1e-15)
         if before is not None:            # the runs after the first compile nothing
             assert compile_notice.compiles() == before, gains
         before = compile_notice.compiles()
-    assert len(run.overloads) == 1
+    assert len(run.overloads) == (1 if jit == "specialized" else loops)
 
 
 def test_control_params_refusals(torque_pendulum):

@@ -96,6 +96,29 @@ def run_{method}_events(kern, n_saved, {wrapped}):
 '''
 
 
+# The portable controlled glue (fixed-step methods): the portable glue with an input hook
+# (run/control.py), a first-class function of one signature for every controller and Signal,
+# so that it too compiles once per method for every model and every hook.
+_CONTROLLED_GLUE = '''
+
+@njit(cache=True, error_model="numpy")
+def run_{method}_controlled(kern, n_saved, {wrapped}):
+    """run_{method} with the input hook ``control(control_data, t, q, v, p) -> changed`` (a
+    first-class function, portable.hook_pointer) writing the model's inputs at t0 and before
+    each step; control_data: the hook's float64 vector (run/control.py)."""
+    return _{loop}(_stepper_{method}, None, kern, n_saved, 0, {wrapped_call})
+
+
+@njit(cache=True, error_model="numpy")
+def run_{method}_controlled_events(kern, n_saved, {wrapped}):
+    """run_{method}_controlled on the kernel table of a model with events."""
+    return _{loop}(_stepper_{method}, None, kern, n_saved, 1, {wrapped_call})
+'''
+
+#: The arguments the portable controlled glue takes after the glue's (GLUE_ARGS).
+CONTROL_ARGS = ", control, control_data"
+
+
 #: Arguments of the ensemble glue of a fixed-step method (lagrange_gen.ensemble wraps it).
 ENSEMBLE_GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
                       "out_q, out_v, out_stats, out_extra, out_last, out_status")
@@ -202,9 +225,10 @@ def _stepping_loop_text(method, kern, n_events):
 
 def portable_glue_source(method: str, digest: str) -> str:
     """Source text of the portable ``run_<method>(kern, n_saved, ...)``,
-    ``run_<method>_events`` and, for a fixed-step method, ``ensemble_<method>(kern, n_saved,
-    ...)`` (models without events) (lagrange_gen.jit.portable) for the library version ``digest``;
-    deterministic."""
+    ``run_<method>_events`` and, for a fixed-step method, ``run_<method>_controlled(kern,
+    n_saved, ..., control, control_data)`` and its ``_events`` twin (_CONTROLLED_GLUE) and
+    ``ensemble_<method>(kern, n_saved, ...)`` (models without events)
+    (lagrange_gen.jit.portable) for the library version ``digest``; deterministic."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
     wrapped = _wrap(args, f"def run_{method}_events(")
@@ -215,7 +239,17 @@ def portable_glue_source(method: str, digest: str) -> str:
     if spec(method).adaptive:
         return source
     # ensemble_<method>(kern, n_saved, ...) for models without events (the literal 0)
-    return source + "\n\n" + _ensemble_source(method, "n_saved", 0, "kern", "kern, n_saved, ")
+    return (source + _controlled_source(method) + "\n\n"
+            + _ensemble_source(method, "n_saved", 0, "kern", "kern, n_saved, "))
+
+
+def _controlled_source(method):
+    """_CONTROLLED_GLUE of the fixed-step ``method``."""
+    args = GLUE_ARGS + CONTROL_ARGS
+    return _CONTROLLED_GLUE.format(
+        method=method, loop=LOOPS[False][1],
+        wrapped=_wrap(args, f"def run_{method}_controlled_events("),
+        wrapped_call=_wrap(args, f"    return _{LOOPS[False][1]}("))
 
 
 def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:

@@ -15,7 +15,9 @@ the argument types simulate passes, and records its CPU seconds. One process per
 library version at a time: a lock file beside the portable glue records the compiling process
 (pid, host, start time: ``lock_record``); a stale lock (older than LOCK_STALE_S, of a process that
 is gone or whose pid another process now has, or not a record at all) is taken over at once, with
-a note. The next process then finds the glue in numba's cache (the warm path, unchanged).
+a note. The next process then finds the glue in numba's cache (the warm path, unchanged). A
+controlled run that compiled its specialized loop because the portable controlled glue was not
+cached asks for that glue the same way (argument ``controlled``; its own lock).
 $LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns it off (tests and CI do); $LAGRANGE_GEN_INTERPRETED=0
 turns the interpreted tier off. Both read the words of jit.env.env_flag.
 """
@@ -98,11 +100,12 @@ def record_compile_seconds(method, seconds) -> None:
         pass
 
 
-def lock_path(method) -> Path:
-    """The lock file of a background compile of ``method`` (beside its portable glue)."""
+def lock_path(method, controlled=False) -> Path:
+    """The lock file of a background compile of ``method``'s portable glue (controlled: its
+    controlled glue), beside the glue."""
     from .portable import glue_path
     path = glue_path(method)
-    return path.with_name(f".{path.stem}.compiling")
+    return path.with_name(f".{path.stem}{'_controlled' if controlled else ''}.compiling")
 
 
 def process_start(pid):
@@ -233,13 +236,14 @@ def release_lock(lock: Path) -> None:
         pass
 
 
-def start_background_compile(module, method, stream=None):
-    """Start the detached compile of ``method``'s portable glue and ``module``'s kernels for the
-    next process (module docstring) unless it is turned off or another holds the lock; one line
-    on ``stream`` (default stderr) says so. Returns the process id, or None."""
+def start_background_compile(module, method, stream=None, controlled=False):
+    """Start the detached compile of ``method``'s portable glue (controlled: the portable
+    controlled glue, portable.controlled_runner) and ``module``'s kernels for the next process
+    (module docstring) unless it is turned off or another holds the lock; one line on
+    ``stream`` (default stderr) says so. Returns the process id, or None."""
     if not background_enabled():
         return None
-    lock = lock_path(method)
+    lock = lock_path(method, controlled)
     notes = []
     if not take_lock(lock, notes):
         return None
@@ -249,15 +253,16 @@ def start_background_compile(module, method, stream=None):
         [package_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
     try:
         pid = spawn_detached(
-            [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)],
-            env)
-    except (OSError, ValueError):
+            [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)]
+            + (["controlled"] if controlled else []), env)
+    except (OSError, ValueError, subprocess.SubprocessError):
         release_lock(lock)
         return None
     _write_record(lock, pid)
     stream = stream or sys.stderr
     took_over = "".join(f"; {note}" for note in notes)
-    stream.write(f"lagrange-gen: compiling run_{method} in the background for the next run "
+    glue = f"run_{method}_controlled" if controlled else f"run_{method}"
+    stream.write(f"lagrange-gen: compiling {glue} in the background for the next run "
                  f"(process {pid}; {BACKGROUND_ENV}=0 turns this off{took_over})\n")
     stream.flush()
     return pid
@@ -318,19 +323,26 @@ def zero_step_args(module, method):
             np.zeros((0, events_size(n))))
 
 
-def compile_for_next_time(method, name, path) -> float:
+def compile_for_next_time(method, name, path, controlled=False) -> float:
     """In the background process: import the generated module at ``path`` as ``name``, compile
     its kernels and the portable glue of ``method`` (nothing when numba's cache has it), record
-    the CPU seconds. Returns them (0 when nothing was compiled)."""
+    the CPU seconds. controlled: the portable controlled glue instead, with a hook that writes
+    nothing (portable.no_inputs_hook: its type is every hook's), seconds not recorded (the
+    estimate is the uncontrolled glue's). Returns the seconds (0 when nothing was compiled)."""
     import importlib.util
-    from .portable import portable_cached, runner
+    import numpy as np
+    from .portable import controlled_runner, no_inputs_hook, portable_cached, runner
     spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module
     spec.loader.exec_module(module)
-    if portable_cached(module, method):
+    if portable_cached(module, method, controlled):
         return 0.0
     start = time.process_time()
+    if controlled:
+        controlled_runner(module, method, no_inputs_hook(), np.zeros(0))(
+            *zero_step_args(module, method))
+        return time.process_time() - start
     runner(module, method)(*zero_step_args(module, method))
     seconds = time.process_time() - start
     record_compile_seconds(method, seconds)
@@ -338,13 +350,13 @@ def compile_for_next_time(method, name, path) -> float:
 
 
 def main(argv) -> int:
-    method, name, path, lock = argv
+    method, name, path, lock = argv[:4]
     try:
         try:
             os.nice(10)
         except (AttributeError, OSError):      # no os.nice (Windows), or not allowed
             pass
-        compile_for_next_time(method, name, path)
+        compile_for_next_time(method, name, path, controlled=argv[4:] == ["controlled"])
     finally:
         release_lock(Path(lock))
     return 0

@@ -138,10 +138,11 @@ def _function_kernel_class():
 
     class FunctionKernel(WrapperAddressProtocol):
         """A generated kernel as a numba first-class function: the address of its compiled C
-        wrapper for the portable argument types (the dispatcher, kept alive here, owns it)."""
+        wrapper for the portable argument types, or for ``args`` (numba types) when given (the
+        dispatcher, kept alive here, owns it)."""
 
-        def __init__(self, dispatcher):
-            args = _kernel_arg_types(dispatcher.py_func)
+        def __init__(self, dispatcher, args=None):
+            args = args or _kernel_arg_types(dispatcher.py_func)
             dispatcher.compile(args)
             result = dispatcher.overloads[args]
             self.dispatcher, self.sig = dispatcher, result.signature
@@ -354,12 +355,14 @@ def glue_path(method) -> Path:
     return Path(_glue_module(method).__file__)
 
 
-def portable_cached(module, method) -> bool:
-    """Whether the portable glue that runs ``method`` on ``module`` is compiled in this process
-    or has entries in numba's cache for this library version (any entry: its kernel table's type
-    is the same for every model but the constants', so an entry is taken as a hit; a wrong guess
-    costs the compile it would have cost anyway)."""
-    glue = getattr(_glue_module(method), _run_name(module, method))
+def portable_cached(module, method, controlled=False) -> bool:
+    """Whether the portable glue that runs ``method`` on ``module`` (controlled: the one with
+    an input hook, controlled_runner) is compiled in this process or has entries in numba's
+    cache for this library version (any entry: its kernel table's type is the same for every
+    model but the constants', so an entry is taken as a hit; a wrong guess costs the compile it
+    would have cost anyway)."""
+    name = _controlled_name(module, method) if controlled else _run_name(module, method)
+    glue = getattr(_glue_module(method), name)
     if glue.overloads:
         return True
     table_class(method)          # the index refers to the table's class: defined before it is read
@@ -367,6 +370,76 @@ def portable_cached(module, method) -> bool:
         return bool(glue._cache._cache_file._load_index())
     except Exception:      # numba's cache internals moved, or no cache: not known to be cached
         return False
+
+
+def _controlled_name(module, method):
+    return f"run_{method}_controlled_events" if module.N_EVENTS else f"run_{method}_controlled"
+
+
+def hook_arg_types():
+    """numba types of the arguments of an input hook apply(c, t, q, v, p) -> changed
+    (run/control.py): c, q, v and p C-contiguous float64 vectors, t a float64, as run_loop
+    passes them."""
+    from numba import types
+    vector = types.float64[::1]
+    return (vector, types.float64, vector, vector, vector)
+
+
+#: {hook dispatcher: its FunctionKernel}: a hook is compiled for the pointer once per process.
+_HOOK_POINTERS: dict = {}
+
+
+def hook_pointer(hook):
+    """The jitted input hook ``hook`` as a numba first-class function (FunctionKernel on
+    hook_arg_types: compiled now, or loaded from numba's cache when the hook is cached); its
+    numba type is the same for every hook, so the portable controlled glue compiled for one
+    runs them all."""
+    pointer = _HOOK_POINTERS.get(hook)
+    if pointer is None:
+        pointer = _HOOK_POINTERS[hook] = _function_kernel_class()(hook, hook_arg_types())
+    return pointer
+
+
+@functools.lru_cache(maxsize=None)
+def no_inputs_hook():
+    """A hook that writes nothing (False: no input changed): what the background compile
+    (jit/first_run.py) compiles the portable controlled glue with, before any controller."""
+    from .cache import njit
+
+    @njit(error_model="numpy")
+    def no_inputs(c, t, q, v, p):
+        return False
+
+    return no_inputs
+
+
+def controlled_runner(module, method, hook, data):
+    """A callable with the arguments of ``module.run_<method>`` that runs the portable
+    controlled glue (run_<method>_controlled, codegen.glue) on ``module``'s kernels with the
+    input hook ``hook`` (reached through hook_pointer) and its data ``data`` (a float64
+    vector): nothing is compiled for a new hook but the hook."""
+    run = getattr(_glue_module(method), _controlled_name(module, method))
+    table, saved, pointer = kernel_table(module, method), n_saved(module, method), \
+        hook_pointer(hook)
+
+    def bound(*args):
+        return run(table, saved, *args, pointer, data)
+
+    return bound
+
+
+def choose_controlled(jit, specialized, compiled, module, method, hook, data):
+    """(glue, "specialized" or "portable") of a run whose inputs ``hook`` writes (data: its
+    vector): ``specialized`` (the loop of module, method and hook, run/control.controlled_run,
+    data bound; ``compiled``: whether it is compiled in this process) under jit="specialized",
+    when numba lacks what the portable glue uses, and under "auto" when it is compiled already
+    or the portable controlled glue is not cached (the run then compiles it as before; the
+    driver starts the background compile of the portable one); else the portable controlled
+    glue (controlled_runner; jit="portable" compiles it when it is not cached)."""
+    if jit == "specialized" or _portable_off(jit) or (jit == "auto" and (
+            compiled or not portable_cached(module, method, controlled=True))):
+        return specialized, "specialized"
+    return controlled_runner(module, method, hook, data), "portable"
 
 
 def interpreted_runner(module, method):

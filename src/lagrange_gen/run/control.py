@@ -3,23 +3,33 @@
 A model's inputs (``Model(inputs=[u1, ...])``) are the last N_INPUTS entries of its parameter
 vector p, so every generated kernel reads them without a change of signature. Before each step
 (and once at t0) the run loop (steppers/run_loop.run_loop, argument ``control``) calls a jitted
-``apply(data, t, q, v, p) -> changed`` that writes them: a zero-order hold over each step (a
+hook ``apply(c, t, q, v, p) -> changed`` that writes them: a zero-order hold over each step (a
 changed input re-runs the method's prepare, which may have cached forces). Supplied by
 
 * a controller ``u = f(t, q, qd, p)``, a numba-jitted function returning a float (one input),
   a 1-D array or a tuple (n_inputs), evaluated at the state at the start of each step; with
-  ``control_params=c`` (a 1-D array of numbers: gains, set points) it is ``f(t, q, qd, p, c)``,
-  and new values of c run the loop already compiled for f (a new controller function compiles
-  the loop again, seconds: tune gains through c);
+  ``control_params=c`` (a 1-D array of numbers: gains, set points) it is ``f(t, q, qd, p, c)``;
 * a :class:`Signal` of samples (times (S,), values (S, n_inputs)), held between samples
   (``hold="zoh"``) or interpolated linearly (``hold="linear"``, evaluated at the middle of each
   step, which keeps an input error of O(h^2) in the step);
 * constants: ``params={"u": 0.5}`` (an input is a parameter; no loop hook then).
 
-The loop with a hook is compiled in this process for (module, method, controller) and kept (not
-cached on disk: numba does not cache code that receives a function). Trajectories of a model
-with inputs carry ``saved["input_<name>"]`` (the input held over the step that starts at each
-saved row) and, with outputs, ``saved["output_<name>"]`` (the generated ``outputs`` kernel).
+Every hook has the one signature ``(c float64[::1], t float64, q, v, p float64[::1]) ->
+bool`` and writes the trailing entries of p (as many as it has values): a controller's hook is a
+small jitted wrapper (make_apply: the controller's value, of any of its three kinds, written into
+p; c = control_params, empty without them), a Signal's is one library function
+(_signal_apply, cached by numba) whose c is the samples as data (signal_data). So the loop
+compiled for one hook runs them all: the portable controlled glue (jit/portable.py,
+``run_<method>_controlled``), compiled once per method and cached on disk by numba, reaches the
+hook through a function pointer, and a new process running a new controller compiles only the
+controller and its wrapper (fractions of a second). The specialized loop of (module, method,
+hook) (controlled_run: the hook inlined, faster per step, compiled in each process: numba does
+not cache code that receives a jitted function) runs under jit="specialized", and under "auto"
+when it is compiled in this process already or the portable controlled glue is not yet cached
+(then a background process compiles that glue for the next process, jit/first_run.py).
+Trajectories of a model with inputs carry ``saved["input_<name>"]`` (the input held over the
+step that starts at each saved row) and, with outputs, ``saved["output_<name>"]`` (the
+generated ``outputs`` kernel).
 """
 
 from __future__ import annotations
@@ -34,8 +44,8 @@ from ..jit.python_calls import unchecked
 from .params import resolve_params
 from ..steppers.core.options import FAST
 
-__all__ = ["Signal", "input_slots", "make_apply", "controlled_run", "resolve_inputs",
-           "attach_inputs_outputs"]
+__all__ = ["Signal", "input_slots", "make_apply", "signal_data", "controlled_run",
+           "resolve_inputs", "attach_inputs_outputs"]
 
 
 class Signal:
@@ -72,9 +82,10 @@ class Signal:
 
     def __call__(self, t):
         """The input (n_inputs,) the loop applies over a step evaluated at t (for checks)."""
-        out = np.zeros(self.values.shape[1] + 1)
-        _signal_apply((self.times, self.values, self.hold == "linear", 1, 0.0), t, None, None, out)
-        return out[1:]
+        out = np.zeros(self.values.shape[1])
+        none = np.zeros(0)
+        _signal_apply(signal_data(self, 0.0), float(t), none, none, out)
+        return out
 
 
 def _samples(name, value):
@@ -85,27 +96,30 @@ def _samples(name, value):
         raise SimulationError(f"Signal: {name} must be numbers, got {value!r}") from None
 
 
-def _write_inputs(u, p, first):
-    """p[first + j] = u_j for a float, a 1-D array or a tuple u; True when an entry changed
-    (jitted: see the overload)."""
+def _write_inputs(u, p):
+    """The trailing entries of p = u (a float, a 1-D array or a tuple: as many entries as u
+    has); True when an entry changed (jitted: see the overload)."""
 
 
 @overload(_write_inputs, jit_options=FAST)
-def _write_inputs_impl(u, p, first):
+def _write_inputs_impl(u, p):
     if isinstance(u, (types.Float, types.Integer)):
-        def impl(u, p, first):
+        def impl(u, p):
+            first = p.shape[0] - 1
             changed = p[first] != u
             p[first] = u
             return changed
     elif isinstance(u, types.Array):
-        def impl(u, p, first):
+        def impl(u, p):
+            first = p.shape[0] - u.shape[0]
             changed = False
             for j in range(u.shape[0]):
                 changed |= p[first + j] != u[j]
                 p[first + j] = u[j]
             return changed
     elif isinstance(u, types.BaseTuple):
-        def impl(u, p, first):
+        def impl(u, p):
+            first = p.shape[0] - len(u)
             changed = False
             j = 0
             for value in u:
@@ -118,20 +132,37 @@ def _write_inputs_impl(u, p, first):
     return impl
 
 
-@njit(**FAST)
-def _signal_apply(data, t, q, v, p):
-    """data = (times (S,), values (S, k), linear, first, half step): p[first:] = the signal at
-    t (zero-order hold) or at t + h/2 (linear); True when an entry changed."""
-    times, values, linear, first, half = data
+#: Entries of a Signal's data vector before its samples (signal_data).
+_SIGNAL_HEAD = 4
+
+
+def signal_data(signal, h):
+    """The samples of ``signal`` as the data c (4 + S (1 + k),) of its hook _signal_apply:
+    [linear (1.0 or 0.0), h / 2, S, k, times (S,), values (S, k) row by row]."""
+    times, values = signal.times, signal.values
+    head = [1.0 if signal.hold == "linear" else 0.0, 0.5 * h, len(times), values.shape[1]]
+    return np.ascontiguousarray(np.concatenate((head, times, values.reshape(-1))))
+
+
+@njit(cache=True, **FAST)
+def _signal_apply(c, t, q, v, p):
+    """The hook of a Signal, c = signal_data: the last k entries of p = the signal at t
+    (zero-order hold) or at t + h/2 (linear); True when an entry changed."""
+    linear, half = c[0] != 0.0, c[1]
+    S, k = int(c[2]), int(c[3])
+    times = c[_SIGNAL_HEAD:_SIGNAL_HEAD + S]
+    at = _SIGNAL_HEAD + S                                 # values[i, j] = c[at + i * k + j]
+    first = p.shape[0] - k
     s = t + half if linear else t
     i = np.searchsorted(times, s, side="right") - 1      # last sample at or before s
     changed = False
     w = 0.0
-    if linear and 0 <= i < times.shape[0] - 1:
+    if linear and 0 <= i < S - 1:
         w = (s - times[i]) / (times[i + 1] - times[i])
-    i = min(max(i, 0), times.shape[0] - 1)
-    for j in range(values.shape[1]):
-        value = values[i, j] if w == 0.0 else (1.0 - w) * values[i, j] + w * values[i + 1, j]
+    i = min(max(i, 0), S - 1)
+    for j in range(k):
+        now = c[at + i * k + j]
+        value = now if w == 0.0 else (1.0 - w) * now + w * c[at + (i + 1) * k + j]
         changed |= p[first + j] != value
         p[first + j] = value
     return changed
@@ -141,23 +172,35 @@ _APPLY = {}
 
 
 def make_apply(controller, with_params=False):
-    """The loop hook apply(data, t, q, v, p) of a jitted controller u = f(t, q, qd, p); data =
-    (first input slot,). with_params: u = f(t, q, qd, p, c), data = (first input slot, c (k,)).
-    One per controller (kept, so its compilation is reused)."""
+    """The hook apply(c, t, q, v, p) -> changed of a jitted controller u = f(t, q, qd, p)
+    (c unused: an empty array), or with with_params u = f(t, q, qd, p, c): u written into the
+    last entries of p. One per controller (kept, so its compilation is reused); compiled with
+    reference counting, which frees the array a controller may return at each step."""
     if not hasattr(controller, "py_func"):
         raise SimulationError(f"control: {getattr(controller, '__name__', controller)!r} is not "
                               "numba-jitted; decorate it with @numba.njit (it runs inside the loop)")
     _check_arity(controller, with_params)
     key = (controller, with_params)
     if key not in _APPLY:
+        # An exception raised by the controller cannot leave a hook called through a pointer
+        # (numba prints it and goes on): the hook writes NaN into the last input instead, which
+        # ends the run at that step with one line naming the controller (blame_inputs).
         if with_params:
-            @njit(**FAST)
-            def apply(data, t, q, v, p):
-                return _write_inputs(controller(t, q, v, p, data[1]), p, data[0])
+            @njit(error_model="numpy")
+            def apply(c, t, q, v, p):
+                try:
+                    return _write_inputs(controller(t, q, v, p, c), p)
+                except Exception:
+                    p[p.shape[0] - 1] = np.nan
+                    return True
         else:
-            @njit(**FAST)
-            def apply(data, t, q, v, p):
-                return _write_inputs(controller(t, q, v, p), p, data[0])
+            @njit(error_model="numpy")
+            def apply(c, t, q, v, p):
+                try:
+                    return _write_inputs(controller(t, q, v, p), p)
+                except Exception:
+                    p[p.shape[0] - 1] = np.nan
+                    return True
         _APPLY[key] = apply
     return _APPLY[key]
 
@@ -202,20 +245,44 @@ def control_params_vector(control, values):
     return c
 
 
-def blame_inputs(error, module, p, control):
-    """``error`` (a SimulationError of a run with inputs from ``control``) as one line that also
-    names the inputs when the last values written to p (n_params,) are not finite: the failure
-    (NaN state, singular matrix) then comes from them, not from the model. Else ``error``."""
+def blame_inputs(error, module, p, control, data=None):
+    """``error`` (a SimulationError of a run with inputs from ``control``; data: its
+    control_params c, None without) as one line that also names the inputs when the last values
+    written to p (n_params,) are not finite: the failure (NaN state, singular matrix) then comes
+    from them, not from the model; and, when the controller raises an exception at the
+    failure's time and state (its hook then writes NaN, make_apply), that exception. Else
+    ``error``."""
     first, k = input_slots(module)
     bad = [f"{name} = {value!r}" for name, value in zip(module.PARAMS[first:], p[first:].tolist())
            if not math.isfinite(value)]
     if not bad:
         return error
-    source = (f"the controller {control.__name__}" if not isinstance(control, Signal)
-              else "the Signal")
+    if isinstance(control, Signal):
+        source = "the Signal"
+    else:
+        source = f"the controller {control.__name__}"
+        raised = _raised(control, error, module, p, data)
+        if raised:
+            source += f" (which raises {raised} at t = {error.time:g})"
     return type(error)(f"{error}; the input {', '.join(bad)} from {source} is not finite there",
                        step=error.step, time=error.time, state=error.state,
                        residual=error.residual)
+
+
+def _raised(controller, error, module, p, data):
+    """'ValueError: text' when ``controller`` called from Python at the time and state of
+    ``error`` raises an exception, else None."""
+    n = module.N_COORDS
+    state = getattr(error, "state", None)
+    if state is None or error.time is None or len(state) != 2 * n:
+        return None
+    q, v = np.ascontiguousarray(state[:n]), np.ascontiguousarray(state[n:])
+    args = (float(error.time), q, v, p.copy())
+    try:
+        controller(*args) if data is None else controller(*args, data.copy())
+    except Exception as exc:            # the user's exception, reported in the line
+        return f"{type(exc).__name__}: {exc}".splitlines()[0]
+    return None
 
 
 def input_slots(module):
@@ -259,7 +326,8 @@ def controlled_run(module, method, apply):
 
 def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None, control_params=None):
     """(p (n_params,), hook, data) for a run: the parameters with the inputs' slots filled
-    (controller and signal: by the loop; hook None for constant inputs). control_params: the
+    (controller and signal: by the loop's hook apply(data, t, q, v, p), data a float64 vector,
+    see make_apply and signal_data; hook None for constant inputs). control_params: the
     controller's own parameters c (then u = f(t, q, qd, p, c)). A model input with no
     value (no control, no params entry, no default), or a controller whose value at (t0, q0,
     v0) has the wrong size, is a SimulationError naming it."""
@@ -291,12 +359,11 @@ def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None, control
         if control.values.shape[1] != k:
             raise SimulationError(f"{module.NAME}: the Signal has {control.values.shape[1]} "
                                   f"value(s) per sample for {k} input(s) ({', '.join(names)})")
-        return p, _signal_apply, (control.times, control.values, control.hold == "linear",
-                                  first, 0.5 * h)
+        return p, _signal_apply, signal_data(control, h)
     apply = make_apply(control, c is not None)
     if q0 is not None:
         _check_size(module, control, float(t0), q0, v0, p, names, c)
-    return p, apply, (first,) if c is None else (first, c)
+    return p, apply, np.zeros(0) if c is None else c
 
 
 def _check_size(module, controller, t0, q0, v0, p, names, c=None):

@@ -16,6 +16,7 @@ import numpy as np
 
 from .failures import raise_for_status
 from ..jit import first_run, portable
+from ..jit import portable as _portable
 from ..jit.compile_notice import compiles, first_use_notice
 from ..steppers.core import status as st
 from ..steppers.core.layout import N_STATS, STAT_ITERS, events_size, last_size, read_last
@@ -112,6 +113,8 @@ def integrate_fixed(task, q, v, out, progress):
         if run is None:
             run, compile_time = warm_up(lambda: task.glue(first), first, label)
             remember_glue(task, run)
+            if task.hook is not None and task.ran == "specialized" and task.jit == "auto":
+                _compile_controlled_for_next_time(task)
     if task.ran != "interpreted":
         announce_duration(task, run, q, v, task.t0, out, task.n_steps)
     chunk = max(1, CHUNK_STEPS // task.save_every) * task.save_every
@@ -266,13 +269,23 @@ def _interpreted_glue(task, args):
     has neither the specialized glue nor the portable glue of the method in memory or in its
     cache (a first use after an install, or after the library changed): compiling one takes
     seconds to tens of seconds, a short run interpreted a fraction of a second."""
-    if task.jit != "auto" or not first_run.interpreted_enabled() or portable.unsupported():
+    if task.jit != "auto" or task.hook is not None or not first_run.interpreted_enabled() or \
+            portable.unsupported():
         return None
     if portable.specialized_ready(task.run, args) or portable.portable_cached(task.module,
                                                                              task.method):
         return None
     task.ran = "interpreted"
     return portable.interpreted_runner(task.module, task.method)
+
+
+def _compile_controlled_for_next_time(task):
+    """After a controlled run under jit="auto" compiled its specialized loop (the portable
+    controlled glue was not cached): start the background compile of the portable controlled
+    glue (first_run), so that the next process runs any controller without compiling a loop."""
+    if not portable.unsupported() and not portable.portable_cached(task.module, task.method,
+                                                                   controlled=True):
+        first_run.start_background_compile(task.module, task.method, controlled=True)
 
 
 def _interpreted_chunk(done, save_every):
@@ -328,6 +341,8 @@ def ready_glue(task):
     if task.jit == "auto" and len(getattr(task.run, "overloads", ())) != overloads:
         return None
     task.ran = ran
+    if task.hook is not None:   # this run's data (control_params, samples), not the first's
+        return _portable.controlled_runner(task.module, task.method, task.hook, task.data)
     return portable
 
 

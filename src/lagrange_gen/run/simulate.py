@@ -31,7 +31,7 @@ from ..codegen.keys import regeneration_command_for
 from .control import attach_inputs_outputs, blame_inputs, controlled_run
 from ..errors import SimulationError
 from .fixed_driver import allocate, integrate_fixed, n_steps_to
-from ..jit.portable import choose, jit_mode
+from ..jit.portable import choose, choose_controlled, jit_mode
 from ..steppers.core import registry
 from .run_result import adaptive_trajectory, fixed_step_trajectory
 from .trajectory import Trajectory
@@ -119,12 +119,15 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
         holds it, else portable, switching to specialized between chunks of a fixed-step run
         whose remaining time would pay for the compile (fixed_run.SPECIALIZE_AFTER_S); a
         fixed-step run whose method numba has compiled nowhere yet starts "interpreted" (the
-        same code as Python, jit/interpreted.py) and compiles only when that would pay. Runs
-        with a control= hook are always specialized. None: the environment variable
+        same code as Python, jit/interpreted.py) and compiles only when that would pay. A run
+        with control= takes the portable controlled glue (compiled once per method for every
+        model and controller, the controller reached through a pointer) when numba's cache
+        holds it and the specialized loop of this controller is not compiled in this process,
+        else that specialized loop (lagrange_gen.run.control). None: the environment variable
         LAGRANGE_GEN_JIT, else "auto". Trajectory.jit says what ran.
     control_params: parameters of the controller (a 1-D sequence of numbers c, e.g. gains),
-        which then takes them last: u = f(t, q, qd, p, c). The loop compiled for a controller
-        (seconds, once per controller function and process) runs every new c without compiling.
+        which then takes them last: u = f(t, q, qd, p, c). New values of c run the loop
+        compiled for the controller without compiling.
     Constrained models (``constraints=`` in the model) need a constrained method
     (steppers.registry.CONSTRAINED_METHODS); q0, v0 off the constraints are projected onto them
     with a warning (lagrange_gen.run.consistent), and the Trajectory carries the multipliers and
@@ -156,9 +159,10 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
     q = run_checks.vector("q0", q0, n, module.COORDS)
     v = run_checks.vector("v0", v0, n, module.COORDS)
     p, hook, data = run_params(plan, module, params, control, control_params, h, t0, q, v)
-    if hook is not None:
-        run = _with_data(controlled_run(module, method, hook), data)
-        jit = "specialized"       # the control glue is compiled per model and controller
+    loop = None
+    if hook is not None:          # the specialized loop of (model, method, hook); compiled on use
+        loop = controlled_run(module, method, hook)
+        run = _with_data(loop, data)
     run_checks.check_element_coefficients(module, p)
     run_checks.check_contact_coefficients(module, p, q)
     t0, t_end, save_every = float(t0), float(t_end), int(save_every)
@@ -200,7 +204,7 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
-                 jit=jit, hook=hook, layout=plan.layout)
+                 jit=jit, hook=hook, layout=plan.layout, data=data, loop=loop)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,
                    getattr(module, "N_EVENTS", 0))
     try:
@@ -208,7 +212,8 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
     except SimulationError as exc:
         if hook is None:
             raise
-        raise blame_inputs(exc, module, task.p, control) from None
+        raise blame_inputs(exc, module, task.p, control,
+                           None if control_params is None else data) from None
     traj = fixed_step_trajectory(task, out, wall, compile_time)
     if overshoot:
         traj.warnings.insert(0, overshoot)
@@ -277,8 +282,11 @@ class _Task:
     controlled: bool = False    # inputs written by a controller or a signal (run/control.py)
     jit: str = "specialized"    # simulate(jit=): "auto", "specialized" or "portable"
     ran: str = ""               # what ran (Trajectory.jit), set by fixed_run / adaptive_run
-    hook: object = None         # the input hook compiled into ``run`` (control.make_apply)
+    hook: object = None         # the input hook apply(data, t, q, v, p) (control.make_apply)
     layout: tuple = None        # ((name, start, width), ...) of the saved fields (MethodPlan)
+    data: object = None         # the hook's data vector (control.resolve_inputs)
+    loop: object = None         # the specialized loop with the hook (control.controlled_run),
+    #                             which ``run`` calls with data bound
 
     def ready_key(self):
         """What the glue's choice and compile depend on, besides argument types that simulate
@@ -288,9 +296,14 @@ class _Task:
         return (m.__name__, m.KEY, self.spec.name, self.jit, type(self.settings), self.hook)
 
     def glue(self, args):
-        """The glue to run (``run`` or the portable one, see portable.choose) for a first call
-        with ``args``; records the choice in ``ran``."""
-        run, self.ran = choose(self.jit, self.run, self.module, self.method, args)
+        """The glue to run (``run`` or the portable one, see portable.choose, and for a run
+        with an input hook portable.choose_controlled) for a first call with ``args``; records
+        the choice in ``ran``."""
+        if self.hook is not None:
+            run, self.ran = choose_controlled(self.jit, self.run, bool(self.loop.overloads),
+                                              self.module, self.method, self.hook, self.data)
+        else:
+            run, self.ran = choose(self.jit, self.run, self.module, self.method, args)
         return run
 
     @property
