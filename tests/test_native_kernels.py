@@ -216,3 +216,38 @@ def test_portable_tables_hold_native_kernels(generated):
     table = portable.kernel_table(mod, "rattle")
     kernels = [getattr(table, f) for f in table._fields if not f.isupper()]
     assert kernels and all(k.__class__.__name__ == "NativeKernel" for k in kernels)
+
+
+def test_kernels_called_from_python_compile_nothing_with_numba(tmp_path, monkeypatch):
+    """A generated module's kernels called from Python (accelerations, a kernel called by hand,
+    the energy check after a run) run their native twins through jit/native_calls.py: numba
+    compiles none of the model's kernels, and the numbers are those of numba's kernels."""
+    from lagrange_gen.codegen import generate_model
+    from lagrange_gen.jit.python_calls import unchecked
+    from lagrange_gen.run.loader import import_generated
+    from lg_test_support import MODELS_DIR
+    path = generate_model(MODELS_DIR / "double_pendulum.py", tmp_path, methods=["rk4"]).path
+    mod = import_generated(path)
+    q, qd, p = np.array([0.3, -0.4]), np.array([0.2, 0.7]), mod.DEFAULT_PARAMS.copy()
+    acc = mod.accelerations(q, qd)
+    energy = mod.energy(q, qd, 0, p)                     # an int t, as a user may pass
+    rows = unchecked(mod.energy)(q, qd, 0.0, p)
+    H = np.zeros((2, 2))
+    status = mod.forward_dynamics(q, qd, 0.0, p, H, np.zeros(2))
+    kernels = [getattr(mod, k) for k in mod.KERNELS] + [mod.forward_dynamics]
+    assert all(not k.overloads for k in kernels)          # numba compiled none of them
+    # numba's own kernels give the same numbers
+    base = type(mod.energy).unchecked_base
+    assert base.__call__(mod.energy, q, qd, 0.0, p) == energy == rows
+    qdd = np.zeros(2)
+    assert base.__call__(mod.forward_dynamics, q, qd, 0.0, p, np.zeros((2, 2)), qdd) == status
+    np.testing.assert_array_equal(acc, qdd)
+
+
+def test_a_strided_argument_from_python_goes_to_numba(generated):
+    """Native kernels take C-contiguous writable arrays; any other layout numba takes."""
+    mod = generated("double_pendulum")
+    q2 = np.array([[0.3, 9.0], [-0.4, 9.0]])[:, 0]       # a column: not contiguous
+    q = np.ascontiguousarray(q2)
+    qd, p = np.array([0.2, 0.7]), mod.DEFAULT_PARAMS
+    assert mod.energy(q2, qd, 0.0, p) == mod.energy(q, qd, 0.0, p)

@@ -234,19 +234,22 @@ def _optimize(llvm, module, tm, level):
     pm.run(module)
 
 
-def _load_object(obj: bytes, symbol: str) -> int:
-    """Address of ``symbol`` in object code ``obj``, loaded into a new execution engine that
-    lives as long as the process."""
+def _load_object(obj: bytes, symbol: str, *more: str):
+    """Address of ``symbol`` (with ``more``: of each, as a tuple) in object code ``obj``,
+    loaded into a new execution engine that lives as long as the process."""
     llvm = _llvm()
     empty = llvm.parse_assembly("")
     engine = llvm.create_mcjit_compiler(empty, _target_machine(0))
     engine.add_object_file(llvm.ObjectFileRef.from_data(obj))
     engine.finalize_object()
-    address = engine.get_function_address(symbol)
-    if not address:
-        raise Unsupported(f"the object code has no symbol {symbol}")
+    addresses = []
+    for name in (symbol, *more):
+        address = engine.get_function_address(name)
+        if not address:
+            raise Unsupported(f"the object code has no symbol {name}")
+        addresses.append(address)
     _ENGINES.append(engine)
-    return address
+    return addresses[0] if not more else tuple(addresses)
 
 
 @functools.lru_cache(maxsize=None)
@@ -276,6 +279,21 @@ def _native_kernel_class():
 
         def __repr__(self):
             return f"<native kernel {self.name} at {self.address:#x}>"
+
+        def python_call(self):
+            """A Python callable running the kernel: call(*args) with the kernel's arguments
+            (C-contiguous float64 arrays of its shapes, t a float: jit.python_calls checks
+            them), through native_calls' caller of its return kind (compiled once per
+            installation, not per model)."""
+            if self._python_call is None:
+                from .native_calls import CALLERS
+                caller = CALLERS.get((self.ret_kind, len(self.sig.args)))
+                if caller is None:
+                    raise Unsupported(f"no Python caller of {len(self.sig.args)} arguments")
+                self._python_call = functools.partial(caller, self.address)
+            return self._python_call
+
+        _python_call = None
 
     return NativeKernel
 
@@ -348,5 +366,6 @@ def native_kernel(module, name, folder: Path):
         kernel = _native_kernel_class()(fn, name, address, _signature(ret, arg_types), key,
                                         time.perf_counter() - start, cached)
         kernel.compile_seconds = compile_seconds
+        kernel.ret_kind = ret
         _KERNELS[memo] = kernel
         return kernel

@@ -5,7 +5,9 @@ of a (1, 1) H writes past it). Called from a stepper, the shapes are the stepper
 from Python, they are whatever the caller passed. ``check_python_calls`` gives each kernel of a
 generated module a check of its arguments (kernel_abi.ARGUMENTS: float64 arrays of the module's
 shapes, a real number t) that runs on a call from Python only: jitted callers call the compiled
-code, not the dispatcher's ``__call__``, so a stepper pays nothing.
+code, not the dispatcher's ``__call__``, so a stepper pays nothing. A checked call from Python
+runs the kernel's native twin (jit/native.py) where it has one, so a Python caller compiles
+nothing with numba.
 """
 
 from __future__ import annotations
@@ -36,16 +38,31 @@ def check_python_calls(namespace):
         dispatcher.__class__ = _checked_class(type(dispatcher))
         dispatcher.python_call_fast = _fast_check(shapes)
         dispatcher.python_call_check = functools.partial(_full_check, f"{model}.{kernel}", shapes)
+        dispatcher.python_call_native = _NativeCall(namespace, kernel)
     if "forward_dynamics" in namespace:
         namespace["_forward_dynamics_unchecked"] = unchecked(namespace["forward_dynamics"])
 
 
 def unchecked(kernel):
     """``kernel``'s call without the argument check, for a loop of the package over arrays it
-    made itself (one call per saved row: the check costs a few microseconds a call). A kernel
-    without the check is returned as it is."""
+    made itself (one call per saved row: the check costs a few microseconds a call): through
+    its native kernel where it has one (_NativeCall), else numba's. A kernel without the check
+    is returned as it is."""
     base = getattr(type(kernel), "unchecked_base", None)
-    return kernel if base is None else functools.partial(base.__call__, kernel)
+    if base is None:
+        return kernel
+    numba_call = functools.partial(base.__call__, kernel)
+    native = getattr(kernel, "python_call_native", None)
+    chosen = []
+
+    def call(*args):
+        # the first call chooses (a module's import makes this before the kernel is needed)
+        if not chosen:
+            resolved = native.resolve() if native is not None else None
+            chosen.append(resolved if resolved is not None else numba_call)
+        return chosen[0](*args)
+
+    return call
 
 
 def check_kernel_arguments(kernel, shapes, args, kwargs):
@@ -80,8 +97,57 @@ _FLOAT64 = np.dtype(np.float64)
 
 def _full_check(kernel, shapes, args, kwargs):
     """check_kernel_arguments for a call the fast check did not pass: it names what is wrong,
-    or accepts what the kernel takes all the same (an int t, keyword arguments)."""
-    check_kernel_arguments(kernel, shapes, args, kwargs)
+    or accepts what the kernel takes all the same (an int t, keyword arguments); returns the
+    arguments in order."""
+    args = check_kernel_arguments(kernel, shapes, args, kwargs)
+    # a real t of another type (an int, numpy's float64) as the float the native call takes
+    return tuple(float(a) if shape is None else a for a, (_, shape) in zip(args, shapes))
+
+
+class _NativeCall:
+    """A kernel's call from Python through its native kernel (jit/native.py: compiled by LLVM,
+    called through jit/native_calls.py), so that a Python caller (accelerations, the energy check after a
+    run, linearize) compiles nothing with numba: made on the first call, from the generated
+    module's namespace. None where native kernels are off or the kernel is outside what
+    native_ir lowers (then numba compiles it, one line says why). A call whose arrays are not
+    C-contiguous and writable goes to numba, which takes any layout."""
+
+    def __init__(self, namespace, kernel):
+        self.namespace, self.kernel, self.call = namespace, kernel, False
+
+    def resolve(self):
+        if self.call is False:
+            self.call = None
+            from . import native
+            if native.enabled():
+                import sys
+                module = sys.modules.get(self.namespace.get("__name__"))
+                if module is not None and getattr(module, self.kernel, None) is not None:
+                    from .native_ir import Unsupported
+                    from .portable import native_dir
+                    try:
+                        self.call = native.native_kernel(module, self.kernel,
+                                                         native_dir()).python_call()
+                    except Unsupported as exc:
+                        native.warn_numba_compiles(module, self.kernel, exc)
+        return self.call
+
+    def __call__(self, args, trusted=False):
+        """The kernel's result, or _NUMBA when numba should run this call; ``trusted``: the
+        package's own arrays (unchecked), known C-contiguous and writable."""
+        call = self.call if self.call is not False else self.resolve()
+        if call is None:
+            return _NUMBA
+        if not trusted:
+            for value in args:
+                if type(value) is np.ndarray:
+                    flags = value.flags
+                    if not (flags.c_contiguous and flags.writeable):
+                        return _NUMBA
+        return call(*args)
+
+
+_NUMBA = object()
 
 
 def _fast_check(shapes):
@@ -114,7 +180,12 @@ def _checked_class(base):
     class CheckedKernel(base):
         def __call__(self, *args, **kwargs):
             if kwargs or not self.python_call_fast(args):
-                self.python_call_check(args, kwargs)
+                args, kwargs = self.python_call_check(args, kwargs), {}
+            native = getattr(self, "python_call_native", None)
+            if native is not None:
+                result = native(args)
+                if result is not _NUMBA:
+                    return result
             return call(self, *args, **kwargs)
 
     CheckedKernel.unchecked_base = base
