@@ -177,7 +177,9 @@ def kernel_arg_types(fn):
                  else types.float64[::1] for a in names)
 
 
-def _write_atomic(path: Path, data: bytes) -> None:
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in its folder (made if missing) and
+    a rename: a reader sees the old file or the new one, never a part."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -351,8 +353,8 @@ def native_kernel(module, name, folder: Path):
             compile_seconds = time.process_time() - cpu
             try:
                 # the object first: a reader trusts an object only through its meta's hash
-                _write_atomic(obj_path, obj)
-                _write_atomic(meta_path, json.dumps({
+                write_atomic(obj_path, obj)
+                write_atomic(meta_path, json.dumps({
                     "ret": ret, "kernel": name, "sha256": hashlib.sha256(obj).hexdigest(),
                     "seconds": round(compile_seconds, 4)}).encode())
             except OSError:          # an unwritable cache: compiled again next time

@@ -282,17 +282,8 @@ def _write_glue(folder: Path, method: str, source: str) -> Path:
     except OSError:                    # a shared directory we may not touch: it is only a mark
         pass
     if not path.is_file() or path.read_text() != source:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".run_{method}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as f:
-                f.write(source)
-            os.replace(tmp, path)
-        except BaseException:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-            raise
+        from .native import write_atomic
+        write_atomic(path, source.encode())
     return path
 
 
