@@ -48,8 +48,10 @@ def configurations():
 def measure(module_path, what, speedups, timeout=900) -> float:
     """Seconds of the first compile of ``what`` for ``module_path`` in a fresh process."""
     with tempfile.TemporaryDirectory() as numba_dir, tempfile.TemporaryDirectory() as glue_dir:
+        # native kernels off: the kernels case measures numba's compile of them (jit/native.py
+        # compiles them without numba, which no numba speedup touches)
         env = dict(os.environ, NUMBA_CACHE_DIR=numba_dir, LAGRANGE_GEN_PORTABLE_DIR=glue_dir,
-                   LAGRANGE_GEN_SPEEDUPS=speedups)
+                   LAGRANGE_GEN_SPEEDUPS=speedups, LAGRANGE_GEN_NATIVE="0")
         done = subprocess.run([sys.executable, "-c", _CHILD, str(module_path), what], env=env,
                               capture_output=True, text=True, timeout=timeout)
         if done.returncode != 0:
