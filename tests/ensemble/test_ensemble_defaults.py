@@ -51,13 +51,15 @@ def test_small_ensembles_save_every_step_and_an_explicit_save_every_is_kept(monk
 
 def test_the_warm_up_of_the_ensemble_glue_prints_the_compile_notice(monkeypatch, capsys,
                                                                    tmp_path):
-    """A module generated just now (nothing of it in numba's cache): its first ensemble
-    compiles and says so; the second call compiles nothing and says nothing."""
+    """A module generated just now (nothing of it in numba's cache): its first specialized
+    ensemble compiles its own glue and says so; the second call compiles nothing and says
+    nothing. (The portable ensemble glue, compiled once for every model, reaches a new model's
+    native kernels without compiling: jit/native.py.)"""
     from lagrange_gen.codegen.generated_files import generate_model
     fresh = generate_model(ROOT / "models" / "damped_oscillator.py", tmp_path,
                            methods=["rk4"]).path
     monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
-    run = dict(q0=[1.0], t_end=0.05, h=0.01, save_every=1)
+    run = dict(q0=[1.0], t_end=0.05, h=0.01, save_every=1, jit="specialized")
     lg.ensemble(fresh, "rk4", **run)
     err = capsys.readouterr().err
     assert "lagrange-gen: compiling ensemble_rk4 for damped_oscillator (first use) ..." in err
