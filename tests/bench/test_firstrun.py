@@ -38,8 +38,8 @@ def test_cart_pendulum_first_step_report_has_positive_finite_numbers(tmp_path):
     assert text.startswith("# From model file to first step")
     line = next(x for x in text.splitlines() if x.startswith("| cart pendulum, rk4 |"))
     cells = [c.strip() for c in line.strip("|").split("|")]
-    empty, again = float(cells[1]), float(cells[3])
-    assert empty > 0 and again > 0 and cells[2] == "-"
+    empty, again = float(cells[1]), float(cells[2])     # columns: the variants measured
+    assert empty > 0 and again > 0
     for goal in firstrun.GOALS:                      # every goal of the issue has its row
         assert f"| {goal[0]} | {goal[1]} | {goal[2]} |" in text
     assert "peak memory of any generation or compile" in text

@@ -67,7 +67,7 @@ class Case:
 
 #: upright straight running of the bicycle at 4 m/s (tests/rolling/test_bicycle_benchmark.py)
 _BICYCLE_Q0, _BICYCLE_V0 = (0.0,) * 8, (4.0, 0, 0, 0, 0, 0, -4.0 / 0.3, -4.0 / 0.35)
-_ALL = ("empty", "library", "again", "empty, numba", "library, numba")
+_ALL = ("empty", "library", "again", "library, numba")
 
 CASES = (
     Case("cart pendulum, rk4", "cart_pendulum", "rk4", q0=(0.1, 1.0), variants=_ALL),
@@ -89,9 +89,9 @@ CASES = (
          variants=("library", "again"), timeout=400),
     Case("lagrange-gen on the unchanged humanoid", "humanoid", "implicit_euler", kind="cli",
          variants=("again",), after="humanoid, 30 DoF, implicit_euler"),
-    Case("bicycle, nonholonomic_rk4", "bicycle", "nonholonomic_rk4", q0=_BICYCLE_Q0,
+    Case("bicycle, nonholonomic_midpoint", "bicycle", "nonholonomic_midpoint", q0=_BICYCLE_Q0,
          v0=_BICYCLE_V0, variants=("empty", "library", "again")),
-    Case("bicycle, linearize_nonholonomic", "bicycle", "nonholonomic_rk4", kind="linearize",
+    Case("bicycle, linearize_nonholonomic", "bicycle", "nonholonomic_midpoint", kind="linearize",
          q0=_BICYCLE_Q0, v0=_BICYCLE_V0, variants=("library", "again")),
 )
 QUICK_CASES = (
@@ -104,7 +104,7 @@ QUICK_CASES = (
 #: The model whose run fills the ``library`` caches of a method (another model of the same kind,
 #: so that only the glue and the stepper library are reused), with its start.
 WARMUP = {"dop853_impacts": ("rocking_block", None, None),
-          "nonholonomic_rk4": ("rolling_disk", (0.0, 0.0, 0.3, 0.0),
+          "nonholonomic_midpoint": ("rolling_disk", (0.0, 0.0, 0.3, 0.0),
                                (2 * math.cos(0.3), 2 * math.sin(0.3), 1.5, 4.0))}
 WARMUP_DEFAULT = ("double_pendulum", (0.1, 0.2), None)
 
@@ -215,12 +215,12 @@ class Workspace:
 
     def library(self, case, native):
         """The caches holding ``case.method``'s glue, compiled by a WARMUP model's run."""
-        key = (case.method, case.kind, native)
+        kind = "linearize" if case.kind == "linearize" else "simulate"
+        key = (case.method, kind, native)
         if key not in self.libraries:
-            dirs = self.dirs(f"library-{case.method}-{case.kind}-{'native' if native else 'numba'}")
+            dirs = self.dirs(f"library-{case.method}-{kind}-{'native' if native else 'numba'}")
             stem, q0, v0 = WARMUP.get(case.method, WARMUP_DEFAULT)
-            warm = Case(f"warm-up {stem}", stem, case.method,
-                        kind="simulate" if case.kind == "control" else case.kind, q0=q0, v0=v0)
+            warm = Case(f"warm-up {stem}", stem, case.method, kind=kind, q0=q0, v0=v0)
             row = run_child(child_spec(warm, self.models_dir, dirs["numba"].parent / "gen"),
                             child_env(dirs, native), case.timeout, dirs["numba"].parent)
             self.libraries[key] = (dirs, row)
@@ -283,18 +283,14 @@ def _library_rows(space):
     return {key: row for key, (_, row) in space.libraries.items()}
 
 
-def measure_percall(root, models_dir, quick=False, timeout=600):
-    """ns per call and per step once compiled (module docstring): {"native": row, "numba":
-    row}, each row the child's results under $LAGRANGE_GEN_NATIVE on or off."""
-    out = {}
-    for native in (True, False):
-        name = "native" if native else "numba"
-        dirs = {"numba": Path(root) / f"percall-{name}" / "numba",
-                "portable": Path(root) / f"percall-{name}" / "portable"}
-        spec = {"kind": "percall", "models_dir": str(models_dir), "quick": quick,
-                "out_dir": str(Path(root) / f"percall-{name}" / "gen")}
-        out[name] = run_child(spec, child_env(dirs, native), timeout, Path(root) / f"percall-{name}")
-    return out
+def measure_percall(root, models_dir, quick=False, timeout=900):
+    """ns per call and per step once compiled (module docstring), one child process: the
+    native and the numba-compiled kernels side by side in the same process, timed in
+    alternating rounds, so that the load of a shared machine weighs on both alike."""
+    dirs = {"numba": Path(root) / "percall" / "numba", "portable": Path(root) / "percall" / "portable"}
+    spec = {"kind": "percall", "models_dir": str(models_dir), "quick": quick,
+            "out_dir": str(Path(root) / "percall" / "gen")}
+    return run_child(spec, child_env(dirs, True), timeout, Path(root) / "percall")
 
 
 def run_firstrun_bench(models_dir="models", reports_dir="reports", quick=False, cases=None,
@@ -426,6 +422,8 @@ def _child(spec):
 PERCALL_ROBOT = ("ur5", {})
 PERCALL_CHAIN_N = 16
 PERCALL_METHODS = ("rk4", "verlet")
+#: alternating timing rounds; each number is the best round
+ROUNDS = 7
 
 
 def _loop_caller():
@@ -442,24 +440,43 @@ def _loop_caller():
     return repeat
 
 
-def _best_ns(fn, count, repeats=5):
-    best = float("inf")
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn(count)
-        best = min(best, (time.perf_counter() - start) / count)
-    return best * 1e9
+def _interleaved(timers, rounds=ROUNDS):
+    """{name: best seconds} of ``timers`` {name: () -> seconds}, run one after the other in
+    each of ``rounds`` rounds."""
+    best = {name: float("inf") for name in timers}
+    for _ in range(rounds):
+        for name, timer in timers.items():
+            best[name] = min(best[name], timer())
+    return best
+
+
+def _with_native(on, fn):
+    """fn() with $LAGRANGE_GEN_NATIVE on or off (read when a kernel table is built)."""
+    from ..jit.native import NATIVE_ENV
+    saved = os.environ.get(NATIVE_ENV)
+    os.environ[NATIVE_ENV] = "1" if on else "0"
+    try:
+        return fn()
+    finally:
+        if saved is None:
+            os.environ.pop(NATIVE_ENV, None)
+        else:
+            os.environ[NATIVE_ENV] = saved
 
 
 def _percall_child(spec):
-    """The per-call row: UR5 forward dynamics (from Python, in a jitted loop through a pointer
-    and directly) and ns per step of the chain's PERCALL_METHODS, specialized and portable."""
+    """The per-call row: forward dynamics of PERCALL_ROBOT from Python and in a jitted loop
+    (through the native kernel's and the numba-compiled kernel's address, and called directly),
+    then ns per step of the chain's PERCALL_METHODS on the specialized glue and on the portable
+    glue with native and with numba-compiled kernels (two imports of the same module, one
+    kernel table each)."""
     import numpy as np
     from ..jit import portable
-    from ..run.loader import load
+    from ..jit.native import native_kernel
+    from ..run.loader import import_generated, load
     from ..run.simulate import simulate
     from .robots import per_call_ns
-    models_dir, quick, out = Path(spec["models_dir"]), spec["quick"], spec["out_dir"]
+    models_dir, quick, out = Path(spec["models_dir"]), spec["quick"], Path(spec["out_dir"])
     stem, options = ("cart_pendulum", {}) if quick else PERCALL_ROBOT
     mod = load(models_dir / f"{stem}.py", out_dir=out, methods=["rk4"], options=options)
     n = mod.N_COORDS
@@ -468,26 +485,52 @@ def _percall_child(spec):
     Hbuf, qdd = np.zeros((n, n)), np.zeros(n)
     fd = mod.forward_dynamics
     result = {"robot": stem, "fd_python_ns": per_call_ns(lambda: fd(q, v, 0.0, p, Hbuf, qdd))}
-    kernel = portable.table_kernel(mod, "forward_dynamics")
-    result["fd_kernel"] = type(kernel).__name__
-    repeat = _loop_caller()
-    count = 20_000 if quick else 200_000
-    for label, target in (("fd_pointer_ns", kernel), ("fd_direct_ns", fd)):
-        repeat(target, 10, q, v, p, Hbuf, qdd)
-        result[label] = _best_ns(lambda c, t=target: repeat(t, c, q, v, p, Hbuf, qdd), count)
+    kernels = {"fd_native_ns": native_kernel(mod, "forward_dynamics", portable.native_dir()),
+               "fd_numba_ns": portable._function_kernel_class()(fd), "fd_direct_ns": fd}
+    repeat, count = _loop_caller(), (20_000 if quick else 100_000)
+
+    def timer(kernel):
+        def run():
+            start = time.perf_counter()
+            repeat(kernel, count, q, v, p, Hbuf, qdd)
+            return (time.perf_counter() - start) / count
+        return run
+    for kernel in kernels.values():
+        repeat(kernel, 10, q, v, p, Hbuf, qdd)
+    best = _interleaved({name: timer(kernel) for name, kernel in kernels.items()})
+    result.update({name: 1e9 * s for name, s in best.items()})
     _emit(result=result)
+
     chain_n = 4 if quick else PERCALL_CHAIN_N
-    chain = load(models_dir / "n_link_pendulum.py", out_dir=out, methods=list(PERCALL_METHODS),
+    methods = list(PERCALL_METHODS)
+    chain = load(models_dir / "n_link_pendulum.py", out_dir=out, methods=methods,
                  options={"n": chain_n})
+    twin_dir = out / "twin"              # the same module imported again: its own kernel table
+    twin_dir.mkdir(parents=True, exist_ok=True)
+    twin_path = twin_dir / Path(chain.__file__).name
+    twin_path.write_text(Path(chain.__file__).read_text())
+    twin = import_generated(twin_path)
     th0, w0 = 0.3 * np.sin(np.arange(1, chain_n + 1)), np.zeros(chain_n)
     steps = 2_000 if quick else 20_000
-    for method in PERCALL_METHODS:
-        for jit in ("specialized", "portable"):
-            walls = [simulate(chain, method, th0, w0, t_end=steps * H, h=H, save_every=steps,
-                              jit=jit).wall_time for _ in range(4)]
-            result = {f"{method}_{jit}_ns": 1e9 * min(walls[1:]) / steps}
-            _emit(result=result)
-    _emit(result={"chain_n": chain_n, "done": True})
+    runs = {}
+    for method in methods:
+        runs[f"{method}_specialized_ns"] = (chain, method, "specialized", True)
+        runs[f"{method}_portable_native_ns"] = (chain, method, "portable", True)
+        runs[f"{method}_portable_numba_ns"] = (twin, method, "portable", False)
+
+    def step_timer(module, method, jit):
+        def run():
+            traj = simulate(module, method, th0, w0, t_end=steps * H, h=H, save_every=steps,
+                            jit=jit)
+            return traj.wall_time / steps
+        return run
+    timers = {}
+    for name, (module, method, jit, native) in runs.items():
+        timers[name] = step_timer(module, method, jit)
+        _with_native(native, timers[name])        # compile or load; builds the kernel table
+    best = _interleaved(timers)
+    _emit(result={**{name: 1e9 * s for name, s in best.items()}, "chain_n": chain_n,
+                  "done": True})
 
 
 if __name__ == "__main__" and sys.argv[1:2] == ["--child"]:
