@@ -384,9 +384,15 @@ def _child(spec):
         return
     phases.enter("imports")
     import numpy as np
-    from ..run.loader import load
+    from ..jit.compile_notice import time_outermost_compiles
+    from ..run.loader import GENERATED_MODULE_PREFIX, load
     from ..run.simulate import simulate
     phases.done("imports")
+    # wall seconds of numba's outermost compiles: the model's kernels (called from Python, or
+    # put in a kernel table by numba), the glue and stepper library, anything else
+    compiles = time_outermost_compiles(lambda name: (
+        "kernels" if name.startswith(GENERATED_MODULE_PREFIX) else "glue"
+        if name.startswith(("lagrange_gen_portable", "lagrange_gen.steppers")) else "other"))
     phases.enter("model file to module")
     method = spec["method"]
     mod = load(spec["model"], out_dir=spec["out_dir"], methods=[method], options=spec["options"])
@@ -401,7 +407,7 @@ def _child(spec):
         lin = linearize_nonholonomic(mod, q0, v0)
         phases.done("first linearize_nonholonomic")
         result["size"] = int(np.asarray(lin.mass).shape[0])
-        _emit(result={**result, "done": True})
+        _emit(result={**result, "numba_compiles": dict(compiles), "done": True})
         return
     if kind == "simulate":
         from ..jit import portable
@@ -413,7 +419,8 @@ def _child(spec):
     control = _controller() if kind == "control" else None
     traj = simulate(mod, method, q0, v0, t_end=FIRST_STEPS * H, h=H, control=control)
     phases.done("first simulate")
-    result.update(jit=str(traj.jit), final_finite=bool(np.isfinite(traj.q[-1]).all()))
+    result.update(jit=str(traj.jit), final_finite=bool(np.isfinite(traj.q[-1]).all()),
+                  numba_compiles=dict(compiles))
     _emit(result={**result, "done": True})
 
 
@@ -473,6 +480,7 @@ def _percall_child(spec):
     import numpy as np
     from ..jit import portable
     from ..jit.native import native_kernel
+    from ..jit.python_calls import unchecked
     from ..run.loader import import_generated, load
     from ..run.simulate import simulate
     from .robots import per_call_ns
@@ -484,7 +492,9 @@ def _percall_child(spec):
     q, v, p = rng.uniform(-1, 1, n), rng.normal(size=n), mod.DEFAULT_PARAMS.copy()
     Hbuf, qdd = np.zeros((n, n)), np.zeros(n)
     fd = mod.forward_dynamics
-    result = {"robot": stem, "fd_python_ns": per_call_ns(lambda: fd(q, v, 0.0, p, Hbuf, qdd))}
+    bare = unchecked(fd)                 # without the argument check of a call from Python
+    result = {"robot": stem, "fd_python_ns": per_call_ns(lambda: fd(q, v, 0.0, p, Hbuf, qdd)),
+              "fd_python_unchecked_ns": per_call_ns(lambda: bare(q, v, 0.0, p, Hbuf, qdd))}
     kernels = {"fd_native_ns": native_kernel(mod, "forward_dynamics", portable.native_dir()),
                "fd_numba_ns": portable._function_kernel_class()(fd), "fd_direct_ns": fd}
     repeat, count = _loop_caller(), (20_000 if quick else 100_000)

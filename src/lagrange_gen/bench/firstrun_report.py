@@ -60,9 +60,12 @@ def phase_table(cases, results):
             if "native_new" in row:
                 kernels = (f"{row['native_new']} compiled, {row['native_cached']} cached, "
                            f"{row['numba_kernels']} by numba")
-            rows.append([case.label, VARIANT_TITLES[variant], phases, kernels,
+            compiles = ", ".join(f"{k} {s:.1f}" for k, s in sorted(
+                row.get("numba_compiles", {}).items()) if s >= 0.05) or "-"
+            rows.append([case.label, VARIANT_TITLES[variant], phases, kernels, compiles,
                          f"{row['rss_mb']:.0f}"])
-    return md_table(["case", "variant", "CPU s by phase", "kernel table", "peak MB"], rows)
+    return md_table(["case", "variant", "CPU s by phase", "kernel table",
+                     "numba compiles (wall s)", "peak MB"], rows)
 
 
 def library_table(libraries):
@@ -102,6 +105,10 @@ def goal_rows(goals, results):
         value = seconds(row)
         met = ok(row) and row["cpu"] <= limit
         why = f"{VARIANT_TITLES[variant]}, CPU s of the whole process{_dominant(row)}"
+        compiles = {k: s for k, s in row.get("numba_compiles", {}).items() if s >= 0.05}
+        if compiles:
+            why += "; numba compiled " + ", ".join(f"{k} ({s:.1f} s wall)"
+                                                   for k, s in sorted(compiles.items()))
         empty = results[label].get("empty")
         if variant != "empty" and empty is not None:
             why += f"; empty caches (the method's glue compiled too): {seconds(empty)}"
@@ -155,9 +162,10 @@ def percall_row(calls):
     why = (f"native kernel / numba-compiled kernel, same process, alternating rounds: "
            f"{', '.join(f'{what} {r:.2f}x' for what, r in ratios)} (no regression: every ratio "
            f"<= {NOISE}); the specialized glue and a kernel called from Python are numba-compiled "
-           f"as before ({calls.get('robot')} forward_dynamics from Python "
-           f"{_us(calls, 'fd_python_ns')} us this run, 0.74 us in reports/robots.md on another "
-           f"day)")
+           f"as before: {calls.get('robot')} forward_dynamics from Python "
+           f"{_us(calls, 'fd_python_unchecked_ns')} us without the argument check a call from "
+           f"Python now makes (issue 34), {_us(calls, 'fd_python_ns')} us with it; 0.74 us in "
+           f"reports/robots.md, before that check, on another day")
     return [label, "0.74 us; bench speed", "no regression",
             f"worst ratio {worst:.2f}x", "**met**" if met else "**not met**", why]
 
@@ -166,8 +174,11 @@ def percall_table(calls):
     if not calls:
         return ["(not measured)"]
     robot, n = calls.get("robot", "?"), calls.get("chain_n", "?")
-    rows = [[f"{robot} forward_dynamics from Python (numba dispatcher)",
-             _us(calls, "fd_python_ns")],
+    rows = [[f"{robot} forward_dynamics from Python (numba dispatcher, with the argument check "
+             f"of a call from Python)", _us(calls, "fd_python_ns")],
+            [f"{robot} forward_dynamics from Python without the argument check "
+             f"(python_calls.unchecked, as accelerations calls it)",
+             _us(calls, "fd_python_unchecked_ns")],
             [f"{robot} forward_dynamics in a jitted loop through its address: native kernel "
              f"(the portable glue's call)", _us(calls, "fd_native_ns")],
             [f"{robot} forward_dynamics in a jitted loop through its address: numba-compiled "
@@ -224,7 +235,10 @@ def markdown(cases, results, libraries, calls, info):
         "CPU seconds of each phase inside the child (the process total above also counts the "
         "interpreter's start). 'kernels' builds the portable kernel table: native kernels "
         "compiled by llvmlite or loaded from their object cache, or numba-compiled kernels; "
-        "'first simulate' then compiles or loads the glue and runs.", "",
+        "'first simulate' then compiles or loads the glue and runs. 'numba compiles': wall "
+        "seconds of numba's outermost compiles in the child, by what they compile: the model's "
+        "kernels (numba-compiled for a kernel table, or called from Python: the energy check, "
+        "linearize), the glue and the stepper library, other.", "",
         *phase_table(cases, results), "",
         "## The method's glue (once per installation)", "",
         "The warm-up run that filled each warm library: a whole child on empty caches.", "",
