@@ -19,8 +19,12 @@ def _row(cpu, **extra):
 def test_cart_pendulum_first_step_report_has_positive_finite_numbers(tmp_path):
     case = firstrun.Case("cart pendulum, rk4", "cart_pendulum", "rk4", q0=(0.1, 1.0),
                          variants=("empty", "again"))
-    out = firstrun.run_firstrun_bench(MODELS_DIR, tmp_path, cases=[case], percall=False,
-                                      progress=False, command="test")
+    command = firstrun.Case("lagrange-gen, unchanged", "cart_pendulum", "rk4", kind="cli",
+                            variants=("again",), after=case.label)
+    out = firstrun.run_firstrun_bench(MODELS_DIR, tmp_path, cases=[case, command],
+                                      percall=False, progress=False, command="test")
+    unchanged = out["results"][command.label]["again"]      # the module the case generated
+    assert unchanged.get("done") and unchanged["cpu"] > 0, unchanged
     rows = out["results"][case.label]
     for variant in ("empty", "again"):
         row = rows[variant]

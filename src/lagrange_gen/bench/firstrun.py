@@ -151,7 +151,12 @@ def run_child(spec, env, timeout, work):
     it did not finish."""
     work.mkdir(parents=True, exist_ok=True)
     out_path, err_path = work / "child.out", work / "child.err"
-    cmd = [sys.executable, "-m", "lagrange_gen.bench.firstrun", "--child", json.dumps(spec)]
+    if spec.get("kind") == "cli":        # the command itself (bench/ does not import cli/)
+        cmd = [sys.executable, "-m", "lagrange_gen.cli.main", spec["model"], "-o",
+               spec["out_dir"], "--methods", spec["method"],
+               *(f"--set={k}={v}" for k, v in spec["options"].items())]
+    else:
+        cmd = [sys.executable, "-m", "lagrange_gen.bench.firstrun", "--child", json.dumps(spec)]
     start = time.perf_counter()
     with open(out_path, "w") as out, open(err_path, "w") as err:
         proc = subprocess.Popen(cmd, env=env, stdout=out, stderr=err)
@@ -168,6 +173,8 @@ def run_child(spec, env, timeout, work):
                 time.sleep(0.05)
         proc.returncode = os.waitstatus_to_exitcode(status)   # reaped here, not by Popen
     row = parse_events(out_path.read_text())
+    if spec.get("kind") == "cli" and proc.returncode == 0:
+        row["done"] = True
     row.update(cpu=usage.ru_utime + usage.ru_stime, rss_mb=usage.ru_maxrss / 1024,
                wall=time.perf_counter() - start)
     if timed_out:
@@ -306,7 +313,9 @@ def run_firstrun_bench(models_dir="models", reports_dir="reports", quick=False, 
 
     def write(results, libraries, calls):
         info = {"command": command, "numba": numba_version(), "cpus": os.cpu_count(),
-                "load": _load_average()}
+                "load": _load_average(), "goals": GOALS, "first_steps": FIRST_STEPS, "h": H,
+                "warmup_default": WARMUP_DEFAULT[0],
+                "warmups": {method: stem for method, (stem, _, _) in WARMUP.items()}}
         done = [case for case in cases if case.label in results]
         return write_report(target, markdown(done, results, libraries, calls, info))
 
@@ -374,14 +383,6 @@ def _child(spec):
     kind = spec["kind"]
     if kind == "percall":
         return _percall_child(spec)
-    if kind == "cli":
-        phases.enter("lagrange-gen")
-        from ..cli.main import main
-        code = main([spec["model"], "-o", spec["out_dir"], "--methods", spec["method"]]
-                    + [f"--set={k}={v}" for k, v in spec["options"].items()])
-        phases.done("lagrange-gen")
-        _emit(result={"exit": code, "done": code == 0})
-        return
     phases.enter("imports")
     import numpy as np
     from ..jit.compile_notice import time_outermost_compiles
@@ -479,7 +480,6 @@ def _percall_child(spec):
     kernel table each)."""
     import numpy as np
     from ..jit import portable
-    from ..jit.native import native_kernel
     from ..jit.python_calls import unchecked
     from ..run.loader import import_generated, load
     from ..run.simulate import simulate
@@ -495,8 +495,13 @@ def _percall_child(spec):
     bare = unchecked(fd)                 # without the argument check of a call from Python
     result = {"robot": stem, "fd_python_ns": per_call_ns(lambda: fd(q, v, 0.0, p, Hbuf, qdd)),
               "fd_python_unchecked_ns": per_call_ns(lambda: bare(q, v, 0.0, p, Hbuf, qdd))}
-    kernels = {"fd_native_ns": native_kernel(mod, "forward_dynamics", portable.native_dir()),
-               "fd_numba_ns": portable._function_kernel_class()(fd), "fd_direct_ns": fd}
+    # the kernel as a portable kernel table holds it, native and numba-compiled
+    kernels = {"fd_native_ns": _with_native(True, lambda: portable.table_kernel(
+                   mod, "forward_dynamics")),
+               "fd_numba_ns": _with_native(False, lambda: portable.table_kernel(
+                   mod, "forward_dynamics")),
+               "fd_direct_ns": fd}
+    result["fd_native_kind"] = type(kernels["fd_native_ns"]).__name__
     repeat, count = _loop_caller(), (20_000 if quick else 100_000)
 
     def timer(kernel):

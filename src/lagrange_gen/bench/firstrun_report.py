@@ -199,10 +199,12 @@ def percall_table(calls):
 
 
 def markdown(cases, results, libraries, calls, info):
-    from .firstrun import FIRST_STEPS, GOALS, H, WARMUP, WARMUP_DEFAULT
+    """The report's lines. info: command, numba, cpus, load, and the bench's settings: goals
+    (firstrun.GOALS), first_steps, h, warmup_default (a stem), warmups {method: stem}."""
+    FIRST_STEPS, GOALS, H = info["first_steps"], info["goals"], info["h"]
     load = info.get("load")
     load_text = f" (load average {load[0]:.1f} at the end)" if load else ""
-    warmups = ", ".join(f"{m}: {s}" for m, (s, _, _) in WARMUP.items())
+    warmups = ", ".join(f"{m}: {stem}" for m, stem in info["warmups"].items())
     lines = [
         "# From model file to first step", "",
         f"`{info['command']}` (issue 40), numba {info['numba']}. Timings were taken on a loaded "
@@ -218,7 +220,7 @@ def markdown(cases, results, libraries, calls, info):
         "- **empty caches**: the first model after an install (the method's portable glue is "
         "compiled too);",
         f"- **warm library**: the caches already hold the method's glue, compiled by a run of "
-        f"the same method on another model ({WARMUP_DEFAULT[0]}; {warmups}): what every new "
+        f"the same method on another model ({info['warmup_default']}; {warmups}): what every new "
         f"model pays;",
         "- **again**: a new process on the warm-library run's caches and module: nothing new;",
         "- **numba kernels**: the same with $LAGRANGE_GEN_NATIVE=0 (the model's kernels compiled "
