@@ -89,6 +89,13 @@ def _compile(args):
     print(run_compile_bench(Path(args.reports) / "compile.md", progress=not args.no_progress))
 
 
+def _firstrun(args):
+    from .firstrun import run_firstrun_bench
+    command = "lagrange-gen bench firstrun" + (" --quick" if args.quick else "")
+    print(run_firstrun_bench(args.models, args.reports, quick=args.quick,
+                             progress=not args.no_progress, command=command)["report"])
+
+
 def _contact(args):
     from .contact import run_contact
     print(run_contact(**_suite_kwargs(args))["report"])
@@ -121,6 +128,9 @@ SUITES = {
                 _stepapi),
     "compile": ("first compile with each numba speedup on and off (LAGRANGE_GEN_SPEEDUPS)",
                 _compile),
+    "firstrun": ("CPU seconds from model file to first step (empty caches, warm library, native "
+                 "kernels on and off), the goals of issue 40, cost per call once compiled",
+                 _firstrun),
     "contact": ("work-precision of moreau_jean, spook_contacts and dop853_impacts on the bouncing "
                 "ball and the rocking block against closed forms (Siconos when installed)",
                 _contact),

@@ -41,7 +41,7 @@ NATIVE_ENV = "LAGRANGE_GEN_NATIVE"
 OPT_ENV = "LAGRANGE_GEN_NATIVE_OPT"
 
 #: LLVM optimization level: level 1 compiles the big kernels several times faster than 2 or 3
-#: and costs little per call on straight-line code (docs/guides/first-run.md has the table).
+#: and costs about what numba's kernels cost per call (reports/firstrun.md measures both).
 OPT_LEVEL = 1
 
 #: The exported symbol of a kernel in its LLVM module.
