@@ -201,6 +201,15 @@ def test_a_kernel_outside_the_subset_is_compiled_by_numba_with_one_line(tmp_path
     assert np.array_equal(out, 2.0 * np.sin(q))
 
 
+def test_a_junk_optimization_level_says_so_once(monkeypatch):
+    monkeypatch.setattr(native, "_WARNED", set())
+    monkeypatch.setenv(native.OPT_ENV, "fast")
+    with pytest.warns(RuntimeWarning, match=r"LAGRANGE_GEN_NATIVE_OPT='fast' is not 0, 1, 2 or 3"):
+        assert native.opt_level() == native.OPT_LEVEL
+    monkeypatch.setenv(native.OPT_ENV, "2")
+    assert native.opt_level() == 2
+
+
 def test_native_off_uses_numba(generated, monkeypatch):
     mod = generated("cart_pendulum")
     monkeypatch.setenv(native.NATIVE_ENV, "0")

@@ -79,6 +79,11 @@ def opt_level() -> int:
     text = os.environ.get(OPT_ENV, "").strip()
     if text in ("0", "1", "2", "3"):
         return int(text)
+    if text and ("opt", text) not in _WARNED:
+        _WARNED.add(("opt", text))
+        import warnings
+        warnings.warn(f"lagrange-gen: ${OPT_ENV}={text!r} is not 0, 1, 2 or 3; LLVM's level "
+                      f"{OPT_LEVEL} is used", RuntimeWarning, stacklevel=2)
     return OPT_LEVEL
 
 
