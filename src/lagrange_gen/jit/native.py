@@ -241,22 +241,19 @@ def _optimize(llvm, module, tm, level):
     pm.run(module)
 
 
-def _load_object(obj: bytes, symbol: str, *more: str):
-    """Address of ``symbol`` (with ``more``: of each, as a tuple) in object code ``obj``,
-    loaded into a new execution engine that lives as long as the process."""
+def _load_object(obj: bytes, symbol: str) -> int:
+    """Address of ``symbol`` in object code ``obj``, loaded into a new execution engine that
+    lives as long as the process."""
     llvm = _llvm()
     empty = llvm.parse_assembly("")
     engine = llvm.create_mcjit_compiler(empty, _target_machine(0))
     engine.add_object_file(llvm.ObjectFileRef.from_data(obj))
     engine.finalize_object()
-    addresses = []
-    for name in (symbol, *more):
-        address = engine.get_function_address(name)
-        if not address:
-            raise Unsupported(f"the object code has no symbol {name}")
-        addresses.append(address)
+    address = engine.get_function_address(symbol)
+    if not address:
+        raise Unsupported(f"the object code has no symbol {symbol}")
     _ENGINES.append(engine)
-    return addresses[0] if not more else tuple(addresses)
+    return address
 
 
 @functools.lru_cache(maxsize=None)
