@@ -56,6 +56,8 @@ def _resolve_through_the_memo(context, fnty):
 
 # Compiles every kernel of the cart pendulum and of the double pendulum (as generated in
 # generated/) in a fresh process with an empty numba cache and prints a hash of their assembly.
+# LAGRANGE_GEN_NATIVE=0: a kernel called from Python otherwise runs its native (llvmlite) twin
+# and numba, whose typing is under test, compiles nothing.
 _ASM = """
 import hashlib, json, os, sys
 from lagrange_gen.jit import typing_memo as numba_typing_memo
@@ -74,7 +76,7 @@ print(json.dumps({"asm": h.hexdigest(), "stats": numba_typing_memo.stats()}))
 
 
 def _compile_in_fresh_process(tmp_path, memo):
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / f"cache_{memo}"),
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / f"cache_{memo}"), LAGRANGE_GEN_NATIVE="0",
                LAGRANGE_GEN_SPEEDUPS="all" if memo == "1" else "-typing_memo")
     out = subprocess.run([sys.executable, "-c", _ASM, str(ROOT)], capture_output=True, text=True,
                          env=env, timeout=600)
