@@ -293,7 +293,7 @@ def test_using_a_library_version_marks_it_used(tmp_path, monkeypatch):
     portable._glue_module.cache_clear()
     try:
         portable._glue_module("explicit_euler")
-        folder = tmp_path / portable._library_hash("explicit_euler")
+        folder = tmp_path / portable.library_hash("explicit_euler")
         assert (folder / "run_explicit_euler.py").is_file()
         os.utime(folder, (0, 0))
         portable._glue_module.cache_clear()

@@ -10,6 +10,7 @@ import pytest
 import lagrange_gen.run.simulate as simulate_module
 from lagrange_gen.cli.main import main
 from lagrange_gen.cli.simulate import add_parser, run as run_cli
+from lagrange_gen.run.loader import import_generated
 from lagrange_gen.run.simulate import simulate
 
 
@@ -187,4 +188,5 @@ def test_module_generated_without_the_method_gets_it_added(tmp_path, capsys):
     traj = simulate(model, "verlet", q0=[1.0], t_end=0.01, h=1e-3, out_dir=tmp_path)
     assert len(traj.t) == 11
     text = (tmp_path / "damped_oscillator.py").read_text()
-    assert "def run_verlet" in text and "def run_rk4" in text
+    assert "METHODS = ('verlet', 'rk4')" in text
+    assert hasattr(import_generated(tmp_path / "damped_oscillator.py"), "run_verlet")

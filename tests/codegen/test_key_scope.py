@@ -1,9 +1,10 @@
-"""A generated module carries glue only for the methods that apply to its model, and its KEY
-depends only on what it uses (issue 12, item 5): the derived equations as emitted, the stepper
-sources its glue compiles, the options. A comment in the model file or in a stepper the module
-does not glue changes nothing: the file stays byte-identical and numba's on-disk cache (stamped
-with the generated file's mtime and size) is used, not recompiled. A real change of the
-equations is still seen by ``--check`` and ``load``; a change of a glued stepper at import."""
+"""A generated module runs only the methods that apply to its model, and its KEY depends only on
+what it uses: the derived equations as emitted, the package sources its kernels compile, the
+options. A comment in the model file or in any stepper changes nothing in it: the file stays
+byte-identical and numba's on-disk cache (stamped with the generated file's mtime and size) is
+used, not recompiled. A changed stepper gives the module's stepper glue (the library's,
+jit/specialized.py) a new version instead. A real change of the equations is still seen by
+``--check`` and ``load``; a change of what the kernels compile at import."""
 
 import json
 import shutil
@@ -116,28 +117,37 @@ def _add_comment(path):
     path.write_text(path.read_text() + "\n# a comment added by test_key_scope\n")
 
 
-def test_comment_in_an_unrelated_stepper_changes_nothing(cart, package_copy):
+def test_comment_in_a_stepper_leaves_the_module_current_and_versions_its_glue(cart, package_copy):
+    """The module does not go stale when a stepper changes, glued or not; the library version of
+    its glue (the folder its glue file is written to) changes instead, so numba compiles that
+    glue again and nothing else."""
+    from lagrange_gen.jit import portable
     model, out, target = cart
     before, stamp = target.read_bytes(), target.stat().st_mtime_ns
     generate_model(model, out)                 # same text from the copy: hashes are of bytes
     assert target.read_bytes() == before
-    _add_comment(package_copy / "steppers" / "methods" / "rattle.py")          # glued by four_bar, not here
+    versions = {m: portable.library_hash(m) for m in ("rk4", "midpoint")}
+    _add_comment(package_copy / "steppers" / "core" / "options.py")       # shared by every stepper
+    _add_comment(package_copy / "steppers" / "methods" / "rattle.py")     # not a method of the cart
     generate_model(model, out)
     assert target.read_bytes() == before and target.stat().st_mtime_ns == stamp
+    assert check_generated(model, out)[1] is None
     keys.check_current(target, *(import_generated(target).__dict__[k] for k in
                                  ("KEY", "SOURCES", "MODEL_PATH", "OPTIONS", "TEXT_SHA")))
+    assert all(portable.library_hash(m) != v for m, v in versions.items())
 
 
-def test_comment_in_a_glued_stepper_makes_the_module_stale(cart, package_copy, tmp_path):
+def test_comment_in_what_the_kernels_compile_makes_the_module_stale(cart, package_copy, tmp_path):
     model, _, target = cart
     out = tmp_path / "own"
     first = generate_model(model, out)
     mod = import_generated(first.path)
     fields = [mod.KEY, mod.SOURCES, mod.MODEL_PATH, mod.OPTIONS, mod.TEXT_SHA]
-    _add_comment(package_copy / "steppers" / "core" / "options.py")       # shared by every stepper
-    with pytest.raises(StaleModuleError, match=r"steppers/core/options\.py changed since generation.*lagrange-gen"):
+    assert sorted(mod.SOURCES) == ["steppers/core/linalg.py", "steppers/core/status.py"]
+    _add_comment(package_copy / "steppers" / "core" / "linalg.py")       # the kernels' Cholesky
+    with pytest.raises(StaleModuleError, match=r"steppers/core/linalg\.py changed since generation.*lagrange-gen"):
         keys.check_current(first.path, *fields)
-    assert "stepper sources changed: steppers/core/options.py" in check_generated(model, out)[1]
+    assert "kernel sources changed: steppers/core/linalg.py" in check_generated(model, out)[1]
     second = generate_model(model, out)
     assert second.written and second.key != first.key
 

@@ -98,7 +98,7 @@ def model_counts(model):
 
 
 def resolve_methods(requested, model, drop_inapplicable=False):
-    """Methods to emit glue for, in registry order: for None those that apply to ``model``
+    """Methods a module runs, in registry order: for None those that apply to ``model``
     (steppers.registry.applicable_methods), else the requested ones, implicit_euler becoming
     nonsmooth_euler on a model with elements as in simulate. GenerationError for an unknown
     method, and for one that does not apply (one line naming it and why) unless
@@ -160,46 +160,24 @@ def generate_parts(model, out_dir="generated", methods=None, freeze=None, progre
             texts.append(render_kernel(spec, inputs))
         target = output_path(model.name, out_dir)
         source_rel = os.path.relpath(Path(model.source_path or ".").resolve(), Path(out_dir).resolve())
-        text = render_module(dyn, texts, sources=module_sources(methods), options=options,
-                             source_rel=source_rel, methods=methods,
-                             glue=_glue(methods, dyn),
-                             why=selected)
+        text = render_module(dyn, texts, sources=module_sources(), options=options,
+                             source_rel=source_rel, methods=methods, why=selected)
     seconds = {"derive": derived - start, "emit": time.perf_counter() - derived}
     return GenerationParts(text, key_of_text(text), target, dyn, texts, seconds)
 
 
-def _glue(methods, dyn):
-    """The glue of every method: run_<method>, then (fixed-step methods) ensemble_<method>."""
-    from .glue import ensemble_glue_source, glue_source
-    from ..steppers.core.registry import spec
-    blocks = []
-    for m in methods:
-        counts = (_n_saved(m, dyn), len(dyn.model.events))
-        blocks.append(glue_source(m, *counts))
-        if not spec(m).adaptive:
-            blocks.append(ensemble_glue_source(m, *counts))
-    return "\n\n".join(blocks)
-
-
-def _n_saved(method, dyn):
-    from ..steppers.core.registry import spec
-    return spec(method).n_saved(dyn.n, dyn.m, dyn.n_elements, dyn.n_contacts, dyn.n_nonholonomic)
-
-
-def module_sources(methods) -> dict:
-    """{package file: hash} of what a module gluing ``methods`` compiles: the stepper modules,
-    the run loops their glue calls (registry.LOOPS), the package modules they import and the
-    compiled imports of every module (linalg, status)."""
-    from ..steppers.core.registry import LOOPS, spec
-    loops = sorted({f"steppers.core.{LOOPS[spec(m).adaptive][0]}" for m in methods})
-    return source_hashes(source_closure([f"steppers.methods.{m}" for m in methods] + loops
-                                        + list(COMPILED_IMPORTS)))
+def module_sources() -> dict:
+    """{package file: hash} of what a module's kernels compile besides their own text (the
+    Cholesky routines and status codes, COMPILED_IMPORTS, and what they import): the kernels'
+    ABI. The stepper glue is not in it: the library writes it, keyed on its own version
+    (jit/specialized.py), so a changed stepper leaves generated modules current."""
+    return source_hashes(source_closure(list(COMPILED_IMPORTS)))
 
 
 def generate_text(model, out_dir="generated", methods=None, freeze=None):
     """Return (module text, KEY, target path) for a loaded Model; nothing is written.
 
-    methods: stepper methods to emit glue for (default: those that apply to the model); only the
+    methods: stepper methods the module runs (default: those that apply to the model); only the
     kernels they reach are derived and emitted (codegen.needs). freeze: {parameter: value}
     folded into the kernels.
     """

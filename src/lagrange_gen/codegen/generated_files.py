@@ -202,7 +202,7 @@ def _difference(header, on_disk, text, model_path, target):
         return f"generated with other options: {describe_options(header.get('OPTIONS') or {})}"
     if header.get("SOURCES") != new.get("SOURCES"):
         changed = sorted(set((header.get("SOURCES") or {}).items()) ^ set(new["SOURCES"].items()))
-        return f"stepper sources changed: {', '.join(sorted({name for name, _ in changed}))}"
+        return f"kernel sources changed: {', '.join(sorted({name for name, _ in changed}))}"
     record = read_derivation_record(target)
     changed = (changed_input(record, model_path)
                if record is not None and record.get("key") == header.get("KEY") else None)

@@ -1,14 +1,16 @@
-"""The glue each stepper method emits into a generated module, and the portable glue.
+"""The stepper glue of a generated module's methods, and the portable glue.
 
 Why glue: numba caches a compiled function on disk only when it takes no function arguments.
 The cores in ``steppers/methods/<method>.py`` are generic over the kernels: they receive the generated
 module itself as their first argument (``kern``; see steppers/core/run_loop.py for why a module and not the
-dispatchers), so they cannot be cached on their own. The glue ``run_<method>`` lives in the
-generated module, passes that module and takes only arrays and scalars, so it is ``cache=True``
-and its compiled code, cores included, is loaded from numba's cache by the next process. The
-KEY of a generated module hashes the sources of the steppers it glues and of the package
-modules they import (sources.source_closure), so a change there regenerates the module
-and thereby invalidates that cache.
+dispatchers), so they cannot be cached on their own. The specialized glue ``run_<method>``
+passes one generated module and takes only arrays and scalars, so it is ``cache=True`` and its
+compiled code, cores and kernels included, is loaded from numba's cache by the next process.
+
+A generated module holds kernels and metadata only: the library writes its specialized glue
+(specialized_glue_source) into its own cache folder on first use (jit/specialized.py), under a
+file name that carries the module's KEY and the library version, so that a changed model or a
+changed stepper compiles again and nothing else does.
 
 Glue signature of the fixed-step methods::
 
@@ -31,7 +33,7 @@ Glue signature of the fixed-step methods::
 
 Fixed-step methods also get ``ensemble_<method>(q0, v0, t0, h, n_steps, save_every, p, settings,
 out_q, out_v, out_stats, out_extra, out_last, out_status)``: the same loop for M members at once
-(a numba prange over members; member arrays with a leading M axis, see ensemble_glue_source and
+(a numba prange over members; member arrays with a leading M axis, see _ENSEMBLE_GLUE and
 lagrange_gen.ensemble).
 
 The glue is compiled with error_model="numpy", like the kernels and the cores: non-finite
@@ -51,14 +53,22 @@ GLUE_ARGS = ("q0, v0, t0, h, n_steps, save_every, p, settings, "
              "out_t, out_q, out_v, out_stats, out_extra, out_last, out_events")
 
 
-# _THIS_MODULE (this generated module, typed by numba as a compile-time constant) is what the
-# cores call kernels through; assigning it in every glue block keeps each block self-contained.
-_GLUE = '''import sys as _sys
+# _THIS_MODULE (the generated module, typed by numba as a compile-time constant) is what the
+# cores call kernels through; the glue file names it by the name it was imported under, which
+# numba's cache refers to it by.
+_GLUE = '''"""Stepper glue of {method} for the generated module {module_name!r} (KEY {key}),
+written by lagrange_gen.jit.specialized; DO NOT EDIT.
 
+Library version {digest} (a hash of the package files it compiles)."""
+import sys as _sys
+
+import numpy as np
+
+from lagrange_gen.jit import njit
 from lagrange_gen.steppers.methods import {method} as _stepper_{method}
 from lagrange_gen.steppers.core.{loop_module} import {loop} as _{loop}{loop_import}
 
-_THIS_MODULE = _sys.modules[__name__]{loop_def}
+_THIS_MODULE = _sys.modules[{module_name!r}]{loop_def}
 
 
 @njit(cache=True, error_model="numpy")
@@ -189,19 +199,26 @@ def glue_args(method: str) -> str:
     return ADAPTIVE_GLUE_ARGS if spec(method).adaptive else GLUE_ARGS
 
 
-def glue_source(method: str, n_saved: int, n_events: int) -> str:
-    """Source text of ``run_<method>`` to append to a generated module whose model gives the
-    method n_saved saved fields (SPEC.n_saved) and has n_events event functions; deterministic.
-    Both are passed to the loop as literals: numba prunes the event branches of a model without
-    events before compiling them (a module constant would only be folded later, by LLVM)."""
+def specialized_glue_source(method: str, module_name: str, key: str, digest: str,
+                            n_saved: int, n_events: int) -> str:
+    """Source text of the glue file of ``method`` for the generated module imported as
+    ``module_name`` (sys.modules), whose KEY is ``key`` and whose model gives the method n_saved
+    saved fields (SPEC.n_saved) and has n_events event functions, for the library version
+    ``digest``: ``run_<method>``, then (fixed-step methods) ``ensemble_<method>``;
+    deterministic. n_saved and n_events are passed to the loop as literals: numba prunes the
+    event branches of a model without events before compiling them (a module constant would
+    only be folded later, by LLVM)."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
     wrapped = _wrap(args, f"def run_{method}(")
     wrapped_call = _wrap(args, f"    return _{loop}(")
-    return _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
+    text = _GLUE.format(method=method, wrapped=wrapped, wrapped_call=wrapped_call,
                         summary=spec(method).summary, loop_module=loop_module, loop=loop,
-                        n_saved=n_saved, n_events=n_events,
-                        **_stepping_loop_text(method, "_THIS_MODULE", n_events))
+                        n_saved=n_saved, n_events=n_events, module_name=module_name, key=key,
+                        digest=digest, **_stepping_loop_text(method, "_THIS_MODULE", n_events))
+    if not spec(method).adaptive:
+        text += "\n\n" + _ensemble_source(method, n_saved, n_events, "_THIS_MODULE", "")
+    return text + "\n"
 
 
 def _stepping_loop_text(method, kern, n_events):
@@ -252,16 +269,8 @@ def _controlled_source(method):
         wrapped_call=_wrap(args, f"    return _{LOOPS[False][1]}("))
 
 
-def ensemble_glue_source(method: str, n_saved: int, n_events: int) -> str:
-    """Source text of ``ensemble_<method>`` (fixed-step methods only), appended after
-    ``run_<method>`` (whose block imports the stepper and run_loop); deterministic."""
-    if spec(method).adaptive:
-        raise ValueError(f"{method} chooses its own steps: no ensemble glue (fixed-step only)")
-    return _ensemble_source(method, n_saved, n_events, "_THIS_MODULE", "")
-
-
 def _ensemble_source(method, n_saved, n_events, kern, table):
-    """_ENSEMBLE_GLUE for the generated module (kern "_THIS_MODULE", no table argument) or the
+    """_ENSEMBLE_GLUE for a generated module (kern "_THIS_MODULE", no table argument) or the
     portable glue (kern "kern", table "kern, n_saved, ": the kernel table passed in)."""
     wrapped = _wrap(ENSEMBLE_GLUE_ARGS, f"def ensemble_{method}(")
     member_args = table + _wrap(_MEMBER_ARGS, f"def _member_{method}(") if table else _MEMBER_ARGS

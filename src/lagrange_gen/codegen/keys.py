@@ -68,8 +68,8 @@ def text_hash(text: str) -> str:
 def key_of_text(text: str) -> str:
     """KEY of a generated module: sha256 of its text without the KEY and TEXT_SHA lines. The
     text is the canonical form of what the module uses: its kernels as emitted (the derived
-    equations, not the model file's text), OPTIONS, and SOURCES (hashes of the stepper and
-    shared sources its glue compiles), so the KEY changes exactly when one of those does."""
+    equations, not the model file's text), OPTIONS, and SOURCES (hashes of the package
+    sources its kernels compile), so the KEY changes exactly when one of those does."""
     return hashlib.sha256(_without_lines(text, (KEY_PREFIX, TEXT_SHA_PREFIX)).encode()).hexdigest()
 
 
@@ -77,9 +77,10 @@ def check_current(module_file, key, sources, model_relpath, options, text_sha):
     """Raise StaleModuleError when a generated module no longer matches what it uses.
 
     Called at import by every generated module (cheap, no sympy): its text against TEXT_SHA
-    and KEY (a hand edit anywhere), and every package source its compiled code is built from
-    against SOURCES (numba's on-disk cache is keyed on the generated file only, so a changed
-    stepper must make the module stale). A changed model file is seen by re-deriving:
+    and KEY (a hand edit anywhere), and every package source its kernels compile against
+    SOURCES (numba's on-disk cache is keyed on the generated file only, so a changed Cholesky
+    routine must make the module stale; the stepper glue is keyed on the library's version by
+    jit/specialized.py instead). A changed model file is seen by re-deriving:
     ``lagrange-gen --check`` and ``lagrange_gen.load``; at import, a model text or a file the
     model read or imported that differs from the one recorded when the module was last
     generated or checked (changed_input) is stale too, so a direct import never runs old kernels

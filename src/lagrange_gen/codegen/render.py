@@ -53,7 +53,8 @@ _DIRECTIONS = {1: "+1 rising", -1: "-1 falling", 0: "both directions"}
 def _specialization(dyn, methods, why, texts):
     """Docstring lines stating every specialization decided for this module."""
     lines = ["Specialization (decided from the model and the requested methods):",
-             f"    stepper glue emitted for: {', '.join(methods) if methods else 'none'}"]
+             f"    methods (their stepper glue is the library's, jit/specialized.py): "
+             f"{', '.join(methods) if methods else 'none'}"]
     lines += [f"    kernel {name}: {', '.join(reasons)}" for name, reasons in why.items()]
     left = [k for k in default_kernels(dyn) if k not in why]
     if left:
@@ -80,6 +81,7 @@ _IMPORTS = [
     "",
     "from lagrange_gen.codegen.keys import check_current",
     "from lagrange_gen.jit import KERNEL_OPTIONS, check_python_calls, njit  # numba.njit; a bad cache entry is a miss",
+    "from lagrange_gen.jit.specialized import glue_attribute",
     "from lagrange_gen.run.loader import register_module",
     "from lagrange_gen.errors import SingularMass",
     "from lagrange_gen.steppers.core.linalg import SINGULAR_RTOL, cholesky_inplace, cholesky_solve_inplace",
@@ -87,7 +89,7 @@ _IMPORTS = [
     "from lagrange_gen.steppers.core.status import OK, SINGULAR_MASS",
 ]
 #: The modules of _IMPORTS whose functions or constants numba compiles into the kernels (the
-#: others run in Python): with the glued steppers, the roots of the module's SOURCES.
+#: others run in Python): the roots of the module's SOURCES, the kernels' ABI.
 COMPILED_IMPORTS = ("steppers.core.linalg", "steppers.core.status")
 
 
@@ -134,9 +136,15 @@ def _model_constants(dyn, methods, texts):
     ]
 
 
-def render_module(dyn, texts, *, sources, options, source_rel, methods, glue, why=None) -> str:
-    """The whole generated module as text. ``glue`` is the per-stepper source to append;
-    ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
+_GLUE_LOOKUP = '''def __getattr__(name):
+    """run_<method> and ensemble_<method> of METHODS: the library's stepper glue with this
+    module's kernels compiled in, written and imported on first use (lagrange_gen.jit.specialized)."""
+    return glue_attribute(__name__, name)'''
+
+
+def render_module(dyn, texts, *, sources, options, source_rel, methods, why=None) -> str:
+    """The whole generated module as text: kernels and metadata; its methods' stepper glue is
+    the library's (``__getattr__``, jit/specialized.py). ``why`` {kernel: reasons} is stated in the docstring (codegen.needs.select_kernels);
     ``texts`` are the rendered kernels (emit.render_kernel), in module order.
 
     The header records TEXT_SHA, the hash of the whole text but that line (keys.text_hash),
@@ -166,8 +174,7 @@ def render_module(dyn, texts, *, sources, options, source_rel, methods, glue, wh
         parts += ["", text.function, ""]
     parts += ["", forward_source(dyn)]
     parts += ["", "", "check_python_calls(globals())  # a call from Python checks its arguments' shapes"]
-    if glue:
-        parts += ["", glue]
+    parts += ["", "", _GLUE_LOOKUP]
     text = "\n".join(parts).rstrip() + "\n"
     key = key_of_text(text)
     text = text.replace(KEY_PREFIX, KEY_PREFIX + key, 1)          # line 1, then the KEY line

@@ -237,12 +237,15 @@ def table_kernel(module, name):
     return _function_kernel_class()(getattr(module, name))
 
 
-def _library_hash(method: str) -> str:
-    """sha256 prefix of every package file the portable glue of ``method`` compiles."""
+def library_hash(method: str) -> str:
+    """sha256 prefix of every package file the glue of ``method`` compiles, and of the file
+    that writes the glue's text (codegen/glue.py): the library version of its portable and
+    specialized glue."""
     from ..codegen.sources import source_closure, source_hashes
     from ..steppers.core.registry import LOOPS, spec
     loop_module = LOOPS[spec(method).adaptive][0]
-    files = source_closure([f"steppers.methods.{method}", f"steppers.core.{loop_module}"])
+    files = source_closure([f"steppers.methods.{method}", f"steppers.core.{loop_module}",
+                            "codegen.glue"])
     digest = hashlib.sha256(repr(sorted(source_hashes(files).items())).encode())
     return digest.hexdigest()[:16]
 
@@ -254,12 +257,9 @@ def _glue_module(method: str):
     written is replaced by the per-user temporary one (_use_fallback_dir); one that already
     holds this version's glue is only read (a shared, read-only install)."""
     from ..codegen.glue import portable_glue_source
-    digest = _library_hash(method)
+    digest = library_hash(method)
     source = portable_glue_source(method, digest)
-    try:
-        path = _write_glue(portable_dir() / digest, method, source)
-    except OSError as exc:
-        path = _write_glue(_use_fallback_dir(portable_dir(), exc) / digest, method, source)
+    path = write_in_version(digest, f"run_{method}.py", source)
     name = f"lagrange_gen_portable_{digest}_{method}"
     module = sys.modules.get(name)
     if module is None:
@@ -270,10 +270,20 @@ def _glue_module(method: str):
     return module
 
 
-def _write_glue(folder: Path, method: str, source: str) -> Path:
-    """The file of ``method``'s glue in ``folder`` (a library version's directory), written
-    atomically unless it already holds ``source``; OSError when it cannot be."""
-    path = folder / f"run_{method}.py"
+def write_in_version(digest: str, name: str, source: str) -> Path:
+    """The file ``name`` holding ``source`` in the library version ``digest``'s directory
+    (write_versioned), replaced by the per-user temporary one when the configured directory
+    cannot be written (_use_fallback_dir)."""
+    try:
+        return write_versioned(portable_dir() / digest, name, source)
+    except OSError as exc:
+        return write_versioned(_use_fallback_dir(portable_dir(), exc) / digest, name, source)
+
+
+def write_versioned(folder: Path, name: str, source: str) -> Path:
+    """The file ``name`` in ``folder`` (a library version's directory, or a folder below one),
+    written atomically unless it already holds ``source``; OSError when it cannot be."""
+    path = folder / name
     if not folder.is_dir():
         folder.mkdir(parents=True, exist_ok=True)
         remove_unused_versions(folder)
@@ -289,7 +299,7 @@ def _write_glue(folder: Path, method: str, source: str) -> Path:
 
 def remove_unused_versions(current: Path) -> list:
     """Remove the sibling library-version directories of ``current`` (16 hex digits, as
-    _library_hash names them; anything else is left alone) whose modification time, refreshed
+    library_hash names them; anything else is left alone) whose modification time, refreshed
     by every process that uses one (_glue_module), is more than UNUSED_DAYS old. A process still
     loading from one loses only its cache: an unreadable entry is a miss (lagrange_gen.jit).
     Returns the directories removed."""
