@@ -6,7 +6,7 @@
   pages cannot go stale.
 - reference/cli.md: the `--help` of the lagrange-gen command and of each subcommand.
 - reference/kernels.md: the kernels a generated module may hold and their arguments
-  (lagrange_gen.codegen.kernel_abi.ARGUMENTS).
+  (lagrange_gen.jit.kernel_abi.ARGUMENTS).
 - reports/: the reports `lagrange-gen bench` writes (and their figures), so the guides link
   to them.
 """
@@ -109,10 +109,10 @@ def write_cli_help():
 
 
 def write_kernel_table():
-    from lagrange_gen.codegen.kernel_abi import ARGUMENTS
+    from lagrange_gen.jit.kernel_abi import ARGUMENTS
     lines = ["# Kernels of a generated module", "",
              "Every kernel a generated module may define, with its arguments in order "
-             "(`lagrange_gen.codegen.kernel_abi.ARGUMENTS`; sizes: n coordinates, m holonomic "
+             "(`lagrange_gen.jit.kernel_abi.ARGUMENTS`; sizes: n coordinates, m holonomic "
              "constraints, r nonholonomic constraints, c contacts, ne nonsmooth elements, and "
              "the counts of parameters, events, inputs and outputs). A module holds the kernels "
              "its model and methods need; its docstring lists them and why. Output arrays are "

@@ -137,6 +137,49 @@ def test_no_import_circles():
     assert not gone, f"no longer circles, remove them from KNOWN_CIRCLES: {gone}"
 
 
+def _layers():
+    """[[module names of a layer]] from docs/ARCHITECTURE.md's numbered list ("Which folder may
+    import which"), lowest first: the backticked names before the first colon of each item."""
+    import re
+    text = (ROOT / "docs" / "ARCHITECTURE.md").read_text()
+    section = text.split("## Which folder may import which", 1)[1].split("\n## ", 1)[0]
+    layers = []
+    for line in section.splitlines():
+        item = re.match(r"\d+\. (.*?):", line)
+        if item:
+            layers.append(re.findall(r"`([\w.]+)`", item.group(1)))
+    return layers
+
+
+def _layer_of(name, layers):
+    """Index in ``layers`` of the most specific name covering the module ``name`` (None: none)."""
+    best, index = -1, None
+    for k, names in enumerate(layers):
+        for covering in names:
+            if (name == covering or name.startswith(covering + ".")) and len(covering) > best:
+                best, index = len(covering), k
+    return index
+
+
+def test_the_layers_are_read_from_the_page():
+    layers = _layers()
+    assert layers[0] == ["errors"] and layers[-1] == ["cli"] and len(layers) >= 10
+    assert _layer_of("jit.portable", layers) > _layer_of("steppers.methods.rk4", layers) \
+        > _layer_of("jit.cache", layers)
+
+
+def test_every_import_points_down_the_layers_of_the_architecture_page():
+    """A module imports only from its own layer and those listed before it: the package order
+    that docs/ARCHITECTURE.md states holds, with no circle between folders."""
+    layers = _layers()
+    unplaced = sorted(name for name in MODULES if name and _layer_of(name, layers) is None)
+    assert not unplaced, f"modules in no layer of docs/ARCHITECTURE.md: {unplaced}"
+    offenders = [f"{name} -> {target}" for name, targets in _graph().items() if name
+                 for target in sorted(targets) if target
+                 and _layer_of(target, layers) > _layer_of(name, layers)]
+    assert not offenders, "imports against the layers of docs/ARCHITECTURE.md: " + "; ".join(offenders)
+
+
 def test_no_module_imports_another_modules_underscore_names():
     offenders = [f"{name}:{line}: {target}.{imported}"
                  for name in MODULES for line, target, imported in _imports(name)

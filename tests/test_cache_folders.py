@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from lagrange_gen.errors import SimulationError
-from lagrange_gen.jit import first_run, portable
+from lagrange_gen.jit import first_run, folders, portable
 from lg_test_support import MODELS_DIR
 
 
@@ -23,8 +23,8 @@ def fresh_glue(tmp_path, monkeypatch):
     """The portable glue written anew in this test: no remembered module or fallback; the
     per-user temporary directory under tmp_path."""
     portable._glue_module.cache_clear()
-    monkeypatch.setattr(portable, "_FALLBACK_DIRS", {})
-    monkeypatch.setattr(portable, "_temporary_dir", lambda: tmp_path / "per-user")
+    monkeypatch.setattr(folders, "_FALLBACK_DIRS", {})
+    monkeypatch.setattr(folders, "_temporary_dir", lambda: tmp_path / "per-user")
     for name in [m for m in sys.modules if m.startswith("lagrange_gen_portable_")]:
         monkeypatch.delitem(sys.modules, name)          # put back after the test
     yield tmp_path
@@ -109,7 +109,7 @@ def test_no_writable_place_at_all_is_one_line(fresh_glue, monkeypatch):
 def test_the_temporary_dir_is_per_user(monkeypatch):
     if not hasattr(os, "getuid"):
         pytest.skip("no user ids here")
-    assert portable._temporary_dir().name == f"lagrange_gen_portable-{os.getuid()}"
+    assert folders._temporary_dir().name == f"lagrange_gen_portable-{os.getuid()}"
 
 
 @pytest.mark.parametrize("kind", ["portable", "numba"])

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from harness.check import _caller, pure_kernels
-from lagrange_gen.codegen.kernel_abi import argument_shapes, kernel_dimensions
+from lagrange_gen.jit.kernel_abi import argument_shapes, kernel_dimensions
 from lagrange_gen.jit import native, portable
 from lagrange_gen.jit.native_ir import Unsupported
 

@@ -17,7 +17,8 @@ import pytest
 import lagrange_gen
 from lg_test_support import MODELS_DIR, ROOT
 from lagrange_gen.cli.main import main
-from lagrange_gen.codegen import keys, sources
+from lagrange_gen.codegen import keys
+from lagrange_gen.jit import sources
 from lagrange_gen.codegen import generate_model
 from lagrange_gen.codegen.generated_files import check_generated
 from lagrange_gen.errors import SimulationError, StaleModuleError

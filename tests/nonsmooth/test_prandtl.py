@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen.identify import identify_prandtl
-from lagrange_gen.nonsmooth import experiments
+from lagrange_gen.analysis import nonsmooth_experiments as experiments
 from lagrange_gen.run.simulate import simulate
 from nonsmooth_util import forcing, ns_model  # noqa: F401  (fixture)
 

@@ -20,7 +20,7 @@ def _steppers(args):
 
 
 def _nonsmooth(args):
-    from ..nonsmooth.experiments import run_nonsmooth_report
+    from ..analysis.nonsmooth_experiments import run_nonsmooth_report
     print(run_nonsmooth_report(args.reports, args.models))
 
 

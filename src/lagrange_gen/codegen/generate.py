@@ -23,7 +23,7 @@ from .keys import key_of_text
 from .needs import methods_needs, select_kernels
 from .printer import Inputs
 from .render import COMPILED_IMPORTS, render_module
-from .sources import source_closure, source_hashes
+from ..jit.sources import source_closure, source_hashes
 
 #: Seconds a generation stage may run before progress lines go to stderr (small models: none).
 PROGRESS_AFTER = 2.0

@@ -11,7 +11,7 @@ from importlib import metadata
 from pathlib import Path
 
 from ..errors import StaleModuleError
-from .sources import source_hashes
+from ..jit.sources import source_hashes
 
 _PACKAGE = Path(__file__).resolve().parents[1]     # src/lagrange_gen
 # Sources that shape the text generated from a model (equations, kernels, module layout, glue

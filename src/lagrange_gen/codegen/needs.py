@@ -14,7 +14,7 @@ from __future__ import annotations
 import ast
 from functools import lru_cache
 
-from .sources import module_path, relative_module
+from ..jit.sources import module_path, relative_module
 
 _KERN = "kern"                                         # the parameter naming the generated module
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from .kernel_abi import ALWAYS_2D
+from ..jit.kernel_abi import ALWAYS_2D
 from ..derive.nonholonomic import constraint_gamma_jacobians, nonholonomic_jacobians
 from ..derive.recursive import operation_count
 from ..model.symbols import Parameter

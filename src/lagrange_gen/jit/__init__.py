@@ -4,8 +4,9 @@ njit with a cache keyed on a function's source closure (cache), the compile with
 wrappers for functions only jitted code calls (callee), numba speedups (inline_copy,
 typing_memo, compile_gc; which are on, and the scope they patch in: speedups), the compile
 notice (compile_notice) and the portable glue that runs one compiled stepper on any model's
-kernel table (portable). Imports numba lazily; may import codegen.keys / codegen.sources and
-the stepper runtime, never sympy, derive or the codegen pipeline.
+kernel table (portable). Imports numba lazily. Its core (everything but portable, specialized,
+first_run and interpreted, which bind the steppers to a module's kernels) imports nothing of the
+steppers or the generator (docs/ARCHITECTURE.md, "Which folder may import which").
 
 Importing it checks numba's version against speedups.SUPPORTED_NUMBA (an older numba: one-line
 ImportError; a newer one: one warning, speedups off).

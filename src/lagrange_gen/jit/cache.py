@@ -38,7 +38,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..codegen.sources import module_name, source_closure, source_hashes
+from .sources import module_name, source_closure, source_hashes
 from . import speedups
 
 

@@ -66,7 +66,7 @@ def interpreted_enabled() -> bool:
 
 
 def _estimates_path() -> Path:
-    from .portable import portable_dir
+    from .folders import portable_dir
     return portable_dir() / ESTIMATES_FILE
 
 

@@ -8,7 +8,7 @@ its source, and the sources of every function it calls (a sibling kernel, the Ch
 factorization of steppers/core/linalg.py), are lowered to one LLVM module, optimized at
 OPT_LEVEL for the host CPU (its name and features: a generic x86-64 target is several times
 slower on the Jacobians) and compiled in this process. The object code is written to
-``<folder>/<key>.o`` (jit.portable.native_dir: beside the portable glue) with its return kind
+``<folder>/<key>.o`` (jit.folders.native_dir: beside the portable glue) with its return kind
 and hash beside it; the key hashes those sources,
 the module constants they read, this package's IR writer, llvmlite's version, the CPU and the
 optimization level, so an unchanged kernel loads in milliseconds in the next process.
@@ -172,11 +172,11 @@ def kernel_key(fn, arg_kinds, level) -> str:
 
 def kernel_arg_types(fn):
     """numba types of a kernel's arguments, from their names: t a float, the outputs that are
-    always 2-D (codegen.kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
+    always 2-D (kernel_abi.ALWAYS_2D) 2-D arrays, every other argument a 1-D array; all
     C-contiguous, as the steppers pass them (a kernel may flatten an output with reshape)."""
     import inspect
     from numba import types
-    from ..codegen.kernel_abi import ALWAYS_2D
+    from .kernel_abi import ALWAYS_2D
     names = list(inspect.signature(fn).parameters)
     return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
                  else types.float64[::1] for a in names)
@@ -310,7 +310,7 @@ def _signature(ret, arg_types):
 
 def native_kernel(module, name, folder: Path):
     """The kernel ``name`` of generated ``module`` compiled natively (a NativeKernel), from the
-    object cache in ``folder`` when it holds it (jit.portable.native_dir). Raises
+    object cache in ``folder`` when it holds it (jit.folders.native_dir). Raises
     native_ir.Unsupported when the kernel is outside the subset, or llvmlite lacks what is used
     (then the caller compiles it with numba)."""
     import time

@@ -17,7 +17,7 @@ import numbers
 
 import numpy as np
 
-from ..codegen.kernel_abi import argument_shapes, kernel_dimensions
+from .kernel_abi import argument_shapes, kernel_dimensions
 from ..errors import SimulationError
 
 __all__ = ["check_python_calls", "check_kernel_arguments", "unchecked"]
@@ -124,7 +124,7 @@ class _NativeCall:
                 module = sys.modules.get(self.namespace.get("__name__"))
                 if module is not None and getattr(module, self.kernel, None) is not None:
                     from .native_ir import Unsupported
-                    from .portable import native_dir
+                    from .folders import native_dir
                     try:
                         self.call = native.native_kernel(module, self.kernel,
                                                          native_dir()).python_call()

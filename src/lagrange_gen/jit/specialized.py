@@ -22,7 +22,7 @@ import re
 import sys
 from pathlib import Path
 
-from . import portable
+from . import folders, portable
 
 #: The attributes of a generated module that are its glue: prefix + a method of its METHODS.
 GLUE_PREFIXES = ("run_", "ensemble_", "_member_", "_loop_")
@@ -66,7 +66,7 @@ def glue_file_stem(module) -> str:
 def glue_module(module, method):
     """The imported glue file of ``method`` for the generated ``module`` (written if missing;
     one per process). A cache folder that cannot be written is replaced as the portable glue's
-    is (portable.write_in_version)."""
+    is (folders.write_in_version)."""
     glues = module.__dict__.setdefault("_SPECIALIZED_GLUE", {})
     if method in glues:
         return glues[method]
@@ -75,7 +75,7 @@ def glue_module(module, method):
     source = specialized_glue_source(method, module.__name__, module.KEY, digest,
                                      portable.n_saved(module, method), module.N_EVENTS)
     stem = glue_file_stem(module)
-    path = portable.write_in_version(digest, f"{stem}.py", source)
+    path = folders.write_in_version(digest, f"{stem}.py", source)
     remove_earlier_keys(path.parent, stem)
     name = f"lagrange_gen_specialized_{digest}_{stem}"
     glue = sys.modules.get(name)

@@ -6,25 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SimulationError
-from ..run.control import input_slots
-from ..run.params import resolve_params
+from ..run.control import parameter_vector  # noqa: F401 (the linearizations' p; run/ owns it)
 
 __all__ = ["parameter_vector", "as_vector", "need_kernels"]
-
-
-def parameter_vector(module, params=None, u=None):
-    """p (n_params,) with the inputs' slots set to u (n_inputs,), default 0."""
-    first, k = input_slots(module)
-    defaults = list(module.DEFAULTS[:first]) + [0.0] * k
-    p = resolve_params(module.PARAMS, defaults, params, model=module.NAME,
-                       frozen=getattr(module, "FROZEN", None))
-    if u is not None:
-        u = np.atleast_1d(np.asarray(u, dtype=np.float64))
-        if u.shape != (k,):
-            raise SimulationError(f"{module.NAME}: u has {u.size} entries for {k} input(s) "
-                                  f"({', '.join(module.PARAMS[first:]) or 'none'})")
-        p[first:] = u
-    return p
 
 
 def need_kernels(module, *names):

@@ -1,4 +1,5 @@
-"""Nonsmooth elements: the Saint-Venant return map, the play operator, and the lecture's experiments.
+"""Nonsmooth elements: the Saint-Venant return map and the play operator (the lecture's experiments
+are analysis/nonsmooth_experiments.py).
 
 The model elements themselves (SaintVenant, DryFriction) are declared in lagrange_gen.model; the
 time stepper that treats them is steppers/methods/nonsmooth_euler.py.

@@ -4,6 +4,6 @@ simulate (simulate) with its chunked drivers (fixed_driver, adaptive_driver), th
 before a run (checks), status -> error (failures), the energy check, consistent initial states
 (consistent), parameters (params), importing generated modules (loader), Trajectory and its
 I/O (trajectory, trajectory_io), control inputs (control), the one-step Stepper (stepper) and
-ensembles (ensemble, ensemble_inputs, ensemble_dask). May import steppers, jit, codegen.keys /
-codegen.sources and errors; never sympy on a cold simulate of a generated module.
+ensembles (ensemble, ensemble_inputs, ensemble_dask). May import steppers, jit, codegen.keys,
+errors; never sympy on a cold simulate of a generated module.
 """

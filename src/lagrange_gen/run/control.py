@@ -44,7 +44,7 @@ from ..jit.python_calls import unchecked
 from .params import resolve_params
 from ..steppers.core.options import FAST
 
-__all__ = ["Signal", "input_slots", "make_apply", "signal_data", "controlled_run",
+__all__ = ["Signal", "input_slots", "parameter_vector", "make_apply", "signal_data", "controlled_run",
            "resolve_inputs", "attach_inputs_outputs"]
 
 
@@ -291,6 +291,22 @@ def input_slots(module):
     return len(module.PARAMS) - k, k
 
 
+def parameter_vector(module, params=None, u=None):
+    """p (n_params,) with the inputs' slots set to u (n_inputs,), default 0."""
+    first, k = input_slots(module)
+    defaults = list(module.DEFAULTS[:first]) + [0.0] * k
+    p = resolve_params(module.PARAMS, defaults, params, model=module.NAME,
+                       frozen=getattr(module, "FROZEN", None))
+    if u is not None:
+        u = np.atleast_1d(np.asarray(u, dtype=np.float64))
+        if u.shape != (k,):
+            raise SimulationError(f"{module.NAME}: u has {u.size} entries for {k} input(s) "
+                                  f"({', '.join(module.PARAMS[first:]) or 'none'})")
+        p[first:] = u
+    return p
+
+
+#: {(module name, KEY, method, hook): the controlled loop compiled in this process}.
 _RUNS = {}
 
 

@@ -21,14 +21,13 @@ import math
 
 import numpy as np
 from .checks import vector
-from .control import input_slots
+from .control import input_slots, parameter_vector
 from ..errors import SimulationError
 from ..jit import njit
 from ..jit.api import jitclass, typeof
 from ..jit.compile_notice import first_use_notice
 from .failures import raise_for_status
 from .params import is_number
-from ..linear.linearize import parameter_vector
 from ..steppers.core import status as st
 from ..steppers.core import registry
 from ..steppers.core.options import fast_loop

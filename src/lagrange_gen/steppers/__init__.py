@@ -6,7 +6,8 @@ composition, composition6. Constrained (holonomic Phi(q) = 0): rattle, constrain
 constrained_implicit_euler, spook (regularized), index1 (the acceleration-level bad example).
 Nonsmooth elements: nonsmooth_euler.
 core/: what they share: run_loop.py holds the run loop, layout.py the layout of its buffers;
-registry.py lists the methods (registry.METHODS, registry.INFO), codegen.glue writes the cached
-``run_<method>`` glue into generated modules; lagrange_gen.simulate is the Python driver.
+registry.py lists the methods (registry.METHODS, registry.INFO); jit/specialized.py writes a
+generated module's cached ``run_<method>`` glue (codegen.glue's text); lagrange_gen.simulate is
+the Python driver.
 The steppers import jit and numpy, never sympy, derive or codegen.
 """

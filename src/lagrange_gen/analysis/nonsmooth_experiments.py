@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .play import loop_area, play_operator
+from ..nonsmooth.play import loop_area, play_operator
 
 
 def restoring_force(t, v, h, F, m, c):
