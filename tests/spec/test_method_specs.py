@@ -33,7 +33,7 @@ def test_spec_is_complete(method):
     spec = registry.spec(method)
     assert spec.name == method and spec.family in FAMILIES and spec.order >= 1
     assert spec.summary and "blowup_bound" in spec.settings._fields
-    assert all(isinstance(w, int) or w in ("n", "m", "m1", "ne", "c", "r")
+    assert all(isinstance(w, int) or w in ("n", "m", "m1", "ne", "c", "r", "r1")
                for _, w in spec.saved)
     if not (spec.constraints or spec.elements or spec.adaptive or spec.contacts
             or spec.nonholonomic):

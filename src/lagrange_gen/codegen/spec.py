@@ -207,10 +207,11 @@ CONSTRAINED_NONHOLONOMIC_LINEARIZE = ("constraint_dq", "constraint_gamma_dq")
 def nonholonomic_kernels(dyn) -> dict:
     """The ``nonholonomic`` kernel of a model with velocity constraints and the derivatives
     linearize needs (``nonholonomic_dq``; ``constraint_gamma_dq`` with holonomic constraints
-    too); {} without velocity constraints."""
-    if not dyn.n_nonholonomic:
-        return {}
+    too). Without velocity constraints: a ``nonholonomic`` kernel of 0 rows for a model with
+    contacts (moreau_jean treats velocity constraints beside contacts and reaches it), else {}."""
     nat, o = dyn.native, dyn.ops
+    if not dyn.n_nonholonomic:
+        return {"nonholonomic": lambda: _nonholonomic_kernel(nat)} if dyn.n_contacts else {}
     q, qd = o.symbols(dyn.q), o.symbols(dyn.qd)
 
     def derivatives():
@@ -229,15 +230,18 @@ def nonholonomic_kernels(dyn) -> dict:
             [Output("dgamma_dq", d["dgamma_dq"]), Output("dgamma_dqd", d["dgamma_dqd"])],
             doc="d gamma/dq and d gamma/dqd (m, n) of the holonomic constraints (J qdd = gamma)")
 
-    table = {"nonholonomic": lambda: KernelSpec(
-        "nonholonomic", ["q", "qd", "t", "p"],
-        [Output("A", nat["nh_A"]), Output("b", nat["nh_b"]), Output("gamma", nat["nh_gamma"])],
-        doc="nonholonomic constraints A qd + b = 0: A(q, t) (r, n), b(q, t) (r,), gamma (r,) "
-            "with A qdd = gamma along a motion"),
-             "nonholonomic_dq": derivatives}
+    table = {"nonholonomic": lambda: _nonholonomic_kernel(nat), "nonholonomic_dq": derivatives}
     if dyn.m:
         table["constraint_gamma_dq"] = gamma_derivatives
     return table
+
+
+def _nonholonomic_kernel(nat):
+    return KernelSpec(
+        "nonholonomic", ["q", "qd", "t", "p"],
+        [Output("A", nat["nh_A"]), Output("b", nat["nh_b"]), Output("gamma", nat["nh_gamma"])],
+        doc="nonholonomic constraints A qd + b = 0: A(q, t) (r, n), b(q, t) (r,), gamma (r,) "
+            "with A qdd = gamma along a motion")
 
 
 def column_kernels(dyn) -> dict:

@@ -22,7 +22,8 @@ __all__ = ["check_nonholonomic"]
 def check_nonholonomic(model):
     """ModelError (one line, naming the model and the constraint) when a nonholonomic constraint
     has no velocity in it, has a term that is not linear in the velocities (the term is named),
-    or the model also has nonsmooth elements or contacts (no method treats those together yet).
+    or the model also has nonsmooth elements (no method treats those together yet; contacts
+    beside them run with moreau_jean).
     Holonomic constraints may come with them (the rolling wheels of a bicycle)."""
     qd = set(model.velocities)
     for i, c in enumerate(model.nonholonomic):
@@ -36,11 +37,10 @@ def check_nonholonomic(model):
                              "as A(q, t) . qdot + b(q, t)")
     if not model.nonholonomic:
         return
-    others = [what for what, count in (("nonsmooth elements", len(model.elements)),
-                                       ("contacts", len(model.contacts))) if count]
-    if others:
-        raise ModelError(f"model {model.name}: nonholonomic constraints together with "
-                         f"{' and '.join(others)} are not supported by any method yet")
+    if model.elements:
+        raise ModelError(f"model {model.name}: nonholonomic constraints together with nonsmooth "
+                         "elements are not supported by any method yet (contacts are: "
+                         "moreau_jean)")
 
 
 def nonlinear_term(expr, velocities):

@@ -180,6 +180,9 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
         from .contact_start import contact_start
         q, v = contact_start(module, q, v, p, t0, penetration, stacklevel=3)
         initial = np.zeros(n_saved)
+        if getattr(module, "N_NONHOLONOMIC", 0):   # v0 onto A v + b = 0 (moreau_jean)
+            from .consistent import nonholonomic_start
+            q, v = nonholonomic_start(module, q, v, p, t0, stacklevel=3)
         if constrained:          # the constrained fields come last (contact_kkt.CONTACT_SAVED)
             q, v, start = _constrained_start(module, q, v, p, t0, 1e-12, keep)
             initial[n_saved - start.shape[0]:] = start

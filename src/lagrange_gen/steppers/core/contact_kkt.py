@@ -41,6 +41,14 @@ CONTACT_SAVED = (("active_contacts", 1), ("normal_impulse", "c"), ("tangent_impu
                  ("constraint_error", "m1"), ("velocity_constraint_error", "m1"))
 
 
+#: CONTACT_SAVED of a contact method that also treats nonholonomic constraints (moreau_jean):
+#: their multipliers (r) and max|A v + b| at the end of the step (1 with nonholonomic
+#: constraints, 0 without) before the holonomic fields, which stay last.
+NONHOLONOMIC_CONTACT_SAVED = (CONTACT_SAVED[:6] + (("nonholonomic_multipliers", "r"),
+                                                   ("nonholonomic_error", "r1"))
+                              + CONTACT_SAVED[6:])
+
+
 @njit(inline="always")
 def min_gap(g):
     """The smallest entry of g (c,) (inf for no contacts)."""

@@ -20,7 +20,8 @@ method names. A spec says:
 * ``saved``: the named fields the method saves per output row besides (t, q, v, energy, Newton
   iterations and residual), in the order of its ``extra`` buffer, each with a width given as a
   count name (``"m"`` constraints, ``"m1"`` 1 with constraints and 0 without, ``"ne"``
-  elements, ``"c"`` contacts, ``"r"`` nonholonomic constraints, ``"n"`` coordinates) or an int;
+  elements, ``"c"`` contacts, ``"r"`` nonholonomic constraints, ``"r1"`` 1 with nonholonomic
+  constraints and 0 without, ``"n"`` coordinates) or an int;
 * ``adaptive``: the method chooses its own steps (error control, dense output); its glue has the
   adaptive signature (codegen/glue.py).
 
@@ -114,6 +115,9 @@ class Spec:
     #: A nonholonomic or contact method that also treats holonomic constraints beside the
     #: velocity constraints or the contacts.
     holonomic_too: bool = False
+    #: A contact method that also treats nonholonomic (velocity) constraints beside the
+    #: contacts, as rigid equality rows of its step (a bicycle that falls onto the floor).
+    nonholonomic_too: bool = False
     saved: tuple = ()
     limits: dict = field(default_factory=dict)
     adaptive: bool = False
@@ -135,7 +139,7 @@ class Spec:
     def saved_layout(self, n: int, m: int, ne: int, nc: int = 0, nr: int = 0) -> tuple:
         """((name, start, width), ...) of the saved fields in the extra buffer (nc contacts,
         nr nonholonomic constraints)."""
-        counts = {"n": n, "m": m, "m1": min(m, 1), "ne": ne, "c": nc, "r": nr}
+        counts = {"n": n, "m": m, "m1": min(m, 1), "ne": ne, "c": nc, "r": nr, "r1": min(nr, 1)}
         layout, start = [], 0
         for name, width in self.saved:
             w = counts[width] if isinstance(width, str) else int(width)

@@ -70,9 +70,18 @@ def inapplicable(method: str, n_constraints: int, n_elements: int, n_contacts: i
                  n_nonholonomic: int = 0) -> str:
     """Why ``method`` (after runs_as) does not apply to a model with these counts, or ""."""
     flags = INFO[method]
-    if n_nonholonomic and (n_elements or n_contacts):
-        return ("nonholonomic constraints together with nonsmooth elements or contacts are not "
-                "supported by any method yet")
+    if n_nonholonomic and n_elements:
+        return ("nonholonomic constraints together with nonsmooth elements are not supported by "
+                "any method yet")
+    if n_nonholonomic and n_contacts:
+        both = [m for m in METHODS if INFO[m].contacts and INFO[m].nonholonomic_too
+                and (INFO[m].holonomic_too or not n_constraints)]
+        if not flags.nonholonomic_too:
+            what = ("ignores the model's unilateral contacts" if flags.nonholonomic else
+                    "does not treat nonholonomic constraints beside contacts")
+            return f"it {what} (use {', '.join(both) or 'no method yet'})"
+        return "" if not n_constraints or flags.holonomic_too else (
+            f"it does not treat holonomic constraints beside contacts (use {', '.join(both)})")
     if bool(n_nonholonomic) != flags.nonholonomic:
         fits = [m for m in NONHOLONOMIC_METHODS if INFO[m].holonomic_too or not n_constraints]
         return (f"it ignores the model's nonholonomic constraints (use "

@@ -45,6 +45,13 @@ sqrt(1 - theta) < 1, so |Phi| stays O(h^2), reported as constraint_error). The c
 act on the constrained motion: D = W K^-1 W^T (core/contact_kkt.py), and the constraint
 impulses follow the contact impulses exactly. The multipliers saved are lam = nu / h.
 
+Nonholonomic constraints A(q, t) v + b(q, t) = 0 (r rows, forces A^T mu; a wheel rolling on the
+floor) join the same system as r more rigid rows after the holonomic ones, with A and b at
+(q, t + h) and the target A v+ + b = 0: the step's end velocity satisfies them exactly for the
+step's configuration (as W and the contact rows, A is not updated within the step), so
+|A v + b| at the next configuration is O(h) times the speed of A's change and does not grow
+(reported as nonholonomic_error). Contacts then act on the motion both kinds of rows allow.
+
 Order 1 (impacts located to within a step). theta = 1/2 (default) is energy-neutral in free
 flight; the work of the contact impulses per step is r . (W v + W v+) / 2 (the kinetic energy
 change an impulse causes; the surface's own velocity b is not part of it), and for forces that do not depend on q and v
@@ -56,7 +63,10 @@ Positions may go below the gap by O(h |u_N|) at an impact (the impulse acts on v
 (1), normal impulses p_N (c), tangential impulses p_T1 (c), p_T2 (c) (zero with one tangent),
 the smallest gap at the end of the step (1), the cumulated work of the contact impulses (1);
 with holonomic constraints the multipliers (m), max|Phi| and max|J v + dPhi/dt| at the end of
-the step. The step returns (status, sweeps, last sweep's largest change).
+the step; with nonholonomic constraints, between the contact fields and the holonomic ones,
+their multipliers (r) and max|A v + b| at the end of the step
+(core/contact_kkt.NONHOLONOMIC_CONTACT_SAVED). The step returns (status, sweeps, last sweep's
+largest change).
 """
 
 from collections import namedtuple
@@ -67,7 +77,7 @@ from ...jit.cache import njit
 
 from ..core.options import FAST, inline_step
 from ..core.constrained import constraint_rate
-from ..core.contact_kkt import (CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
+from ..core.contact_kkt import (NONHOLONOMIC_CONTACT_SAVED, apply_impulses, assemble_constraint_rows,
                                 contact_prepare, impulse_work, pad_rows,
                                 record_constraints, record_contacts, row_dot, solve_contacts)
 from ..core.contact_lcp import lcp_arrays
@@ -76,10 +86,11 @@ from ..core.method_spec import Spec
 from ..core.solve import failed_solve_status
 from ..core.status import OK
 
-#: Scratch of one run (n coordinates, m constraints, c contacts, N = n + m, R = 3c rows). x the
-#: unknown (v+ - v, nu), then (v+, nu) (N,); solver scratch s and pivots piv (N,); the
-#: iteration matrix K (N, N) (LU-factored in place); (n,): rhs f; (n, n): H, d rhs/dq Jq,
-#: d rhs/dv Jqd; phi, gam (m,), G (m, n); (c,): gaps g, relative normal velocities before the
+#: Scratch of one run (n coordinates, m constraints, r nonholonomic constraints, c contacts,
+#: N = n + m + r, R = 3c rows). x the unknown (v+ - v, nu, mu), then (v+, nu, mu) (N,); solver
+#: scratch s and pivots piv (N,); the iteration matrix K (N, N) (LU-factored in place); (n,):
+#: rhs f; (n, n): H, d rhs/dq Jq, d rhs/dv Jqd; phi, gam (m,), G (m, n); the equality rows
+#: E (m + r, n) (G, then A); A (r, n), b and its gamma nb, ng (r,); (c,): gaps g, relative normal velocities before the
 #: step un, active flag of each contact; W_N (c, n), W_T (2c, n) and their copies padded to N
 #: columns WNp, WTp; coef (c, 2) = (e, mu); (R,): impulses r = (p_N, p_T1, p_T2), free local
 #: velocities uf, law (every contact UNILATERAL / COULOMB, core/contact_problem.py), the surface
@@ -87,8 +98,8 @@ from ..core.status import OK
 #: Delassus matrix; lcp_B, lcp_C, lcp_T, lcp_z, lcp_basis the exact fallback's scratch
 #: (core/contact_lcp.lcp_arrays).
 Workspace = namedtuple("Workspace",
-                       "x s piv K f H Jq Jqd phi gam G g un active WN WT WNp WTp coef r uf law Y D "
-                       "bias bias_end lcp_B lcp_C lcp_T lcp_z lcp_basis")
+                       "x s piv K f H Jq Jqd phi gam G E A nb ng g un active WN WT WNp WTp coef r "
+                       "uf law Y D bias bias_end lcp_B lcp_C lcp_T lcp_z lcp_basis")
 
 
 class MoreauJeanSettings(NamedTuple):
@@ -103,12 +114,13 @@ class MoreauJeanSettings(NamedTuple):
 @njit
 def workspace(kern, n):
     """Allocated once per run by run_loop.run_loop."""
-    m, c = kern.N_CONSTRAINTS, kern.N_CONTACTS
-    N, T = n + m, 2 * c               # T: the rows of W_T, two tangents per contact
+    m, c, nr = kern.N_CONSTRAINTS, kern.N_CONTACTS, kern.N_NONHOLONOMIC
+    N, T = n + m + nr, 2 * c          # T: the rows of W_T, two tangents per contact
     R = c + T
     return Workspace(np.zeros(N), np.zeros(N), np.zeros(N, np.int64), np.zeros((N, N)),
                      np.zeros(n), np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros(m), np.zeros(m), np.zeros((m, n)), np.zeros(c), np.zeros(c),
+                     np.zeros(m), np.zeros(m), np.zeros((m, n)), np.zeros((m + nr, n)),
+                     np.zeros((nr, n)), np.zeros(nr), np.zeros(nr), np.zeros(c), np.zeros(c),
                      np.zeros(c), np.zeros((c, n)), np.zeros((T, n)), np.zeros((c, N)),
                      np.zeros((T, N)), np.zeros((c, 2)), np.zeros(R), np.zeros(R),
                      np.zeros(R, np.int64), np.zeros((R, N)), np.zeros((R, R)), np.zeros(R),
@@ -122,10 +134,10 @@ prepare = contact_prepare
 @njit(inline=inline_step, **FAST)
 def step(kern, q, v, mom, t, h, p, settings, ws, extra):
     """One step from (q, v) at t, in place. Returns (status, Gauss-Seidel sweeps, last change)."""
-    n, m, c = kern.N_COORDS, kern.N_CONSTRAINTS, kern.N_CONTACTS
-    N, R = n + m, ws.r.shape[0]
+    n, m, c, nr = kern.N_COORDS, kern.N_CONSTRAINTS, kern.N_CONTACTS, kern.N_NONHOLONOMIC
+    N, R = n + m + nr, ws.r.shape[0]
     theta = settings.theta
-    x, K, G, phi, gam, WN, WT = ws.x, ws.K, ws.G, ws.phi, ws.gam, ws.WN, ws.WT
+    x, K, G, phi, gam, WN, WT, E, A = ws.x, ws.K, ws.G, ws.phi, ws.gam, ws.WN, ws.WT, ws.E, ws.A
     kern.dynamics(q, v, t + theta * h, p, ws.H, ws.f)
     kern.rhs_jacobian(q, v, t + theta * h, p, ws.Jq, ws.Jqd)
     for i in range(n):
@@ -136,12 +148,20 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         x[i] = s
     kern.constraints(q, v, t, p, phi, G, gam)
     constraint_rate(kern, q, t, p, gam)                # gam: dPhi/dt
-    assemble_constraint_rows(K, n, G, 0.0)
+    kern.nonholonomic(q, v, t + h, p, A, ws.nb, ws.ng)
     for k in range(m):                                 # G (v+ - v) = -Phi / h - dPhi/dt - G v
         s = -phi[k] / h - gam[k]
         for j in range(n):
+            E[k, j] = G[k, j]
             s -= G[k, j] * v[j]
         x[n + k] = s
+    for k in range(nr):                                # A (v+ - v) = -b - A v
+        s = -ws.nb[k]
+        for j in range(n):
+            E[m + k, j] = A[k, j]
+            s -= A[k, j] * v[j]
+        x[n + m + k] = s
+    assemble_constraint_rows(K, n, E, 0.0)
     if not lu_inplace(K, ws.piv):
         return failed_solve_status(K), 0, 0.0
     lu_solve_inplace(K, ws.piv, x, ws.s)
@@ -179,10 +199,31 @@ def step(kern, q, v, mom, t, h, p, settings, ws, extra):
         v[i] = x[i]
     kern.contacts(q, t + h, p, ws.g, WN, WT, ws.coef)
     record_contacts(extra, n_active, ws.r, ws.g, work)
+    kern.nonholonomic(q, v, t + h, p, A, ws.nb, ws.ng)
+    record_nonholonomic(extra, R + 3, x, n + m, 1.0 / h, A, ws.nb, v)
     kern.constraints(q, v, t + h, p, phi, G, gam)
     constraint_rate(kern, q, t + h, p, gam)
-    record_constraints(extra, R + 3, x, n, 1.0 / h, phi, G, v, gam)
+    record_constraints(extra, R + 3 + nr + min(nr, 1), x, n, 1.0 / h, phi, G, v, gam)
     return OK, sweeps, change
+
+
+@njit(inline="always")
+def record_nonholonomic(extra, start, x, at, scale, A, b, v):
+    """The nonholonomic fields of extra from index start (nothing without them): the
+    multipliers x[at + k] * scale (r), then max|A v + b| (A (r, n), b (r,) at the end of the
+    step)."""
+    nr = b.shape[0]
+    if nr == 0:
+        return
+    worst = 0.0
+    for k in range(nr):
+        extra[start + k] = x[at + k] * scale
+        s = b[k]
+        for j in range(v.shape[0]):
+            s += A[k, j] * v[j]
+        if abs(s) > worst or s != s:
+            worst = abs(s)
+    extra[start + nr] = worst
 
 
 SPEC = Spec(
@@ -190,10 +231,10 @@ SPEC = Spec(
     symmetric=False,
     summary="Moreau-Jean time stepping: impacts (Newton) and Coulomb friction as impulses, "
             "projected Gauss-Seidel",
-    contacts=True, holonomic_too=True, constraint_drift="bounded",
-    saved=CONTACT_SAVED,
+    contacts=True, holonomic_too=True, nonholonomic_too=True, constraint_drift="bounded",
+    saved=NONHOLONOMIC_CONTACT_SAVED,
     limits={"theta": (0.0, False, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
     settings=MoreauJeanSettings,
     kernels=("constraint_rate", "constraints", "contact_bias", "contacts", "dynamics",
-             "rhs_jacobian"))
+             "nonholonomic", "rhs_jacobian"))
