@@ -144,3 +144,29 @@ def test_layout_sizes_from_python_compile_nothing():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["0"]
+
+
+def test_a_line_written_while_the_notice_is_open_gets_a_line_of_its_own(monkeypatch, capsys):
+    """A warning written while a call compiles (an unreadable cache entry found by a callee's
+    compile) ends the notice's line first; the notice then ends on a line naming the glue again
+    (before, the warning was glued to "... (first use) ..." and " done in" stood alone)."""
+    import sys
+    monkeypatch.setattr(compile_notice, "NOTICE_AFTER_S", 0.0)
+    work = _compiling_glue()
+
+    def run(*args):
+        deadline = time.perf_counter() + 5.0
+        work()                                  # compiles: the notice's timer starts
+        while time.perf_counter() < deadline and not compile_notice._OPEN.notice.shown:
+            time.sleep(0.01)
+        compile_notice.end_open_lines()
+        sys.stderr.write("lagrange-gen: warning: something while compiling\n")
+        return 0, 0, 0
+
+    _fixed_warm_up(run)
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0] == "lagrange-gen: compiling run_rattle for four_bar (first use) ...", lines
+    assert lines[1] == "lagrange-gen: warning: something while compiling", lines
+    assert re.fullmatch(r"lagrange-gen: compiling run_rattle for four_bar done in \d+\.\d s",
+                        lines[2]), lines
+    assert len(lines) == 3, lines

@@ -207,6 +207,8 @@ def _discard_entry(cache, exc):
     source = source.co_filename if source else "?"
     if source not in _WARNED:
         _WARNED.add(source)
+        from .compile_notice import end_open_lines
+        end_open_lines()
         if _written_at_another_path(exc):
             print(f"lagrange-gen: warning: numba cache of {source} was written where the file "
                   f"was before (the project moved or was copied); removed {removed} file(s) in "

@@ -81,11 +81,13 @@ class first_use_notice:
     four_bar"); prints the notice on ``stream`` (default sys.stderr) only if numba compiles
     inside it and the call outlasts NOTICE_AFTER_S."""
 
-    __slots__ = ("label", "stream", "start", "lock", "timer", "shown", "returned", "around")
+    __slots__ = ("label", "stream", "start", "lock", "timer", "shown", "returned", "around",
+                 "broken")
 
     def __init__(self, label, stream=None):
         self.label, self.stream = label, stream
         self.timer, self.shown, self.returned, self.around = None, False, False, None
+        self.broken = False
 
     def __enter__(self):
         if not _LISTENING:
@@ -113,6 +115,18 @@ class first_use_notice:
                 stream.flush()
                 self.shown = True
 
+    def end_line(self):
+        """Another line is about to be written (a warning while this call compiles): end the
+        notice's line now; its end is then a line of its own."""
+        if self.timer is None:
+            return
+        with self.lock:
+            if self.shown and not self.returned and not self.broken:
+                stream = self.stream or sys.stderr
+                stream.write("\n")
+                stream.flush()
+                self.broken = True
+
     def __exit__(self, kind, value, traceback):
         _OPEN.notice = self.around
         if self.timer is None:
@@ -126,6 +140,16 @@ class first_use_notice:
             if self.shown:
                 stream = self.stream or sys.stderr
                 outcome = "done in" if kind is None else "failed after"
-                stream.write(f" {outcome} {time.perf_counter() - self.start:.1f} s\n")
+                opening = f"lagrange-gen: compiling {self.label}" if self.broken else ""
+                stream.write(f"{opening} {outcome} {time.perf_counter() - self.start:.1f} s\n")
                 stream.flush()
         return False
+
+
+def end_open_lines():
+    """End the line of every notice shown in this thread and still open (first_use_notice.
+    end_line): call before writing another line to stderr while a compile may be announced."""
+    notice = getattr(_OPEN, "notice", None)
+    while notice is not None:
+        notice.end_line()
+        notice = notice.around
