@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from lagrange_gen.codegen import generate_model
-from lagrange_gen.jit import compile_notice, first_run, interpreted, portable
+from lagrange_gen.jit import compile_notice, first_run, folders, interpreted, portable
 from lagrange_gen.run import fixed_driver
 from lagrange_gen.run.loader import import_generated
 from lagrange_gen.run.simulate import simulate
@@ -215,7 +215,7 @@ def test_a_python_only_exception_becomes_the_failure_value():
 
 
 def test_expected_compile_seconds_default_and_record(tmp_path, monkeypatch):
-    monkeypatch.setattr(portable, "portable_dir", lambda: tmp_path)
+    monkeypatch.setattr(folders, "portable_dir", lambda: tmp_path)
     assert first_run.expected_compile_seconds("rk4") == first_run.DEFAULT_COMPILE_S
     first_run.record_compile_seconds("rk4", 4.5)
     first_run.record_compile_seconds("verlet", 12.0)

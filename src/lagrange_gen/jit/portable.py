@@ -18,9 +18,9 @@ when numba's cache already holds it, and otherwise starts portable and switches 
 glue between chunks when the run is long enough to pay for its compile (run/fixed_driver.py).
 
 Layout: the portable glue sources (codegen.glue.portable_glue_source) are written to
-``portable_dir()/<library hash>/`` (jit/folders.py); the hash covers every package file the glue compiles, so a
-changed library gives new files and numba never loads a stale entry (numba's cache checks only
-the glue file itself). A version directory no process has used for UNUSED_DAYS is removed when
+``portable_dir()/<library hash>/`` (jit/folders.py); the hash covers every package file the glue
+compiles, so a changed library gives new files and numba never loads a stale entry (numba's
+cache checks only the glue file itself). A version directory no process has used for UNUSED_DAYS is removed when
 a new one is made (remove_unused_versions), so upgrades do not pile up compiled glue.
 
 Over 300 lines with its documentation (a fifth of the module): the kernel table, its cache
