@@ -49,9 +49,9 @@ def glue_attribute(module_name, name):
     method, a method the module was not generated for)."""
     module = sys.modules.get(module_name)
     method = None if module is None else method_of(module, name)
-    if method is None or not hasattr(glue_module(module, method), name):
+    value = None if method is None else getattr(glue_module(module, method), name, None)
+    if value is None:
         raise AttributeError(f"module {module_name!r} has no attribute {name!r}")
-    value = getattr(glue_module(module, method), name)
     setattr(module, name, value)
     return value
 
