@@ -10,6 +10,9 @@ module, LAGRANGE_GEN_BACKGROUND_COMPILE=0 (nothing else runs) and LAGRANGE_GEN_I
   compiled too;
 - ``library``: caches already holding the glue of the method, compiled by a run of the same
   method on ANOTHER model (WARMUP): what every new model but the first pays (its own kernels);
+  for a controlled run, the portable controlled glue compiled by ANOTHER model's run with
+  ANOTHER controller (WARMUP_CONTROL, jit="portable": what the background compile leaves a user
+  after a first controlled run), so the case's own controller is new;
 - ``again``: a new process on the ``library`` run's caches and module (nothing new);
 - ``empty, numba`` and ``library, numba``: the same with $LAGRANGE_GEN_NATIVE=0 (the model's
   kernels compiled by numba, the path before native kernels).
@@ -63,6 +66,9 @@ class Case:
     variants: tuple = ("empty", "library", "again")
     after: str = None
     timeout: float = 300.0
+    jit: str = "auto"
+    #: gains (kp, kd) of the controller of a "control" case, u = kp q[1] + kd qd[1]
+    gains: tuple = (20.0, 3.0)
 
 
 #: upright straight running of the bicycle at 4 m/s (tests/rolling/test_bicycle_benchmark.py)
@@ -107,6 +113,10 @@ WARMUP = {"dop853_impacts": ("rocking_block", None, None),
           "nonholonomic_midpoint": ("rolling_disk", (0.0, 0.0, 0.3, 0.0),
                                (2 * math.cos(0.3), 2 * math.sin(0.3), 1.5, 4.0))}
 WARMUP_DEFAULT = ("double_pendulum", (0.1, 0.2), None)
+#: The warm-up of a controlled case: another model with an input, another controller (gains),
+#: the portable controlled glue compiled (jit="portable").
+WARMUP_CONTROL = Case("warm-up cart_pendulum_forced", "cart_pendulum_forced", "midpoint",
+                      kind="control", q0=(0.0, 0.2), jit="portable", gains=(10.0, 1.0))
 
 #: The issue's goals: (case, before, goal, seconds or None, label of the case and variant
 #: judged, why that variant).
@@ -222,12 +232,14 @@ class Workspace:
 
     def library(self, case, native):
         """The caches holding ``case.method``'s glue, compiled by a WARMUP model's run."""
-        kind = "linearize" if case.kind == "linearize" else "simulate"
+        kind = case.kind if case.kind in ("linearize", "control") else "simulate"
         key = (case.method, kind, native)
         if key not in self.libraries:
             dirs = self.dirs(f"library-{case.method}-{kind}-{'native' if native else 'numba'}")
             stem, q0, v0 = WARMUP.get(case.method, WARMUP_DEFAULT)
             warm = Case(f"warm-up {stem}", stem, case.method, kind=kind, q0=q0, v0=v0)
+            if kind == "control":
+                warm, stem = WARMUP_CONTROL, WARMUP_CONTROL.stem
             row = run_child(child_spec(warm, self.models_dir, dirs["numba"].parent / "gen"),
                             child_env(dirs, native), case.timeout, dirs["numba"].parent)
             self.libraries[key] = (dirs, row)
@@ -260,7 +272,7 @@ class Workspace:
 def child_spec(case, models_dir, gen_dir):
     return {"model": str(Path(models_dir) / f"{case.stem}.py"), "options": case.options,
             "method": case.method, "kind": case.kind, "q0": case.q0, "v0": case.v0,
-            "out_dir": str(gen_dir)}
+            "out_dir": str(gen_dir), "jit": case.jit, "gains": list(case.gains)}
 
 
 def describe(row):
@@ -369,12 +381,15 @@ def _kernel_stats(table):
     return stats
 
 
-def _controller():
+def _controller(gains):
+    """A PD law on the pole angle, a force on the cart: u = kp q[1] + kd qd[1]; the gains are
+    constants of the function (another pair: another controller)."""
     from numba import njit
+    kp, kd = (float(g) for g in gains)
 
     @njit
-    def balance(t, q, qd, p):          # a PD law on the pole angle, a force on the cart
-        return 20.0 * q[1] + 3.0 * qd[1]
+    def balance(t, q, qd, p):
+        return kp * q[1] + kd * qd[1]
     return balance
 
 
@@ -417,8 +432,9 @@ def _child(spec):
         phases.done("kernels")
         result.update(_kernel_stats(table))
     phases.enter("first simulate")
-    control = _controller() if kind == "control" else None
-    traj = simulate(mod, method, q0, v0, t_end=FIRST_STEPS * H, h=H, control=control)
+    control = _controller(spec.get("gains", (20.0, 3.0))) if kind == "control" else None
+    traj = simulate(mod, method, q0, v0, t_end=FIRST_STEPS * H, h=H, control=control,
+                    jit=spec.get("jit", "auto"))
     phases.done("first simulate")
     result.update(jit=str(traj.jit), final_finite=bool(np.isfinite(traj.q[-1]).all()),
                   numba_compiles=dict(compiles))

@@ -108,7 +108,6 @@ def write_versioned(folder: Path, name: str, source: str) -> Path:
     except OSError:                    # a shared directory we may not touch: it is only a mark
         pass
     if not path.is_file() or path.read_text() != source:
-        from .native import write_atomic
         write_atomic(path, source.encode())
     return path
 
@@ -134,3 +133,20 @@ def remove_unused_versions(current: Path) -> list:
         except OSError:                # another process removed or is writing it: leave it
             pass
     return removed
+
+
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in its folder (made if missing) and
+    a rename: a reader sees the old file or the new one, never a part."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise

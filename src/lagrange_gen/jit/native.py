@@ -26,12 +26,12 @@ import functools
 import hashlib
 import json
 import os
-import tempfile
 import threading
 from pathlib import Path
 
 from . import native_ir
 from .env import env_flag
+from .folders import write_atomic
 from .native_ir import LIBM_SYMBOLS, ModuleBuilder, Unsupported, function_source
 
 #: Environment variable that turns native kernels off ("0", "off", "no", "false").
@@ -180,23 +180,6 @@ def kernel_arg_types(fn):
     names = list(inspect.signature(fn).parameters)
     return tuple(types.float64 if a == "t" else types.float64[:, ::1] if a in ALWAYS_2D
                  else types.float64[::1] for a in names)
-
-
-def write_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in its folder (made if missing) and
-    a rename: a reader sees the old file or the new one, never a part."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def lower_kernel(fn, arg_kinds, name="kernel"):

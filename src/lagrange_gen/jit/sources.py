@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import ast
 import hashlib
+import json
 from functools import lru_cache
 from pathlib import Path
 
@@ -63,16 +64,68 @@ def source_closure(roots) -> tuple:
     Package ``__init__`` files are not followed: they run at import, numba compiles nothing
     from them."""
     seen, files, todo = set(), [], list(roots)
+    known = _import_memo()
+    size = len(known)
     while todo:
         dotted = todo.pop()
         path = module_path(dotted)
         if dotted in seen or path is None or path.name == "__init__.py":
             continue
         seen.add(dotted)
-        files.append(path.relative_to(_PACKAGE).as_posix())
+        relative = path.relative_to(_PACKAGE).as_posix()
+        files.append(relative)
         stat = path.stat()
-        todo += _imports_of(dotted, str(path), stat.st_mtime_ns, stat.st_size)
+        digest = _file_hash(str(path), stat.st_mtime_ns, stat.st_size)
+        if known.get(relative, (None,))[0] != digest:
+            known[relative] = (digest, list(_imports_of(dotted, str(path), stat.st_mtime_ns, stat.st_size)))
+        todo += known[relative][1]
+    if len(known) != size or _IMPORT_MEMO["changed"]:
+        _save_import_memo(known)
     return tuple(sorted(files))
+
+
+#: The import graph of the package files, by file and content hash: {relative path: (sha256
+#: prefix, imported modules)}, kept on disk (IMPORT_MEMO_FILE in the portable folder) so that a
+#: new process reads it instead of parsing every file its glue compiles from; "changed": an
+#: entry was replaced in this process.
+_IMPORT_MEMO = {"entries": None, "changed": False}
+
+#: File name of the import graph's memo in the portable folder.
+IMPORT_MEMO_FILE = "imports.json"
+
+
+def _import_memo() -> dict:
+    """The import graph's memo, read from disk once per process ({} when missing or unreadable:
+    every file is parsed)."""
+    if _IMPORT_MEMO["entries"] is None:
+        entries = {}
+        try:
+            from .folders import portable_dir
+            raw = json.loads((portable_dir() / IMPORT_MEMO_FILE).read_text())
+            entries = {str(k): (str(v[0]), [str(m) for m in v[1]]) for k, v in raw.items()}
+        except (OSError, ValueError, TypeError, IndexError, AttributeError):
+            pass
+        _IMPORT_MEMO["entries"] = _TrackedDict(entries)
+    return _IMPORT_MEMO["entries"]
+
+
+class _TrackedDict(dict):
+    """A dict that notes, in _IMPORT_MEMO, that an entry was replaced (a file edited)."""
+
+    def __setitem__(self, key, value):
+        if key in self:
+            _IMPORT_MEMO["changed"] = True
+        super().__setitem__(key, value)
+
+
+def _save_import_memo(entries):
+    """Write the memo atomically; a folder that cannot be written keeps none (a memo only)."""
+    try:
+        from .folders import portable_dir, write_atomic
+        write_atomic(portable_dir() / IMPORT_MEMO_FILE, json.dumps(entries, sort_keys=True).encode())
+        _IMPORT_MEMO["changed"] = False
+    except OSError:
+        pass
 
 
 @lru_cache(maxsize=None)

@@ -21,8 +21,11 @@ p; c = control_params, empty without them), a Signal's is one library function
 (_signal_apply, cached by numba) whose c is the samples as data (signal_data). So the loop
 compiled for one hook runs them all: the portable controlled glue (jit/portable.py,
 ``run_<method>_controlled``), compiled once per method and cached on disk by numba, reaches the
-hook through a function pointer, and a new process running a new controller compiles only the
-controller and its wrapper (fractions of a second). The specialized loop of (module, method,
+hook through a function pointer. A controller's hooks (the wrapper, and the probe that checks its
+value at the initial state) are written to a file named after the controller's content key
+(run/controller_hooks.py, jit/function_key.py) and cached by numba there: a new process running
+a controller it ran before compiles nothing, a new controller compiles only itself and its
+hooks. The specialized loop of (module, method,
 hook) (controlled_run: the hook inlined, faster per step, compiled in each process: numba does
 not cache code that receives a jitted function) runs under jit="specialized", and under "auto"
 when it is compiled in this process already or the portable controlled glue is not yet cached
@@ -132,6 +135,40 @@ def _write_inputs_impl(u, p):
     return impl
 
 
+def _value_into(u, out):
+    """(ndim, size) of a controller's value u (a float: (0, 1)), its first entries (flattened)
+    written into out: what the run checks before the loop writes u unchecked (jitted: see the
+    overload)."""
+
+
+@overload(_value_into, jit_options=FAST)
+def _value_into_impl(u, out):
+    if isinstance(u, (types.Float, types.Integer)):
+        def impl(u, out):
+            if out.shape[0]:
+                out[0] = u
+            return 0, 1
+    elif isinstance(u, types.Array):
+        def impl(u, out):
+            j = 0
+            for value in u.flat:
+                if j < out.shape[0]:
+                    out[j] = value
+                j += 1
+            return u.ndim, u.size
+    elif isinstance(u, types.BaseTuple):
+        def impl(u, out):
+            j = 0
+            for value in u:
+                if j < out.shape[0]:
+                    out[j] = value
+                j += 1
+            return 1, len(u)
+    else:
+        raise TypeError(f"a controller returns a float, a 1-D array or a tuple, not {u}")
+    return impl
+
+
 #: Entries of a Signal's data vector before its samples (signal_data).
 _SIGNAL_HEAD = 4
 
@@ -168,41 +205,29 @@ def _signal_apply(c, t, q, v, p):
     return changed
 
 
-_APPLY = {}
+_HOOKS = {}
 
 
 def make_apply(controller, with_params=False):
     """The hook apply(c, t, q, v, p) -> changed of a jitted controller u = f(t, q, qd, p)
     (c unused: an empty array), or with with_params u = f(t, q, qd, p, c): u written into the
-    last entries of p. One per controller (kept, so its compilation is reused); compiled with
+    last entries of p (controller_hooks: cached on disk by the controller's content, so a new
+    process running it compiles nothing). One per controller in a process; compiled with
     reference counting, which frees the array a controller may return at each step."""
+    return _hooks(controller, with_params).apply
+
+
+def _hooks(controller, with_params):
+    """controller_hooks.ControllerHooks of a jitted controller, made once per process."""
     if not hasattr(controller, "py_func"):
         raise SimulationError(f"control: {getattr(controller, '__name__', controller)!r} is not "
                               "numba-jitted; decorate it with @numba.njit (it runs inside the loop)")
     _check_arity(controller, with_params)
     key = (controller, with_params)
-    if key not in _APPLY:
-        # An exception raised by the controller cannot leave a hook called through a pointer
-        # (numba prints it and goes on): the hook writes NaN into the last input instead, which
-        # ends the run at that step with one line naming the controller (blame_inputs).
-        if with_params:
-            @njit(error_model="numpy")
-            def apply(c, t, q, v, p):
-                try:
-                    return _write_inputs(controller(t, q, v, p, c), p)
-                except Exception:
-                    p[p.shape[0] - 1] = np.nan
-                    return True
-        else:
-            @njit(error_model="numpy")
-            def apply(c, t, q, v, p):
-                try:
-                    return _write_inputs(controller(t, q, v, p), p)
-                except Exception:
-                    p[p.shape[0] - 1] = np.nan
-                    return True
-        _APPLY[key] = apply
-    return _APPLY[key]
+    if key not in _HOOKS:
+        from .controller_hooks import controller_hooks
+        _HOOKS[key] = controller_hooks(controller, with_params)
+    return _HOOKS[key]
 
 
 def _check_arity(controller, with_params=False):
@@ -384,14 +409,18 @@ def resolve_inputs(module, params, control, h, t0=0.0, q0=None, v0=None, control
 
 def _check_size(module, controller, t0, q0, v0, p, names, c=None):
     """The jitted loop writes a controller's value without bounds checks: its size must be
-    n_inputs, checked here once (the controller called from Python at the initial state)."""
-    args = (t0, np.array(q0, dtype=np.float64), np.array(v0, dtype=np.float64), p.copy())
-    u = np.atleast_1d(np.asarray(controller(*args) if c is None else controller(*args, c.copy())))
-    if u.ndim != 1 or u.shape[0] != len(names):
+    n_inputs, checked here once, at the initial state, by the controller's probe hook (compiled
+    with it, cached like it: controller_hooks)."""
+    probe = _hooks(controller, c is not None).probe
+    values = np.full(len(names), np.nan)
+    ndim, size = probe(np.zeros(0) if c is None else c.copy(), t0,
+                       np.ascontiguousarray(q0, dtype=np.float64),
+                       np.ascontiguousarray(v0, dtype=np.float64), p.copy(), values)
+    if ndim > 1 or size != len(names):
         raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns "
-                              f"{u.size} value(s) at t0 for {len(names)} input(s) "
+                              f"{size} value(s) at t0 for {len(names)} input(s) "
                               f"({', '.join(names)})")
-    bad = [f"{name} = {value!r}" for name, value in zip(names, u.tolist()) if not math.isfinite(value)]
+    bad = [f"{name} = {value!r}" for name, value in zip(names, values.tolist()) if not math.isfinite(value)]
     if bad:
         raise SimulationError(f"{module.NAME}: the controller {controller.__name__} returns a "
                               f"non-finite input at t0 = {t0:g}: input {', '.join(bad)}")
