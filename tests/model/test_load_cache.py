@@ -129,3 +129,16 @@ def test_a_model_that_reads_a_data_file_is_served_until_the_file_changes(tmp_pat
     mod = load(path, out_dir=out, methods=["rk4"])
     assert _runs(path) > ran
     assert mod.DEFAULTS == (5.0,)
+
+
+def test_generating_runs_the_model_file_once(tmp_path):
+    """load() decides what to generate from the Model the file gives and hands that Model to
+    the generator: a missing module, a stale one and a missing method each run the file once."""
+    path, out = _spring(tmp_path), tmp_path / "gen"
+    load(path, out_dir=out, methods=["rk4"])
+    assert _runs(path) == 1
+    load(path, out_dir=out, methods=["rk4", "midpoint"])
+    assert _runs(path) == 2
+    path.write_text(SPRING.replace("defaults=(float(k0),)", "defaults=(float(k0) + 1,)"))
+    assert load(path, out_dir=out, methods=["rk4"]).DEFAULTS == (3.0,)
+    assert _runs(path) == 3

@@ -32,7 +32,7 @@ def _label(model_path, options):
 
 
 def generate_model(model_path, out_dir=None, methods=None, options=None,
-                   freeze=None, force=False) -> GenerationResult:
+                   freeze=None, force=False, model=None) -> GenerationResult:
     """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched).
     out_dir None: keys.default_generated_dir of the model file.
 
@@ -41,15 +41,17 @@ def generate_model(model_path, out_dir=None, methods=None, options=None,
     (model_cache.generation_current) - is kept without running the model file or deriving:
     the result says ``current``. ``force`` derives and writes it again, and overwrites a file
     generated from another model file (or not by lagrange-gen), which is otherwise refused
-    (GenerationError naming both files)."""
+    (GenerationError naming both files). ``model``: the Model this model file gave with these
+    ``options``, when the caller has run it already (it is not run a second time)."""
     out_dir = default_generated_dir(model_path) if out_dir is None else out_dir
     if not force:
         known = generation_current(model_path, out_dir, methods, options, freeze)
         if known is not None:
             return GenerationResult(known, False, read_header(known)["KEY"], current=True)
     progress = Progress(_label(model_path, options))
-    with progress.stage("load model"):
-        model = load_model(model_path, **(options or {}))
+    if model is None or model.build_options != dict(options or {}):
+        with progress.stage("load model"):
+            model = load_model(model_path, **(options or {}))
     target = output_path(model.name, out_dir)
     if not force:
         refuse_overwrite(model_path, target, model.name)

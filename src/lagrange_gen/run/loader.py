@@ -67,20 +67,22 @@ def load(path, out_dir=None, methods=None, options=None, regenerate=True, freeze
     if known is not None:
         return import_generated(known)
     from ..codegen.generated_files import generate_model
-    target, plan = _plan(path, out_dir, methods, options, freeze, force)
+    target, plan, model = _plan(path, out_dir, methods, options, freeze, force)
     if plan is not None:
         why, build, methods, freeze, command = plan
         if not regenerate:
             raise StaleModuleError(f"{target} is {why}: run {command}")
-        generate_model(path, out_dir, methods, build, freeze, force=True)
+        generate_model(path, out_dir, methods, build, freeze, force=True, model=model)
     module = import_generated(target)
     model_cache.remember_module(path, out_dir, options, target)
     return module
 
 
 def _plan(path, out_dir, methods, options, freeze, force):
-    """(target, None) when the module on disk serves the request of load(), else (target,
-    (why, build, methods, freeze, command)) to generate with. Requested methods that do not
+    """(target, None, model) when the module on disk serves the request of load(), else (target,
+    (why, build, methods, freeze, command), model) to generate with; model: the Model the
+    model file's last run gave when its build is the one to generate (generation then does not
+    run the file again), else None. Requested methods that do not
     apply to the model are not added (simulate refuses them, naming why); whether the module
     on disk is current is codegen.generated_files.module_current (re-derives only when the model file
     or the generator changed since that was last decided)."""
@@ -98,17 +100,20 @@ def _plan(path, out_dir, methods, options, freeze, force):
     if not isinstance(disk, dict):          # missing (or forced over another model's module)
         build, freeze = dict(options or {}), dict(freeze or {})
         methods = resolve_methods(asked or None, model)
-        return target, ("missing", build, methods, freeze, regeneration_command(path, out_dir, build, methods, freeze))
+        return target, ("missing", build, methods, freeze, regeneration_command(path, out_dir, build, methods, freeze)), model
     have = list(disk.get("methods", ()))
     build = dict(disk.get("build", {}) if options is None else options)
     freeze = dict(disk.get("freeze", {}) if freeze is None else freeze)
     if disk.get("build", {}) != model.build_options:
         model = load_model(path, **disk.get("build", {}))   # the module's own build, to compare
+    # the Model of the build to generate when the last run of the file gave it (the file is not
+    # run again; what it read is recorded as that run found it)
+    model_for_build = model if model.build_options == build else None
     methods = resolve_methods(have + list(asked or ()), model, drop_inapplicable=True)
     wanted = generation_options(build, methods, freeze)
     command = regeneration_command(path, out_dir, build, methods, freeze)
     if not module_current(model, target, header):
-        return target, ("stale", build, methods, freeze, command)
+        return target, ("stale", build, methods, freeze, command), model_for_build
     if (wanted["build"], wanted.get("freeze")) != (disk.get("build"), disk.get("freeze")) and not force:
         have_options = {"build": disk.get("build"), "freeze": disk.get("freeze")}
         raise GenerationError(f"{target} was generated with {describe_options(have_options)}, not with "
@@ -116,8 +121,8 @@ def _plan(path, out_dir, methods, options, freeze, force):
                               f"with `{command}`, or ask for what it has")
     if wanted != disk:
         return target, (f"missing method(s) {', '.join(m for m in methods if m not in have)}",
-                        build, methods, freeze, command)
-    return target, None
+                        build, methods, freeze, command), model_for_build
+    return target, None, model_for_build
 
 
 def register_module(namespace):
