@@ -30,6 +30,19 @@ __all__ = [
 ]
 
 
+class _IntermediateLabel:
+    """"intermediate <name> of <definition>" for a message: a deep tree's definitions are long,
+    and printing each one for a label that no message shows costs more than the checks."""
+
+    __slots__ = ("sym",)
+
+    def __init__(self, sym):
+        self.sym = sym
+
+    def __str__(self):
+        return f"intermediate {self.sym.name} of {self.sym.definition}"
+
+
 class Model:
     """A Lagrangian model. Build it in a model file and assign it to ``model``.
 
@@ -291,7 +304,7 @@ class Model:
         evaluated, never differentiated."""
         yield from self._expressions_and_events()
         for sym in self.intermediates:
-            yield f"intermediate {sym.name} of {sym.definition}", sym.definition
+            yield _IntermediateLabel(sym), sym.definition
 
     def symbols_of(self, expr):
         """The free symbols of ``expr`` seen through its Intermediates' definitions."""
