@@ -125,6 +125,35 @@ def run_{method}_controlled_events(kern, n_saved, {wrapped}):
     return _{loop}(_stepper_{method}, None, kern, n_saved, 1, {wrapped_call})
 '''
 
+# The step API (run/stepper.py) of a fixed-step method: its state (steppers/core/step_api.py,
+# a structref holding the kernel table) made, prepared and stepped by functions compiled once
+# per method for every model and kept in numba's cache, as the glue above.
+_STEPPER_GLUE = '''
+
+@njit(cache=True, error_model="numpy")
+def stepper_new_{method}(kern, q, v, p, clock, info, settings, h, first):
+    """The StepperState of {method} on the kernel table ``kern``: q, v (n,), p (n_params,),
+    clock [t0, 0, t0], info (2,) shared with the caller."""
+    return _new_stepper_state(_stepper_{method}, kern, q, v, p, clock, info, settings, h, first)
+
+
+@njit(cache=True, error_model="numpy")
+def stepper_prepare_{method}(state):
+    """{method}'s prepare on a StepperState: its status."""
+    return _prepare_state(_stepper_{method}, state)
+
+
+@njit(cache=True, error_model="numpy")
+def stepper_step_{method}(state, u, k):
+    """k steps of {method} with the inputs held at u (n_inputs,; empty: unchanged)."""
+    return _step_state(_stepper_{method}, state, u, k)
+'''
+
+_STEPPER_IMPORT = ("\nfrom lagrange_gen.steppers.core.step_api import (\n"
+                   "    new_stepper_state as _new_stepper_state, prepare_state as _prepare_state,\n"
+                   "    step_state as _step_state)\n")
+
+
 #: The arguments the portable controlled glue takes after the glue's (GLUE_ARGS).
 CONTROL_ARGS = ", control, control_data"
 
@@ -243,8 +272,10 @@ def _stepping_loop_text(method, kern, n_events):
 def portable_glue_source(method: str, digest: str) -> str:
     """Source text of the portable ``run_<method>(kern, n_saved, ...)``,
     ``run_<method>_events`` and, for a fixed-step method, ``run_<method>_controlled(kern,
-    n_saved, ..., control, control_data)`` and its ``_events`` twin (_CONTROLLED_GLUE) and
-    ``ensemble_<method>(kern, n_saved, ...)`` (models without events)
+    n_saved, ..., control, control_data)`` and its ``_events`` twin (_CONTROLLED_GLUE), the
+    step API's ``stepper_new_<method>``, ``stepper_prepare_<method>`` and
+    ``stepper_step_<method>`` (_STEPPER_GLUE) and ``ensemble_<method>(kern, n_saved, ...)``
+    (models without events)
     (lagrange_gen.jit.portable) for the library version ``digest``; deterministic."""
     loop_module, loop = LOOPS[spec(method).adaptive]
     args = glue_args(method)
@@ -256,8 +287,8 @@ def portable_glue_source(method: str, digest: str) -> str:
     if spec(method).adaptive:
         return source
     # ensemble_<method>(kern, n_saved, ...) for models without events (the literal 0)
-    return (source + _controlled_source(method) + "\n\n"
-            + _ensemble_source(method, "n_saved", 0, "kern", "kern, n_saved, "))
+    return (source + _controlled_source(method) + _STEPPER_IMPORT + _STEPPER_GLUE.format(method=method)
+            + "\n\n" + _ensemble_source(method, "n_saved", 0, "kern", "kern, n_saved, "))
 
 
 def _controlled_source(method):

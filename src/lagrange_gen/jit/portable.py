@@ -174,9 +174,15 @@ def library_hash(method: str) -> str:
     from ..steppers.core.registry import LOOPS, spec
     loop_module = LOOPS[spec(method).adaptive][0]
     files = source_closure([f"steppers.methods.{method}", f"steppers.core.{loop_module}",
-                            "codegen.glue"])
+                            "steppers.core.step_api", "codegen.glue"])
     digest = hashlib.sha256(repr(sorted(source_hashes(files).items())).encode())
     return digest.hexdigest()[:16]
+
+
+def glue_function(method: str, name: str):
+    """The function ``name`` of ``method``'s portable glue (its file written and imported on
+    first use)."""
+    return getattr(_glue_module(method), name)
 
 
 @functools.lru_cache(maxsize=None)

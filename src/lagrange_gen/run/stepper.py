@@ -7,120 +7,34 @@
     stepper.t, stepper.q, stepper.v
 
 The method's workspace, the momentum and the saved fields are allocated once, in the
-constructor, inside a numba jitclass that holds them; ``step`` writes u into the inputs' slots
-of p (the last N_INPUTS entries) and calls the method's jitted ``step`` k times, so a call costs
-one dispatch into compiled code (measured by ``lagrange-gen bench stepapi``). The jitclass is
-compiled in this process for each (module, method) and kept; numba does not cache it on disk.
+constructor, in a StepperState (steppers/core/step_api.py) that also holds the model's kernel
+table; ``step`` calls the method's portable ``stepper_step_<method>`` (codegen/glue.py), which
+writes u into the inputs' slots of p (the last N_INPUTS entries) and runs the method's step k
+times: one dispatch into compiled code per call (measured by ``lagrange-gen bench stepapi``).
+Those functions are compiled once per method for every model and kept in numba's cache, so a
+Stepper in a new process, or on a new model, compiles nothing once the method has been used.
 Failures raise the exception simulate raises for that status (failures.raise_for_status).
 """
 
 from __future__ import annotations
 
-import importlib
 import math
 
 import numpy as np
 from .checks import vector
 from .control import input_slots, parameter_vector
 from ..errors import SimulationError
-from ..jit import njit
-from ..jit.api import jitclass, typeof
 from ..jit.compile_notice import first_use_notice
 from .failures import raise_for_status
 from .params import is_number
 from ..steppers.core import status as st
 from ..steppers.core import registry
-from ..steppers.core.options import fast_loop
-from ..steppers.core.state_checks import check_state
 from ..steppers.core.method_spec import make_settings
 
 __all__ = ["Stepper"]
 
-_CORES = {}
-
-
-def _core_class(module, method, settings_type, ws_type):
-    """The jitclass holding one stepper's state and buffers (kept per module and method)."""
-    key = (module.__name__, module.KEY, method, settings_type, ws_type)
-    if key in _CORES:
-        return _CORES[key]
-    stepper, kern = importlib.import_module(f"lagrange_gen.steppers.methods.{method}"), module
-    spec = [("q", typeof(np.zeros(1))), ("v", typeof(np.zeros(1))), ("mom", typeof(np.zeros(1))),
-            ("p", typeof(np.zeros(1))), ("extra", typeof(np.zeros(1))), ("clock", typeof(np.zeros(1))),
-            ("info", typeof(np.zeros(1))), ("settings", settings_type), ("ws", ws_type),
-            ("h", typeof(1.0)), ("first", typeof(1))]
-
-    @fast_loop
-    def _advance(q, v, mom, p, settings, ws, extra, clock, info, h, k):
-        """k steps; clock = [t0, steps done, t]; info = [iterations, residual]. A function
-        of its own without reference counting: jitclass methods count references on every
-        attribute read, which cost as much as the step itself (steppers/core/options.py)."""
-        for _ in range(k):
-            t = clock[0] + clock[1] * h
-            status, iters, resid = stepper.step(kern, q, v, mom, t, h, p, settings, ws, extra)
-            info[0] = iters
-            info[1] = resid
-            if status != 0:
-                return status
-            clock[1] += 1.0
-            clock[2] = clock[0] + clock[1] * h
-            status = check_state(q, v, settings.blowup_bound)
-            if status != 0:
-                return status
-        return 0
-
-    class Core:
-        def __init__(self, q, v, mom, p, extra, clock, info, settings, ws, h, first):
-            self.q, self.v, self.mom, self.p, self.extra = q, v, mom, p, extra
-            self.clock, self.info, self.settings, self.ws = clock, info, settings, ws
-            self.h, self.first = h, first
-
-        def prepare(self):
-            return stepper.prepare(kern, self.q, self.v, self.mom, self.clock[2], self.p,
-                                   self.settings, self.ws, self.extra)
-
-        def advance(self, k):
-            return _advance(self.q, self.v, self.mom, self.p, self.settings, self.ws,
-                            self.extra, self.clock, self.info, self.h, k)
-
-        def step_scalar(self, u, k):
-            if self.p[self.first] != u:     # a changed input invalidates prepare's cache
-                self.p[self.first] = u
-                status = self.prepare()
-                if status != 0:
-                    return status
-            return self.advance(k)
-
-        def step_vector(self, u, k):
-            changed = False
-            for j in range(u.shape[0]):
-                changed |= self.p[self.first + j] != u[j]
-                self.p[self.first + j] = u[j]
-            if changed:
-                status = self.prepare()
-                if status != 0:
-                    return status
-            return self.advance(k)
-
-    _CORES[key] = jitclass(spec)(Core)
-    return _CORES[key]
-
-
-_MAKERS = {}
-
-
-def _workspace(module, method):
-    """The method's workspace namedtuple for this module (its jitted maker kept per module)."""
-    key = (module.__name__, module.KEY, method)
-    if key not in _MAKERS:
-        stepper, kern, n = (importlib.import_module(f"lagrange_gen.steppers.methods.{method}"), module,
-                            module.N_COORDS)
-
-        @njit
-        def make():
-            return stepper.workspace(kern, n)
-        _MAKERS[key] = make
-    return _MAKERS[key]()
+#: u of a step that keeps the inputs as they are.
+_NO_INPUTS = np.zeros(0)
 
 
 class Stepper:
@@ -159,13 +73,15 @@ class Stepper:
         self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
         self._failure = None        # the message of the failure that ended this stepper
         self._label = f"Stepper({method}) for {module.NAME}"
-        self._warm = set()          # the core's methods step() has called (compiled) already
+        self._warm = False          # step() has run (its function loaded or compiled)
+        from ..jit.portable import glue_function, kernel_table
+        self._step = glue_function(method, f"stepper_step_{method}")
+        self._u = np.zeros(k)        # u of step(), written here (no array made per call)
         with first_use_notice(self._label):
-            ws = _workspace(module, method)
-            cls = _core_class(module, method, typeof(self.settings), typeof(ws))
-            self._core = cls(self.q, self.v, np.zeros(n), p, np.zeros(0), self._clock,
-                             self._info, self.settings, ws, self.h, first)
-            status = self._core.prepare()
+            self._state = glue_function(method, f"stepper_new_{method}")(
+                kernel_table(module, method), self.q, self.v, p, self._clock, self._info,
+                self.settings, self.h, first)
+            status = glue_function(method, f"stepper_prepare_{method}")(self._state)
         self._check(status, 0)
 
     @property
@@ -190,37 +106,28 @@ class Stepper:
             raise SimulationError(f"Stepper: this run failed at t = {self.t:g} ({self._failure}); "
                                   f"make a new Stepper to start again")
         k = int(k)
-        core = self._core
         if u is None:
-            kind = "advance"
+            inputs = _NO_INPUTS
         elif self.n_inputs == 1 and isinstance(u, float):
-            kind = "step_scalar"
+            inputs = self._u
+            inputs[0] = u
         else:
-            kind = "step_vector"
-            u = np.asarray(u, dtype=np.float64).ravel()
-            if u.shape[0] != self.n_inputs:
-                raise SimulationError(f"Stepper: u has {u.shape[0]} entries for "
+            inputs = np.asarray(u, dtype=np.float64).ravel()
+            if inputs.shape[0] != self.n_inputs:
+                raise SimulationError(f"Stepper: u has {inputs.shape[0]} entries for "
                                       f"{self.n_inputs} input(s)")
-        if kind not in self._warm:          # numba compiles each method on its first call
+        if self._warm:
+            code = self._step(self._state, inputs, k)
+        else:                                  # loaded or compiled on the first call
             with first_use_notice(self._label):
-                code = self._call(kind, u, k)
-            self._warm.add(kind)
-        elif u is None:
-            code = core.advance(k)
-        elif kind == "step_scalar":
-            code = core.step_scalar(u, k)
-        else:
-            code = core.step_vector(u, k)
+                code = self._step(self._state, inputs, k)
+            self._warm = True
         if code:
             try:
                 self._check(code, k)
             except SimulationError as exc:
                 self._failure = str(exc)
                 raise
-
-    def _call(self, kind, u, k):
-        """The core's method ``kind`` for step(u, k)."""
-        return self._core.advance(k) if kind == "advance" else getattr(self._core, kind)(u, k)
 
     def _check(self, code, k):
         if code == st.OK:
