@@ -246,18 +246,47 @@ def _nonholonomic_kernel(nat):
 
 def column_kernels(dyn) -> dict:
     """The Newton Jacobian kernels of a graph model as loops over their columns (same names,
-    arguments and outputs as the written-out ones of kernel_table)."""
+    arguments and outputs as the written-out ones of kernel_table): tangents of the Lagrangian
+    graph's rhs, momentum_rate or H w, or, for a tree of joints, of the recursive programs
+    (derive/recursive.py RecursiveDynamics.columns) where those have fewer operations
+    (jacobian_columns)."""
     docs = {"rhs_jacobian": (["q", "qd", "t", "p"], "d rhs/dq and d rhs/dqd (n, n)"),
             "momentum_rate_jacobian": (["q", "qd", "t", "p"], "d(dp/dt)/dq and d(dp/dt)/dqd (n, n)"),
             "mass_matvec_dq": (["q", "w", "t", "p"], "d(H(q) w)/dq (n, n) for a vector w (n,)")}
     out = {}
     for name, (args, doc) in docs.items():
         def build(name=name, args=args, doc=doc):
-            columns = dyn.jac.columns(name)
-            return KernelSpec(name, args, doc=f"{doc}, column by column (one tangent pass per column)",
+            columns, source = jacobian_columns(dyn, name)
+            how = f" of {source}" if source else ""
+            return KernelSpec(name, args, doc=f"{doc}, column by column (one tangent pass{how} per column)",
                               out_args=[c[0] for c in columns], columns=columns)
         out[name] = build
     return out
+
+
+#: What each column kernel differentiates when it comes from the recursive programs.
+RECURSIVE_SOURCES = {"rhs_jacobian": "the bias RNEA, rhs = -tau(q, qd, 0)",
+                     "mass_matvec_dq": "RNEA at rest, H w = tau(q, 0, w) without model forces",
+                     "momentum_rate_jacobian": "Hdot qd - tau(q, qd, 0) by RNEA"}
+
+
+def jacobian_columns(dyn, kernel):
+    """(columns, what they differentiate) of a column kernel: the tangents of the Lagrangian
+    graph (GraphJacobians.columns; "" for the docstring), or of the recursive programs when the
+    model is a tree of joints and they take fewer operations (the seed-free nodes once plus one
+    column's tangent pass: what the kernel evaluates per call and what LLVM compiles)."""
+    columns = dyn.jac.columns(kernel)
+    source = ""
+    if dyn.recursive is not None:
+        seeds = columns[0][1]
+        recursive = dyn.recursive.columns(kernel, seeds, dyn.ops.symbols(dyn.aux["w"]))
+        graph = dyn.ops.graph
+
+        def count(cols):
+            return operation_count(graph, [e for _, _, column in cols for e in column])
+        if count(recursive) < count(columns):
+            columns, source = recursive, RECURSIVE_SOURCES[kernel]
+    return columns, source
 
 
 def io_kernels(dyn) -> dict:
