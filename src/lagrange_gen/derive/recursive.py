@@ -26,18 +26,38 @@ import sympy as sp
 
 from ..model.symbols import Parameter, t
 
-__all__ = ["RecursiveDynamics", "recursive_dynamics", "operation_count"]
+__all__ = ["RecursiveDynamics", "recursive_dynamics", "operation_count", "column_operation_counts"]
+
+
+def _count(e):
+    """Arithmetic operations and function calls in one native expression."""
+    if e.is_Number or e.is_Symbol:
+        return 0
+    own = len(e.args) - 1 if type(e).__name__ in ("Add", "Mul") else 1
+    return own + sum(_count(a) for a in e.args)
 
 
 def operation_count(graph, exprs):
     """Arithmetic operations and function calls to evaluate ``exprs`` (native) with the graph
     nodes they use: what numba's compile time and the run time follow."""
-    def count(e):
-        if e.is_Number or e.is_Symbol:
-            return 0
-        own = len(e.args) - 1 if type(e).__name__ in ("Add", "Mul") else 1
-        return own + sum(count(a) for a in e.args)
-    return sum(count(d) for _, d in graph.used_nodes(exprs)) + sum(count(se.sympify(e)) for e in exprs)
+    return sum(_count(d) for _, d in graph.used_nodes(exprs)) + sum(_count(se.sympify(e)) for e in exprs)
+
+
+def column_operation_counts(graph, columns):
+    """(compiled, per call) operations of a kernel written as loops over columns
+    (codegen.emit.render_column_kernel; columns [(output name, seeds, column)]): the nodes that
+    do not depend on the seeds are evaluated once, the others once per column. compiled: the
+    operations in the kernel's text (what LLVM's compile time follows), the seed-free nodes
+    plus one pass of each loop; per call: the seed-free nodes plus every pass."""
+    seeds = {s for _, column_seeds, _ in columns for s in column_seeds}
+    every = [e for _, _, column in columns for e in column]
+    outside = sum(_count(d) for s, d in graph.used_nodes(every) if not graph.inputs_of(s) & seeds)
+    compiled, per_call = outside, outside
+    for _, column_seeds, column in columns:
+        inside = sum(_count(d) for s, d in graph.used_nodes(column) if graph.inputs_of(s) & seeds)
+        inside += sum(_count(se.sympify(e)) for e in column)
+        compiled, per_call = compiled + inside, per_call + len(column_seeds) * inside
+    return compiled, per_call
 
 
 def _cross(a, b):
