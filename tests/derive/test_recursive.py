@@ -225,3 +225,177 @@ def test_a_tree_that_does_not_reproduce_the_energy_is_refused():
     qdd = o.symbols(dyn.aux["qdd"])
     assert recursive_dynamics(links, o, plain, T, parts, qdd, {}) is not None
     assert recursive_dynamics(wrong, o, plain, T, parts, qdd, {}) is None
+
+
+# ------------------------------------------------- Newton Jacobians from the recursive programs
+
+#: The column kernels and what each differentiates (graph fields, or H w for mass_matvec_dq).
+COLUMN_KERNELS = ("rhs_jacobian", "mass_matvec_dq", "momentum_rate_jacobian")
+
+
+def _column_matrices(dyn, columns, q, v, w, params=(9.81,)):
+    """{output name: (n, n) matrix} of ``columns`` [(name, seeds, column)] at (q, v, w): column
+    k evaluated with seed k = 1, the others 0."""
+    o, n = dyn.ops, dyn.n
+    out = {}
+    for name, seeds, column in columns:
+        args = o.symbols(dyn.q + dyn.qd + dyn.aux["w"] + dyn.params + [t]) + list(seeds)
+        f = o.graph.evaluator(args, list(column))
+        out[name] = np.array([f([*q, *v, *w, *params, 0.0, *np.eye(n)[k]]) for k in range(n)], dtype=float).T
+    return out
+
+
+def _differenced(dyn, kernel, q, v, w, eps=1e-6):
+    """The same matrices by central differences of the graph's rhs, momentum_rate or H w."""
+    o, n = dyn.ops, dyn.n
+    if kernel == "mass_matvec_dq":
+        Hw = o.graph.tangents(dyn.jac._p["p"], dict(zip(o.symbols(dyn.qd), o.symbols(dyn.aux["w"]))))
+        f, names = _evaluate(dyn, Hw), ("out_mat",)
+    else:
+        field = "rhs" if kernel == "rhs_jacobian" else "momentum_rate"
+        f, names = _evaluate(dyn, list(dyn.native[field])), ("Jq", "Jqd")
+    out = {}
+    for name, moving in zip(names, ("q", "qd")):
+        def at(x):
+            return f(x, v, w) if moving == "q" else f(q, x, w)
+        x0 = q if moving == "q" else v
+        out[name] = np.array([(at(x0 + eps * e) - at(x0 - eps * e)) / (2 * eps) for e in np.eye(n)]).T
+    return out
+
+
+def _damped_tree_model():
+    """A 3D tree (prismatic and revolute joints, full inertias) with viscous damping and a
+    velocity-dependent force besides gravity: Q depends on q and qd."""
+    tree = random_tree(np.random.default_rng(4), 4, prismatic=0.4)
+    from sympy.physics.mechanics import dynamicsymbols
+    me_time = dynamicsymbols._t                  # the time of the joints' dynamicsymbols
+    g, c = parameters("g c", defaults=(9.81, 0.3))
+    N, O, q, bodies = tree_bodies(tree)
+    qd = [x.diff(me_time) for x in q]
+    return Model("damped_tree", coords=q, T=kinetic_energy(N, bodies),
+                 V=gravity_potential(N, -g * N.z, bodies),
+                 dissipation=c * sum(x ** 2 for x in qd) / 2,
+                 forces=[sp.sin(q[1]) * qd[0], 0, -0.2 * qd[2] * sp.cos(q[0]), 0])
+
+
+@pytest.mark.parametrize("kernel", COLUMN_KERNELS)
+def test_recursive_jacobian_columns_equal_the_graph_columns(case, kernel):
+    """Each Newton Jacobian as tangents of RNEA equals the Lagrangian graph's tangents (1e-12)
+    and central differences of the graph's rhs, momentum_rate or H w, at two random states."""
+    _, dyn = case
+    n = dyn.n
+    graph_columns = dyn.jac.columns(kernel)
+    recursive = dyn.recursive.columns(kernel, graph_columns[0][1], dyn.ops.symbols(dyn.aux["w"]))
+    assert [c[0] for c in recursive] == [c[0] for c in graph_columns]
+    rng = np.random.default_rng(10)
+    for _ in range(2):
+        q, v, w = rng.uniform(-1.5, 1.5, (3, n))
+        ours = _column_matrices(dyn, recursive, q, v, w)
+        reference = _column_matrices(dyn, graph_columns, q, v, w)
+        numeric = _differenced(dyn, kernel, q, v, w)
+        for name in reference:
+            assert _rel(ours[name], reference[name]) < RTOL, name
+            assert np.allclose(ours[name], numeric[name], rtol=1e-6, atol=1e-7), name
+
+
+def test_recursive_jacobian_columns_with_damping_and_velocity_forces():
+    """Q = F - dD/dqd depends on q and qd: its tangents enter rhs_jacobian and
+    momentum_rate_jacobian through tau_model, as in the graph's."""
+    dyn = derive(_damped_tree_model())
+    assert dyn.recursive is not None
+    n = dyn.n
+    q, v, w = np.random.default_rng(11).uniform(-1.5, 1.5, (3, n))
+    for kernel in COLUMN_KERNELS:
+        graph_columns = dyn.jac.columns(kernel)
+        recursive = dyn.recursive.columns(kernel, graph_columns[0][1], dyn.ops.symbols(dyn.aux["w"]))
+        ours = _column_matrices(dyn, recursive, q, v, w, (9.81, 0.3))
+        reference = _column_matrices(dyn, graph_columns, q, v, w, (9.81, 0.3))
+        for name in reference:
+            assert _rel(ours[name], reference[name]) < RTOL, (kernel, name)
+
+
+def test_emitted_column_kernels_agree_and_come_from_rnea_where_shorter(case):
+    """The column kernels a tree model is generated with (their Python, no numba compile):
+    rhs_jacobian and mass_matvec_dq from RNEA (fewer operations than the graph's on these
+    trees), each equal to the Lagrangian graph's tangents to 1e-12."""
+    from lagrange_gen.codegen.emit import render_kernel
+    from lagrange_gen.codegen.printer import Inputs
+    from lagrange_gen.codegen.spec import RECURSIVE_SOURCES, jacobian_columns, kernel_table
+    _, dyn = case
+    n = dyn.n
+    table, inputs = kernel_table(dyn), Inputs(dyn)
+    rng = np.random.default_rng(12)
+    q, v, w = rng.uniform(-1.5, 1.5, (3, n))
+    p = np.array([9.81])
+    for kernel in COLUMN_KERNELS:
+        _, source = jacobian_columns(dyn, kernel)
+        if kernel != "momentum_rate_jacobian":
+            assert source == RECURSIVE_SOURCES[kernel]
+        spec = table[kernel]()
+        namespace = {}
+        exec(f"import math\nKERNEL_OPTIONS = {{}}\ndef njit(**options):\n    return lambda f: f\n"
+             + render_kernel(spec, inputs).function, namespace)
+        outputs = [np.zeros((n, n)) for _ in spec.columns]
+        second = w if kernel == "mass_matvec_dq" else v
+        namespace[kernel](q, second, 0.0, p, *outputs)
+        reference = _column_matrices(dyn, dyn.jac.columns(kernel), q, v, w)
+        for name, value in zip([c[0] for c in spec.columns], outputs):
+            assert _rel(value, reference[name]) < RTOL, (kernel, name)
+
+
+def _rnea_mass_kernels(dyn, q, v):
+    """(H from mass_matrix, H and rhs from dynamics) of the RNEA-column kernels of a tree
+    (recursive_mass_specs: emitted or not, by operation count), run as Python (no numba)."""
+    from lagrange_gen.codegen.emit import render_kernel
+    from lagrange_gen.codegen.printer import Inputs
+    from lagrange_gen.codegen.spec import recursive_mass_specs
+    n, inputs, namespace = dyn.n, Inputs(dyn), {}
+    for kernel, (build, *_) in recursive_mass_specs(dyn).items():
+        spec = build()
+        assert spec.columns, kernel              # the loop over H's columns, not the graph's H
+        exec(f"import math\nKERNEL_OPTIONS = {{}}\ndef njit(**options):\n    return lambda f: f\n"
+             + render_kernel(spec, inputs).function, namespace)
+    p = np.array([9.81, 0.3][:len(dyn.params)])
+    H_alone, H, rhs = np.full((n, n), np.nan), np.full((n, n), np.nan), np.full(n, np.nan)
+    namespace["mass_matrix"](q, 0.0, p, H_alone)
+    namespace["dynamics"](q, v, 0.0, p, H, rhs)
+    return H_alone, H, rhs
+
+
+def test_emitted_mass_kernels_from_rnea_agree(case):
+    """mass_matrix and dynamics of a tree from RNEA: H column by column by RNEA at rest, exactly
+    symmetric, and rhs by the bias RNEA, equal to the graph's H and rhs to 1e-12."""
+    _, dyn = case
+    q, v = np.random.default_rng(13).uniform(-1.5, 1.5, (2, dyn.n))
+    H_ref, rhs_ref = _graph_dynamics(dyn, q, v)
+    H_alone, H, rhs = _rnea_mass_kernels(dyn, q, v)
+    for matrix in (H_alone, H):
+        assert np.array_equal(matrix, matrix.T) and _rel(matrix, H_ref) < RTOL
+    assert _rel(rhs, rhs_ref) < RTOL
+
+
+def test_rnea_dynamics_with_damping_and_velocity_forces():
+    """rhs = Q - h - g by the bias RNEA where Q depends on q and qd (damping, a force)."""
+    dyn = derive(_damped_tree_model())
+    q, v = np.random.default_rng(14).uniform(-1.5, 1.5, (2, dyn.n))
+    o = dyn.ops
+    args = o.symbols(dyn.q + dyn.qd + dyn.params + [t])
+    f = o.graph.evaluator(args, [*dyn.native["H"], *dyn.native["rhs"]])
+    values = np.asarray(f([*q, *v, 9.81, 0.3, 0.0]), dtype=float)
+    n = dyn.n
+    _, H, rhs = _rnea_mass_kernels(dyn, q, v)
+    assert _rel(H, values[:n * n].reshape(n, n)) < RTOL and _rel(rhs, values[n * n:]) < RTOL
+
+
+def test_a_12_link_chain_takes_its_jacobians_and_mass_kernels_from_rnea():
+    """On models/spatial_chain.py's 12-link chain RNEA's programs are shorter both in the text
+    and per call: rhs_jacobian, mass_matvec_dq, mass_matrix and dynamics come from them;
+    momentum_rate_jacobian stays the graph's (Hdot qd - tau(q, qd, 0) is longer)."""
+    from lagrange_gen.codegen.spec import RECURSIVE_SOURCES, jacobian_columns, kernel_table
+    from lagrange_gen.model.model_file import load_model
+    from pathlib import Path
+    dyn = derive(load_model(Path(__file__).parents[2] / "models" / "spatial_chain.py", n=12))
+    sources = {k: jacobian_columns(dyn, k)[1] for k in COLUMN_KERNELS}
+    assert sources == {**RECURSIVE_SOURCES, "momentum_rate_jacobian": ""}
+    table = kernel_table(dyn)
+    assert table["mass_matrix"]().columns and table["dynamics"]().columns

@@ -192,7 +192,8 @@ def render_kernel(spec: KernelSpec, inputs) -> KernelText:
 def render_column_kernel(spec: KernelSpec, inputs) -> KernelText:
     """A Jacobian kernel of a graph model as loops over its columns: the graph nodes that do not
     depend on the seeds once, then for each output ``for k in range(cols)`` with seed_i = 1.0
-    where i == k, the tangent nodes and the stores of column k. numba's compile time follows
+    where i == k, the tangent nodes and the stores of column k (an output without seeds is a
+    vector stored outside the loops); then the spec's epilogue. numba's compile time follows
     the operations in the text, and the loop holds one tangent pass where the written-out
     Jacobian holds cols of them; the run time is the same number of operations."""
     graph = inputs.graph
@@ -209,6 +210,9 @@ def render_column_kernel(spec: KernelSpec, inputs) -> KernelText:
 
     body = [f"    {s} = {text(d)}" for s, d in outside]
     for name, column_seeds, column in spec.columns:
+        if not column_seeds:             # a plain vector beside the loops (dynamics' rhs)
+            printed += [f"    {name}[{i}] = {text(se.sympify(e)) if e != 0 else '0.0'}" for i, e in enumerate(column)]
+            continue
         inside = [(s, d) for s, d in graph.used_nodes(column) if graph.inputs_of(s) & seeds]
         printed.append(f"    for k in range({len(column_seeds)}):")
         printed += [f"        {s} = 1.0 if k == {i} else 0.0" for i, s in enumerate(column_seeds)]
@@ -218,7 +222,8 @@ def render_column_kernel(spec: KernelSpec, inputs) -> KernelText:
     lines = ['@njit(**KERNEL_OPTIONS)', f"def {spec.name}({args}):",
              f'    """{spec.doc}."""']
     lines += _load_lines(used, inputs.loads(spec.args)) + body + printed
-    n_entries = sum(len(column) * len(column_seeds) for _, column_seeds, column in spec.columns)
+    lines += [f"    {line}" for line in spec.epilogue]
+    n_entries = sum(len(column) * max(1, len(column_seeds)) for _, column_seeds, column in spec.columns)
     return KernelText(spec.name, [], "\n".join(lines), n_entries=n_entries, n_temps=len(body))
 
 

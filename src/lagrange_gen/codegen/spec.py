@@ -4,11 +4,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import symengine as se
 import sympy as sp
 
 from ..jit.kernel_abi import ALWAYS_2D
 from ..derive.nonholonomic import constraint_gamma_jacobians, nonholonomic_jacobians
-from ..derive.recursive import operation_count
+from ..derive.structured import SEED_PREFIX
+from ..derive.recursive import column_operation_counts, operation_count
 from ..model.symbols import Parameter
 
 
@@ -137,6 +139,7 @@ def kernel_table(dyn) -> dict:
     if hasattr(dyn.jac, "columns"):
         table.update(column_kernels(dyn))
         table.update(robot_kernels(dyn))
+        table.update(recursive_mass_kernels(dyn))
     return table
 
 
@@ -246,18 +249,89 @@ def _nonholonomic_kernel(nat):
 
 def column_kernels(dyn) -> dict:
     """The Newton Jacobian kernels of a graph model as loops over their columns (same names,
-    arguments and outputs as the written-out ones of kernel_table)."""
+    arguments and outputs as the written-out ones of kernel_table): tangents of the Lagrangian
+    graph's rhs, momentum_rate or H w, or, for a tree of joints, of the recursive programs
+    (derive/recursive.py RecursiveDynamics.columns) where those have fewer operations
+    (jacobian_columns)."""
     docs = {"rhs_jacobian": (["q", "qd", "t", "p"], "d rhs/dq and d rhs/dqd (n, n)"),
             "momentum_rate_jacobian": (["q", "qd", "t", "p"], "d(dp/dt)/dq and d(dp/dt)/dqd (n, n)"),
             "mass_matvec_dq": (["q", "w", "t", "p"], "d(H(q) w)/dq (n, n) for a vector w (n,)")}
     out = {}
     for name, (args, doc) in docs.items():
         def build(name=name, args=args, doc=doc):
-            columns = dyn.jac.columns(name)
-            return KernelSpec(name, args, doc=f"{doc}, column by column (one tangent pass per column)",
+            columns, source = jacobian_columns(dyn, name)
+            how = f" of {source}" if source else ""
+            return KernelSpec(name, args, doc=f"{doc}, column by column (one tangent pass{how} per column)",
                               out_args=[c[0] for c in columns], columns=columns)
         out[name] = build
     return out
+
+
+#: What each column kernel differentiates when it comes from the recursive programs.
+RECURSIVE_SOURCES = {"rhs_jacobian": "the bias RNEA, rhs = -tau(q, qd, 0)",
+                     "mass_matvec_dq": "RNEA at rest, H w = tau(q, 0, w) without model forces",
+                     "momentum_rate_jacobian": "Hdot qd - tau(q, qd, 0) by RNEA"}
+
+
+def jacobian_columns(dyn, kernel):
+    """(columns, what they differentiate) of a column kernel: the tangents of the Lagrangian
+    graph (GraphJacobians.columns; "" for the docstring), or of the recursive programs when the
+    model is a tree of joints and they take fewer operations both in the kernel's text (what
+    LLVM compiles) and per call (column_operation_counts)."""
+    columns = dyn.jac.columns(kernel)
+    source = ""
+    if dyn.recursive is not None:
+        seeds = columns[0][1]
+        recursive = dyn.recursive.columns(kernel, seeds, dyn.ops.symbols(dyn.aux["w"]))
+        graph = dyn.ops.graph
+        ours, theirs = column_operation_counts(graph, recursive), column_operation_counts(graph, columns)
+        if ours[0] < theirs[0] and ours[1] <= theirs[1]:
+            columns, source = recursive, RECURSIVE_SOURCES[kernel]
+    return columns, source
+
+
+def recursive_mass_kernels(dyn) -> dict:
+    """mass_matrix and dynamics of a tree of joints with H as a loop over its columns
+    (recursive_mass_specs), each where that takes fewer operations than the graph's H (and rhs)
+    written out, both in the kernel's text and per call (column_operation_counts); {} for
+    other models."""
+    if "_recursive_mass_kernels" not in dyn.__dict__:       # kernel_table is built several times
+        dyn.__dict__["_recursive_mass_kernels"] = {
+            name: build for name, (build, compiled, per_call, written_out) in recursive_mass_specs(dyn).items()
+            if compiled < written_out and per_call <= written_out}
+    return dyn.__dict__["_recursive_mass_kernels"]
+
+
+def recursive_mass_specs(dyn) -> dict:
+    """{name: (KernelSpec builder, operations in its text, per call, of the written-out kernel)}
+    for mass_matrix and dynamics of a tree of joints (dyn.recursive; {} otherwise): column k
+    of H is RNEA at rest with qdd = e_k and no model forces (RecursiveDynamics.mass_times),
+    dynamics' rhs = -tau(q, qd, 0) by RNEA."""
+    rec, o = dyn.recursive, dyn.ops
+    if rec is None or dyn.mass_is_constant:
+        return {}
+    graph, n = o.graph, dyn.n
+    seeds = [se.Symbol(f"{SEED_PREFIX}{i}") for i in range(n)]
+    H_columns = [("H", seeds, rec.mass_times(seeds))]
+    dynamics_columns = H_columns + [("rhs", [], [graph.node(-x) for x in rec.inverse_dynamics([0] * n)])]
+    # the loop gives every entry of H; the upper triangle is copied from the lower, which
+    # cholesky_inplace reads, so that H is exactly symmetric as the written-out one is
+    mirror = [f"for i in range({n}):", f"    for j in range(i + 1, {n}):", "        H[i, j] = H[j, i]"]
+    H_doc = "column by column (column k: RNEA at rest with qdd = e_k, no model forces)"
+
+    def mass_matrix():
+        return KernelSpec("mass_matrix", ["q", "t", "p"], out_args=["H"], columns=H_columns,
+                          epilogue=mirror, doc=f"H(q, t) (n, n), the generalized inertia, {H_doc}")
+
+    def dynamics():
+        return KernelSpec("dynamics", ["q", "qd", "t", "p"], out_args=["H", "rhs"],
+                          columns=dynamics_columns, epilogue=mirror,
+                          doc=f"H(q) (n, n) and rhs = Q - h - g (n,), so that H qddot = rhs: H "
+                              f"{H_doc}, rhs = -tau(q, qd, 0) by RNEA")
+    H = list(dyn.native["H"])
+    return {"mass_matrix": (mass_matrix, *column_operation_counts(graph, H_columns), operation_count(graph, H)),
+            "dynamics": (dynamics, *column_operation_counts(graph, dynamics_columns),
+                         operation_count(graph, H + list(dyn.native["rhs"])))}
 
 
 def io_kernels(dyn) -> dict:

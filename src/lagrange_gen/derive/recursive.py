@@ -26,18 +26,38 @@ import sympy as sp
 
 from ..model.symbols import Parameter, t
 
-__all__ = ["RecursiveDynamics", "recursive_dynamics", "operation_count"]
+__all__ = ["RecursiveDynamics", "recursive_dynamics", "operation_count", "column_operation_counts"]
+
+
+def _count(e):
+    """Arithmetic operations and function calls in one native expression."""
+    if e.is_Number or e.is_Symbol:
+        return 0
+    own = len(e.args) - 1 if type(e).__name__ in ("Add", "Mul") else 1
+    return own + sum(_count(a) for a in e.args)
 
 
 def operation_count(graph, exprs):
     """Arithmetic operations and function calls to evaluate ``exprs`` (native) with the graph
     nodes they use: what numba's compile time and the run time follow."""
-    def count(e):
-        if e.is_Number or e.is_Symbol:
-            return 0
-        own = len(e.args) - 1 if type(e).__name__ in ("Add", "Mul") else 1
-        return own + sum(count(a) for a in e.args)
-    return sum(count(d) for _, d in graph.used_nodes(exprs)) + sum(count(se.sympify(e)) for e in exprs)
+    return sum(_count(d) for _, d in graph.used_nodes(exprs)) + sum(_count(se.sympify(e)) for e in exprs)
+
+
+def column_operation_counts(graph, columns):
+    """(compiled, per call) operations of a kernel written as loops over columns
+    (codegen.emit.render_column_kernel; columns [(output name, seeds, column)]): the nodes that
+    do not depend on the seeds are evaluated once, the others once per column. compiled: the
+    operations in the kernel's text (what LLVM's compile time follows), the seed-free nodes
+    plus one pass of each loop; per call: the seed-free nodes plus every pass."""
+    seeds = {s for _, column_seeds, _ in columns for s in column_seeds}
+    every = [e for _, _, column in columns for e in column]
+    outside = sum(_count(d) for s, d in graph.used_nodes(every) if not graph.inputs_of(s) & seeds)
+    compiled, per_call = outside, outside
+    for _, column_seeds, column in columns:
+        inside = sum(_count(d) for s, d in graph.used_nodes(column) if graph.inputs_of(s) & seeds)
+        inside += sum(_count(se.sympify(e)) for e in column)
+        compiled, per_call = compiled + inside, per_call + len(column_seeds) * inside
+    return compiled, per_call
 
 
 def _cross(a, b):
@@ -50,7 +70,7 @@ class RecursiveDynamics:
 
     def __init__(self, links, o, q, qd, tau_model, frozen):
         self.graph, self.o = o.graph, o
-        self.n, self.qd, self.tau_model = len(q), list(qd), list(tau_model)
+        self.n, self.q, self.qd, self.tau_model = len(q), list(q), list(qd), list(tau_model)
         names = {str(s): i for i, s in enumerate(q)}
         freeze = {}
         self.links = []
@@ -140,11 +160,13 @@ class RecursiveDynamics:
         w, v0 = v[:3], v[3:]
         return self._nodes([a + b for a, b in zip(_cross(w, f[:3]), _cross(v0, f[3:]))] + _cross(w, f[3:]))
 
-    def _velocities(self):
-        """[(v, c)] per link: spatial velocity and velocity-product acceleration c = S' qd + v x vJ."""
+    def _velocities(self, qd=None):
+        """[(v, c)] per link: spatial velocity and velocity-product acceleration c = S' qd + v x vJ
+        for the joint velocities ``qd`` (n native expressions; None: the model's qd symbols)."""
+        qd = self.qd if qd is None else qd
         out = []
         for link in self.links:
-            rates = [self.qd[j] for j in link["joint"]]
+            rates = [qd[j] for j in link["joint"]]
             vJ = self._nodes([sum(col[i] * x for col, x in zip(link["S"], rates)) for i in range(6)])
             parent = [0] * 6 if link["parent"] < 0 else self._to_child(link, out[link["parent"]][0])
             v = self._nodes([a + b for a, b in zip(parent, vJ)])
@@ -161,9 +183,12 @@ class RecursiveDynamics:
             total += sum(a * b for a, b in zip(v, self._times(link["inertia"], v))) / 2
         return self.graph.node(total)
 
-    def inverse_dynamics(self, qdd):
-        """tau (n,) = H qdd + h + g - Q by RNEA (qdd: n native expressions, zeros for h + g - Q)."""
-        kinematics = self._velocities()
+    def inverse_dynamics(self, qdd, qd=None, forces=None):
+        """tau (n,) = H qdd + h + g - Q by RNEA (qdd: n native expressions, zeros for h + g - Q).
+        qd (n,): the joint velocities (None: the model's qd symbols; zeros drop h); forces (n,):
+        the generalized forces besides inertia (None: tau_model = Q - g; zeros give H qdd + h)."""
+        kinematics = self._velocities(qd)
+        tau_model = self.tau_model if forces is None else list(forces)
         accelerations, forces = [], []
         for link, (v, c) in zip(self.links, kinematics):
             parent = [0] * 6 if link["parent"] < 0 else self._to_child(link, accelerations[link["parent"]])
@@ -180,7 +205,45 @@ class RecursiveDynamics:
             if link["parent"] >= 0:
                 up = self._to_parent(link, forces[i])
                 forces[link["parent"]] = self._nodes([a + b for a, b in zip(forces[link["parent"]], up)])
-        return [self.graph.node(x - y) for x, y in zip(tau, self.tau_model)]
+        return [self.graph.node(x - y) for x, y in zip(tau, tau_model)]
+
+    def mass_times(self, w):
+        """H(q) w (n,) for a vector w (n native expressions): RNEA at rest (qd = 0) with qdd = w
+        and no forces besides inertia, so that only the inertia term is left."""
+        zeros = [0] * self.n
+        return self.inverse_dynamics(w, qd=zeros, forces=zeros)
+
+    def momentum_rate(self):
+        """dp/dt at qdd = 0, i.e. dT/dq - g + Q (n,): p = H qd, so dp/dt = Hdot qd + H qdd and
+        Lagrange's equations give dT/dq - g + Q = Hdot qd - tau(q, qd, 0); Hdot qd is the
+        tangent of H(q) w along qd in q, at w = qd."""
+        Hw = self.mass_times(self.qd)
+        Hdot_qd = self.graph.tangents(Hw, dict(zip(self.q, self.qd)))
+        bias = self.inverse_dynamics([0] * self.n)
+        return [self.graph.node(a - b) for a, b in zip(Hdot_qd, bias)]
+
+    def columns(self, kernel, seeds, w):
+        """[(output name, seeds, column)] of a Newton Jacobian kernel (the names and outputs of
+        derive.structured.GraphJacobians.columns) as tangents of the recursive programs along
+        one coordinate or velocity at a time (``seeds``: n seed symbols; w: the n native
+        symbols of the kernel's input vector w):
+
+            rhs_jacobian             rhs = Q - h - g = -tau(q, qd, 0), the bias RNEA
+            mass_matvec_dq           H w = RNEA at qd = 0, qdd = w, no model forces
+            momentum_rate_jacobian   dT/dq - g + Q = Hdot qd - tau(q, qd, 0) (momentum_rate)
+        """
+        def along(exprs, xs):
+            return self.graph.tangents(exprs, dict(zip(xs, seeds)))
+
+        if kernel == "mass_matvec_dq":
+            return [("out_mat", seeds, along(self.mass_times(w), self.q))]
+        if kernel == "rhs_jacobian":
+            values = [self.graph.node(-x) for x in self.inverse_dynamics([0] * self.n)]
+        elif kernel == "momentum_rate_jacobian":
+            values = self.momentum_rate()
+        else:
+            raise KeyError(kernel)
+        return [("Jq", seeds, along(values, self.q)), ("Jqd", seeds, along(values, self.qd))]
 
     def forward_dynamics(self, tau_extra=None):
         """(qdd (n,), pivots) by ABA for the generalized forces tau_model (+ tau_extra, n native

@@ -13,7 +13,8 @@ quantity the kernels need is formed through it, by the chain rule, never expande
 
 and the Newton Jacobians (d rhs/dq, d rhs/dqd, ..., d(H w)/dq with H w = the tangent of p along
 w) by forward passes over those graphs: each costs a small multiple of the kernel it
-differentiates. The results are matrices of node symbols and short expressions over them; the
+differentiates. For a tree of joints codegen/spec.py takes them instead from the recursive
+programs (derive/recursive.py RecursiveDynamics.columns) where those are shorter. The results are matrices of node symbols and short expressions over them; the
 Dynamics record keeps the graph, and the emitter writes the nodes a kernel uses before its body.
 
 The graph path applies to scleronomic T = 1/2 qd^T H(q) qd (no T1, T0 or explicit t in T).

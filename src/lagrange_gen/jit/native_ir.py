@@ -241,6 +241,7 @@ class FunctionLowering:
         self.single = frozenset()
         self.frame, self.frame_slots = None, {}
         self.loops = []          # _Loop of each loop being lowered, outermost first
+        self._reads = {}         # id(statement) -> (statement, the names it reads)
 
     def fail(self, node, what):
         line = getattr(node, "lineno", "?")
@@ -294,9 +295,15 @@ class FunctionLowering:
         primal values live across it). The values a piece reads from before it and the ones it
         defines for later statements pass through a frame of doubles on the kernel's stack; an
         input that does not change in a loop is stored there once, before the loop."""
-        later_reads = [set() for _ in range(len(stmts) + 1)]
-        for i in range(len(stmts) - 1, -1, -1):
-            later_reads[i] = later_reads[i + 1] | _names_read(stmts[i])
+        # the last statement reading each name: a name is read at or after statement i when
+        # its last read is (a set of the later reads per statement would be quadratic)
+        last_read = {}
+        for i, stmt in enumerate(stmts):
+            for name in self._names_read(stmt):
+                last_read[name] = i
+
+        def read_from(i):
+            return lambda name: last_read.get(name, -1) >= i
         run = []
         for i, stmt in enumerate(stmts):
             if self.b.block.is_terminated:
@@ -304,19 +311,27 @@ class FunctionLowering:
             if _plain_assignment(stmt):
                 run.append(stmt)
                 if len(run) == CHUNK_STATEMENTS:
-                    self._run(run, later_reads[i + 1], chunk)
+                    self._run(run, read_from(i + 1), chunk)
                     run = []
                 continue
             if run:
-                self._run(run, later_reads[i], chunk)
+                self._run(run, read_from(i), chunk)
                 run = []
             self._stmt(stmt)
         if run and not self.b.block.is_terminated:
-            self._run(run, later_reads[len(stmts)], chunk)
+            self._run(run, read_from(len(stmts)), chunk)
+
+    def _names_read(self, stmt):
+        """_names_read(stmt), once per statement: _statements and _run both ask."""
+        entry = self._reads.get(id(stmt))
+        if entry is None or entry[0] is not stmt:
+            entry = self._reads[id(stmt)] = (stmt, _names_read(stmt))
+        return entry[1]
 
     def _run(self, stmts, read_after, chunk):
         """Lower ``stmts`` (plain assignments) here, or as one piece when there are at least
-        ``chunk`` of them and every value crossing its boundary is a float."""
+        ``chunk`` of them and every value crossing its boundary is a float. read_after(name):
+        whether a statement after them reads the name."""
         if len(stmts) < chunk:
             self._block(stmts)
             return
@@ -325,10 +340,10 @@ class FunctionLowering:
             for t in stmt.targets:
                 if isinstance(t, ast.Name):
                     assigned.add(t.id)
-        read = set().union(*(_names_read(s) for s in stmts))
+        read = set().union(*(self._names_read(s) for s in stmts))
         scalars = {n for n, v in self.vars.items() if isinstance(v, tuple)}
         inputs = sorted(read & scalars)
-        outputs = sorted(assigned & read_after)
+        outputs = sorted(n for n in assigned if read_after(n))
         crossing = inputs + [n for n in outputs if n not in inputs]
         arrays = [(n, v) for n, v in self.vars.items() if isinstance(v, Array)]
         if any(self.vars[n][0] != "f" for n in inputs) or any(
