@@ -43,6 +43,21 @@ from there after ``classify``:
    velocities are then projected onto the persistent rows (u_N = 0; u_T = 0 when sticking) by
    the same solver, so that rest stays rest.
 
+Holonomic constraints Phi(q, t) = 0 (m rows, J = dPhi/dq; N = n + m): the motion between
+switches is the index-1 form
+
+    K (a, lam) = (f + W^T lambda, gamma),   K = [[M, -J^T], [J, 0]]   (gamma = -dJ/dt v, the
+                                                                      generated ``constraints``)
+
+from one LU of K per evaluation (M a = f + J^T lam + W^T lambda, J a = gamma); the contact
+problems (the persistent contacts' forces, the impact, the rest projection) take K as their
+factored matrix with W padded by m zero columns (core/contact_kkt.pad_rows, the same
+contact_problem.delassus), so the constraint forces and impulses follow the contact ones exactly
+and an impulse keeps J v = 0. No Baumgarte term: Phi'' = 0 holds to the integration error, so
+Phi drifts by that between switches; each switch (and the start) first projects q onto
+Phi(q, t) = 0 (the nearest point in the metric of M: newton.solve on assemble_projection) and v
+onto J v + dPhi/dt = 0 (one solve with K). Without constraints K is M and N = n.
+
 Orders: 8 between switches; the switch times are roots of the dense output (order 7), to
 events.ROOT_RTOL of the step. The gap of a persistent contact is held at the acceleration
 level, so it drifts by the integration error (rtol, atol).
@@ -61,6 +76,10 @@ dop853.py) and which a switch leaves as it is: E - E0 - W - contact_work. Row 0
 is the state after the start's classification (an impact at t0 is in the impulse sums); the
 work counts from it. In every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
+
+With holonomic constraints, after ``last_impact``: ``multipliers`` (m) lam at the row's state
+(the persistent contacts' forces included), ``constraint_error`` max|Phi| and
+``velocity_constraint_error`` max|J v + dPhi/dt| (1 each; core/constrained.SAVED's fields).
 
 ``last_impact`` (c) is each contact's latest impact time (-inf before its first): the Zeno
 guard's memory. A run continued in chunks (run/adaptive_driver.py) reclassifies the contacts
