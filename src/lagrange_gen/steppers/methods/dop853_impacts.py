@@ -99,7 +99,7 @@ import numpy as np
 from ...jit.cache import njit
 
 from ..core import events, newton
-from ..core.constrained import SAVED as CONSTRAINED_SAVED, constraint_rate
+from ..core.constrained import constraint_rate
 from ..core.contact_problem import (BILATERAL, SLIDE, SLIDE_NEGATIVE, SLIDE_POSITIVE, STICK,
                                     contact_row, delassus)
 from ..core.contact_kkt import assemble_constraint_rows, pad_rows, record_constraints
@@ -810,7 +810,7 @@ SPEC = Spec(
     settings=Settings,
     saved=(("impacts", 1), ("normal_impulse_sum", "c"), ("tangent_impulse_sum", "c"),
            ("tangent2_impulse_sum", "c"), ("contact_mode", "c"), ("contact_work", 1),
-           ("last_impact", "c"), *CONSTRAINED_SAVED[:1], ("constraint_error", "m1"),
+           ("last_impact", "c"), ("multipliers", "m"), ("constraint_error", "m1"),
            ("velocity_constraint_error", "m1")),
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False),
