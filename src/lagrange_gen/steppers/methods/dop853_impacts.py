@@ -212,6 +212,9 @@ def _kkt_and_rhs(kern, ws, q, v, t, p):
     without constraints), rhs into ws.f, Phi, J and gamma into ws.phi, ws.G, ws.gam; False when
     K is singular (M, or J M^-1 J^T: redundant constraints)."""
     n = kern.N_COORDS
+    if kern.N_CONSTRAINTS == 0:      # K is M (n, n): no copy, no constraint kernel call
+        kern.dynamics(q, v, t, p, ws.K, ws.f)
+        return lu_inplace(ws.K, ws.piv)
     kern.dynamics(q, v, t, p, ws.M, ws.f)
     kern.constraints(q, v, t, p, ws.phi, ws.G, ws.gam)
     for i in range(n):
@@ -243,7 +246,17 @@ def _contacts_at(kern, ws, q, t, p):
     """The contacts' gaps, Jacobians, coefficients and surface terms at (q, t) into ws."""
     kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
     kern.contact_bias(q, t, p, ws.bias)
-    pad_rows(kern.N_COORDS, ws.WN, ws.WT, ws.WNp, ws.WTp)
+    if kern.N_CONSTRAINTS > 0:
+        pad_rows(kern.N_COORDS, ws.WN, ws.WT, ws.WNp, ws.WTp)
+
+
+@njit(inline="always")
+def _padded(kern, ws):
+    """(W_N, W_T) with K's columns (c, N), (2c, N): the padded copies with constraints, the
+    rows themselves without (N = n)."""
+    if kern.N_CONSTRAINTS > 0:
+        return ws.WNp, ws.WTp
+    return ws.WN, ws.WT
 
 
 @njit(inline="always")
@@ -336,7 +349,8 @@ def contact_acceleration(kern, ws, q, v, t, p, a):
         return OK
     _contacts_at(kern, ws, q, t, p)
     kern.contact_rates(q, v, t, p, ws.rate)
-    delassus(c, N, ws.persistent, ws.WNp, ws.WTp, ws.K, ws.piv, ws.s, ws.Y, ws.D)
+    WN, WT = _padded(kern, ws)
+    delassus(c, N, ws.persistent, WN, WT, ws.K, ws.piv, ws.s, ws.Y, ws.D)
     for k in range(3 * c):
         ws.r[k] = 0.0
         ws.uf[k] = _local(ws, k, c, x[:n]) + ws.rate[k] if ws.persistent[k % c] != 0.0 else 0.0
@@ -554,7 +568,8 @@ def _impact(kern, ws, v, t, settings, extra):
     zeno_interval. Returns status."""
     c = kern.N_CONTACTS
     N = kern.N_COORDS + kern.N_CONSTRAINTS
-    delassus(c, N, ws.touching, ws.WNp, ws.WTp, ws.K, ws.piv, ws.s, ws.Y, ws.D)
+    WN, WT = _padded(kern, ws)
+    delassus(c, N, ws.touching, WN, WT, ws.K, ws.piv, ws.s, ws.Y, ws.D)
     for a in range(c):
         ws.coef_impact[a, 0] = ws.coef[a, 0]
         ws.coef_impact[a, 1] = ws.coef[a, 1]
@@ -685,7 +700,8 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
         if not _kkt_and_rhs(kern, ws, q, v, t, p):
             return SINGULAR_MASS
         _contacts_at(kern, ws, q, t, p)
-        delassus(c, n + m, ws.persistent, ws.WNp, ws.WTp, ws.K, ws.piv, ws.s, ws.Y, ws.D)
+        WN, WT = _padded(kern, ws)
+        delassus(c, n + m, ws.persistent, WN, WT, ws.K, ws.piv, ws.s, ws.Y, ws.D)
         for k in range(3 * c):
             ws.r[k] = 0.0
             ws.uf[k] = _relative(ws, k, c, v) if ws.persistent[k % c] != 0.0 else 0.0
