@@ -66,8 +66,14 @@ def test_not_a_contact_is_refused():
 def test_only_the_contact_methods_apply_to_contacts_and_not_elsewhere():
     assert registry.applicable_methods(0, 0, 1) == ("moreau_jean", "spook_contacts",
                                                     "dop853_impacts")
-    # with holonomic constraints too: the two whose step takes them as rows
-    assert registry.applicable_methods(1, 0, 1) == ("moreau_jean", "spook_contacts")
+    # with holonomic constraints too: all three (rows of the step's system; dop853_impacts' KKT
+    # system between switches)
+    assert registry.applicable_methods(1, 0, 1) == ("moreau_jean", "spook_contacts",
+                                                    "dop853_impacts")
+    # velocity constraints beside contacts: moreau_jean alone
+    assert registry.applicable_methods(0, 0, 1, 1) == ("moreau_jean",)
+    assert "nonholonomic constraints beside contacts" in registry.inapplicable(
+        "dop853_impacts", 1, 0, 1, 1)
     assert "nonsmooth elements" in registry.inapplicable("moreau_jean", 0, 1, 1)
     assert "moreau_jean" not in registry.applicable_methods(0, 0, 0)
     assert "dop853_impacts" not in registry.applicable_methods(0, 0, 0)

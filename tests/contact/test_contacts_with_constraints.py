@@ -73,13 +73,12 @@ def test_cartesian_pendulum_hits_the_wall_as_the_angle_form_does(generated, meth
 
 
 def test_a_contact_method_needs_the_rows_for_both(generated):
-    with pytest.raises(SimulationError, match=r"dop853_impacts.*does not treat holonomic "
-                                              r"constraints beside contacts \(use moreau_jean, "
-                                              r"spook_contacts\)"):
-        simulate(generated("pendulum_wall_cartesian"), method="dop853_impacts",
-                 q0=[0.0, -1.0], t_end=0.01)
+    """Every contact method takes holonomic constraints beside its contacts (dop853_impacts:
+    tests/contact/test_dop853_impacts_constraints.py); a constrained method does not take
+    contacts."""
     with pytest.raises(SimulationError, match=r"rattle.*ignores the model's unilateral contacts "
-                                              r"\(use moreau_jean, spook_contacts\)"):
+                                              r"\(use moreau_jean, spook_contacts, "
+                                              r"dop853_impacts\)"):
         simulate(generated("pendulum_wall_cartesian"), method="rattle", q0=[0.0, -1.0],
                  t_end=0.01, h=1e-3)
 

@@ -43,6 +43,21 @@ from there after ``classify``:
    velocities are then projected onto the persistent rows (u_N = 0; u_T = 0 when sticking) by
    the same solver, so that rest stays rest.
 
+Holonomic constraints Phi(q, t) = 0 (m rows, J = dPhi/dq; N = n + m): the motion between
+switches is the index-1 form
+
+    K (a, lam) = (f + W^T lambda, gamma),   K = [[M, -J^T], [J, 0]]   (gamma = -dJ/dt v, the
+                                                                      generated ``constraints``)
+
+from one LU of K per evaluation (M a = f + J^T lam + W^T lambda, J a = gamma); the contact
+problems (the persistent contacts' forces, the impact, the rest projection) take K as their
+factored matrix with W padded by m zero columns (core/contact_kkt.pad_rows, the same
+contact_problem.delassus), so the constraint forces and impulses follow the contact ones exactly
+and an impulse keeps J v = 0. No Baumgarte term: Phi'' = 0 holds to the integration error, so
+Phi drifts by that between switches; each switch (and the start) first projects q onto
+Phi(q, t) = 0 (the nearest point in the metric of M: newton.solve on assemble_projection) and v
+onto J v + dPhi/dt = 0 (one solve with K). Without constraints K is M and N = n.
+
 Orders: 8 between switches; the switch times are roots of the dense output (order 7), to
 events.ROOT_RTOL of the step. The gap of a persistent contact is held at the acceleration
 level, so it drifts by the integration error (rtol, atol).
@@ -62,6 +77,10 @@ is the state after the start's classification (an impact at t0 is in the impulse
 work counts from it. In every-step mode a switch writes two rows at its time: before and after (diff the sums for an
 impact's impulses).
 
+With holonomic constraints, after ``last_impact``: ``multipliers`` (m) lam at the row's state
+(the persistent contacts' forces included), ``constraint_error`` max|Phi| and
+``velocity_constraint_error`` max|J v + dPhi/dt| (1 each; core/constrained.SAVED's fields).
+
 ``last_impact`` (c) is each contact's latest impact time (-inf before its first): the Zeno
 guard's memory. A run continued in chunks (run/adaptive_driver.py) reclassifies the contacts
 at each chunk's start and takes that memory back from the saved fields, so the guard acts the
@@ -79,9 +98,11 @@ from typing import NamedTuple
 import numpy as np
 from ...jit.cache import njit
 
-from ..core import events
+from ..core import events, newton
+from ..core.constrained import constraint_rate
 from ..core.contact_problem import (BILATERAL, SLIDE, SLIDE_NEGATIVE, SLIDE_POSITIVE, STICK,
                                     contact_row, delassus)
+from ..core.contact_kkt import assemble_constraint_rows, pad_rows, record_constraints
 from ..core.contact_lcp import contact_solve, lcp_arrays
 from ..core.linalg import lu_inplace, lu_solve_inplace
 from ..core.method_spec import Spec
@@ -102,6 +123,12 @@ ROWS_PER_STEP = 2
 #: Saved-field offsets in ``extra`` (c contacts): impacts, normal sums, tangent 1 and tangent 2
 #: sums, modes, work.
 IMPACTS = 0
+
+#: The projection of q onto Phi(q, t) = 0 at a switch (Newton, newton.solve): its stopping
+#: tolerance (relative to max(1, |q|)) and iteration cap. It starts within the integration
+#: error of the manifold (rtol, atol), so two iterations are the usual count.
+PROJECTION_TOL = 1e-14
+PROJECTION_MAX_ITER = 20
 
 
 class Settings(NamedTuple):
@@ -138,41 +165,63 @@ class Settings(NamedTuple):
 #: step's start (pairs (slide_ref[a], slide_ref[c + a])), slide (2c,) the force's direction at
 #: the last evaluation; lcp_B, lcp_C, lcp_T, lcp_z, lcp_basis the exact fallback's scratch
 #: (core/contact_lcp.lcp_arrays).
+#: With m holonomic constraints (N = n + m; N = n and the constraint arrays empty without): K
+#: (N, N) the KKT matrix [[M, -J^T], [J, 0]] (LU-factored; s, piv (N,) its scratch and pivots,
+#: Y (3c, N) the rows K^-1 [W_k^T; 0]), x (N,) the KKT unknown (acceleration or velocity
+#: change, then the constraint multipliers or impulses), F, xq (N,) the position projection's
+#: residual and unknown (q, mu); phi, gam (m,) Phi and gamma (J qdd = gamma along a motion),
+#: crate (m,) dPhi/dt, G (m, n) J; WNp (c, N), WTp (2c, N) W_N, W_T padded with zero columns
+#: (core/contact_kkt.pad_rows).
 Workspace = namedtuple("Workspace", "kv ka qs q_new v_new q_int v_int H dense_q dense_v q_old "
                                     "v_old span pk w w_new w_old dense_w pw M f s piv acc g WN WT coef rate r uf zero un "
                                     "mode law impact_law persistent touching coef_impact "
                                     "last_impact Y D sw power contact_stages stage_at quad_F "
                                     "quad_ends solver left_at bias slide slide_ref lcp_B lcp_C "
-                                    "lcp_T lcp_z lcp_basis")
+                                    "lcp_T lcp_z lcp_basis K x F xq phi gam crate G WNp WTp")
 
 
 @njit
 def workspace(kern, n):
     """Allocated once per run by adaptive.run_adaptive."""
-    c = kern.N_CONTACTS
+    c, m = kern.N_CONTACTS, kern.N_CONSTRAINTS
+    N = n + m
     nd = dop853.N_DENSE
     sw = events.Workspace(np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c), np.zeros(2 * c),
                           np.zeros(2 * c, np.int64), np.zeros(n), np.zeros(n), np.zeros(1))
     return Workspace(np.zeros((nd, n)), np.zeros((nd, n)), np.zeros(n), np.zeros(n),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((n, n)),
                      np.zeros((7, n)), np.zeros((7, n)), np.zeros(n), np.zeros(n), np.zeros(2),
-                     *dop853.work_fields(n), np.zeros((n, n)), np.zeros(n), np.zeros(n),
-                     np.zeros(n, np.int64),
+                     *dop853.work_fields(n), np.zeros((n, n)), np.zeros(n), np.zeros(N),
+                     np.zeros(N, np.int64),
                      np.zeros(n), np.zeros(c), np.zeros((c, n)), np.zeros((2 * c, n)),
                      np.zeros((c, 2)), np.zeros(3 * c), np.zeros(3 * c), np.zeros(3 * c),
                      np.zeros(c), np.zeros(c), np.zeros(c, np.int64), np.zeros(2 * c, np.int64),
                      np.zeros(2 * c, np.int64), np.zeros(c), np.zeros(c), np.zeros((c, 2)),
-                     np.full(c, -np.inf), np.zeros((3 * c, n)), np.zeros((3 * c, 3 * c)), sw,
+                     np.full(c, -np.inf), np.zeros((3 * c, N)), np.zeros((3 * c, 3 * c)), sw,
                      np.zeros(2), np.zeros((nd, 1)), np.zeros(1, np.int64), np.zeros((7, 1)),
                      np.zeros(2), np.zeros(4), np.full(c, -np.inf), np.zeros(3 * c),
-                     np.zeros(2 * c), np.zeros(2 * c), *lcp_arrays(c))
+                     np.zeros(2 * c), np.zeros(2 * c), *lcp_arrays(c),
+                     np.zeros((N, N)), np.zeros(N), np.zeros(N), np.zeros(N), np.zeros(m),
+                     np.zeros(m), np.zeros(m), np.zeros((m, n)), np.zeros((c, N)),
+                     np.zeros((2 * c, N)))
 
 
 @njit(inline="always")
-def _mass_and_rhs(kern, ws, q, v, t, p):
-    """M (LU-factored in ws.M, ws.piv) and rhs into ws.f; False when M is singular."""
+def _kkt_and_rhs(kern, ws, q, v, t, p):
+    """The KKT matrix K = [[M, -J^T], [J, 0]] at (q, t) LU-factored in ws.K, ws.piv (K = M
+    without constraints), rhs into ws.f, Phi, J and gamma into ws.phi, ws.G, ws.gam; False when
+    K is singular (M, or J M^-1 J^T: redundant constraints)."""
+    n = kern.N_COORDS
+    if kern.N_CONSTRAINTS == 0:      # K is M (n, n): no copy, no constraint kernel call
+        kern.dynamics(q, v, t, p, ws.K, ws.f)
+        return lu_inplace(ws.K, ws.piv)
     kern.dynamics(q, v, t, p, ws.M, ws.f)
-    return lu_inplace(ws.M, ws.piv)
+    kern.constraints(q, v, t, p, ws.phi, ws.G, ws.gam)
+    for i in range(n):
+        for j in range(n):
+            ws.K[i, j] = ws.M[i, j]
+    assemble_constraint_rows(ws.K, n, ws.G, 0.0)
+    return lu_inplace(ws.K, ws.piv)
 
 
 @njit(inline="always")
@@ -197,6 +246,17 @@ def _contacts_at(kern, ws, q, t, p):
     """The contacts' gaps, Jacobians, coefficients and surface terms at (q, t) into ws."""
     kern.contacts(q, t, p, ws.g, ws.WN, ws.WT, ws.coef)
     kern.contact_bias(q, t, p, ws.bias)
+    if kern.N_CONSTRAINTS > 0:
+        pad_rows(kern.N_COORDS, ws.WN, ws.WT, ws.WNp, ws.WTp)
+
+
+@njit(inline="always")
+def _padded(kern, ws):
+    """(W_N, W_T) with K's columns (c, N), (2c, N): the padded copies with constraints, the
+    rows themselves without (N = n)."""
+    if kern.N_CONSTRAINTS > 0:
+        return ws.WNp, ws.WTp
+    return ws.WN, ws.WT
 
 
 @njit(inline="always")
@@ -255,7 +315,8 @@ def _solve(ws, c, tol, max_sweeps, flags, law, coef, un):
 
 @njit(inline="always")
 def _apply(ws, c, flags, r, x):
-    """x (n,) += sum_k Y_k r_k over the rows of the contacts flagged."""
+    """x += sum_k Y_k r_k over the rows of the contacts flagged: x (n,) the velocities (the
+    constraint impulses' part of Y left out) or x (N,) the KKT unknown (ws.x)."""
     for k in range(3 * c):
         if flags[k % c] != 0.0:
             for i in range(x.shape[0]):
@@ -264,32 +325,43 @@ def _apply(ws, c, flags, r, x):
 
 @njit(**FAST)
 def contact_acceleration(kern, ws, q, v, t, p, a):
-    """a (n,) = M^-1 (f + W^T lambda) with lambda (ws.r) the persistent contacts' forces under
-    ws.law; ws.power[0] <- lambda . (W v). OK, SINGULAR_MASS, CONTACT_NOT_CONVERGED or CONTACT_NO_SOLUTION."""
-    n, c = kern.N_COORDS, kern.N_CONTACTS
-    if not _mass_and_rhs(kern, ws, q, v, t, p):
+    """a (n,) from M a = f + J^T lam + W^T lambda, J a = gamma (the constrained motion; a =
+    M^-1 (f + W^T lambda) without constraints) with lambda (ws.r) the persistent contacts'
+    forces under ws.law; ws.x (N,) <- (a, lam); ws.power[0] <- lambda . (W v). OK,
+    SINGULAR_MASS, CONTACT_NOT_CONVERGED or CONTACT_NO_SOLUTION."""
+    n, c, m = kern.N_COORDS, kern.N_CONTACTS, kern.N_CONSTRAINTS
+    N = n + m
+    if not _kkt_and_rhs(kern, ws, q, v, t, p):
         return SINGULAR_MASS
+    x = ws.x
     for i in range(n):
-        a[i] = ws.f[i]
-    lu_solve_inplace(ws.M, ws.piv, a, ws.s)
+        x[i] = ws.f[i]
+    for k in range(m):       # no Baumgarte term: the drift of Phi is the integration error,
+        x[n + k] = ws.gam[k]  # removed by the projection at each switch
+    lu_solve_inplace(ws.K, ws.piv, x, ws.s)
     ws.power[0] = 0.0
     n_persistent = 0
     for k in range(c):
         n_persistent += int(ws.persistent[k])
     if n_persistent == 0:
+        for i in range(n):
+            a[i] = x[i]
         return OK
     _contacts_at(kern, ws, q, t, p)
     kern.contact_rates(q, v, t, p, ws.rate)
-    delassus(c, n, ws.persistent, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
+    WN, WT = _padded(kern, ws)
+    delassus(c, N, ws.persistent, WN, WT, ws.K, ws.piv, ws.s, ws.Y, ws.D)
     for k in range(3 * c):
         ws.r[k] = 0.0
-        ws.uf[k] = _local(ws, k, c, a) + ws.rate[k] if ws.persistent[k % c] != 0.0 else 0.0
+        ws.uf[k] = _local(ws, k, c, x[:n]) + ws.rate[k] if ws.persistent[k % c] != 0.0 else 0.0
     _slide_directions(ws, c, v)
     status = _solve(ws, c, ws.solver[0], int(ws.solver[1]), ws.persistent, ws.law, ws.coef,
                     ws.zero)
     if status != OK:
         return status
-    _apply(ws, c, ws.persistent, ws.r, a)
+    _apply(ws, c, ws.persistent, ws.r, x)      # the multipliers follow the contact forces
+    for i in range(n):
+        a[i] = x[i]
     power = 0.0
     for k in range(3 * c):
         if ws.persistent[k % c] != 0.0:
@@ -440,6 +512,7 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
             if ws.left_at[a] > -np.inf and ws.g[a] > ws.solver[2]:
                 ws.left_at[a] = -np.inf
                 sw.g_prev[a] = ws.g[a]
+        _record_constraints(kern, ws, ws.q_new, ws.v_new, t_new, p, extra)
         return OK, False, t_new
     status = dense(kern, q, v, t, h, p, ws)
     counters[3] += DENSE_EVALS
@@ -459,6 +532,7 @@ def switch_point(kern, ws, q, v, t, h, t_new, p, extra, counters):
         ws.w_new[0] = dop853.interpolate_work(ws, t_star)
     extra[_work_at(c)] += dop853.dense_integral(ws.contact_stages, h, (t_star - t) / h,
                                                  ws.quad_F, ws.quad_ends)
+    _record_constraints(kern, ws, ws.q_new, ws.v_new, t_star, p, extra)
     return status, True, t_star
 
 
@@ -488,10 +562,14 @@ def _past_crossing(kern, ws, p, t, t_new, first, t_star):
 @njit(inline="always")
 def _impact(kern, ws, v, t, settings, extra):
     """Newton's impact law with Coulomb friction on the touching contacts (ws.touching) at
-    velocity v (n,), in place; ws.M holds the factored mass matrix, WN, WT, coef the contacts.
-    The Zeno guard sets e = 0 for a contact hit again within zeno_interval. Returns status."""
-    n, c = kern.N_COORDS, kern.N_CONTACTS
-    delassus(c, n, ws.touching, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
+    velocity v (n,), in place; ws.K holds the factored KKT matrix (the mass matrix without
+    constraints: the impulses act on the constrained motion, J v kept), WN, WT (and their padded
+    copies), coef the contacts. The Zeno guard sets e = 0 for a contact hit again within
+    zeno_interval. Returns status."""
+    c = kern.N_CONTACTS
+    N = kern.N_COORDS + kern.N_CONSTRAINTS
+    WN, WT = _padded(kern, ws)
+    delassus(c, N, ws.touching, WN, WT, ws.K, ws.piv, ws.s, ws.Y, ws.D)
     for a in range(c):
         ws.coef_impact[a, 0] = ws.coef[a, 0]
         ws.coef_impact[a, 1] = ws.coef[a, 1]
@@ -516,8 +594,8 @@ def _impact(kern, ws, v, t, settings, extra):
 
 @njit(inline="always")
 def _record_impulses(kern, ws, flags, v, extra):
-    """v += M^-1 W^T r over the flagged contacts; the impulses' sums and their work
-    r . (u- + u+) / 2 into extra."""
+    """v += M^-1 W^T r over the flagged contacts (the velocity part of K^-1 [W^T r; 0] with
+    constraints); the impulses' sums and their work r . (u- + u+) / 2 into extra."""
     c = kern.N_CONTACTS
     work = 0.0
     for k in range(3 * c):
@@ -586,15 +664,21 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     impact, the modes, the projection onto the persistent rows); v changes in place. Then the
     first stage ka[0], the switching functions and the power at the new start. Returns
     status."""
-    n, c = kern.N_COORDS, kern.N_CONTACTS
+    n, c, m = kern.N_COORDS, kern.N_CONTACTS, kern.N_CONSTRAINTS
     work_before = extra[_work_at(c)]
     if ws.solver[3] != 0.0:        # a call's start: the Zeno guard's memory from extra
         for a in range(c):
             if extra[IMPACTS] == 0.0:      # none yet (extra starts at zeros)
                 extra[_last_impact_at(c) + a] = -np.inf
             ws.last_impact[a] = extra[_last_impact_at(c) + a]
-    if not _mass_and_rhs(kern, ws, q, v, t, p):
+    if m > 0:                      # the integration's drift off Phi = 0 removed here
+        status = _project_positions(kern, ws, q, v, t, p)
+        if status != OK:
+            return status
+    if not _kkt_and_rhs(kern, ws, q, v, t, p):
         return SINGULAR_MASS
+    if m > 0:                      # and off J v + dPhi/dt = 0
+        _project_velocities(kern, ws, q, v, t, p)
     _contacts_at(kern, ws, q, t, p)
     approaching = False
     for a in range(c):
@@ -613,10 +697,11 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     for a in range(c):
         n_persistent += int(ws.persistent[a])
     if n_persistent > 0:     # rest stays rest: u_N = 0 (and u_T = 0 sticking) on the velocities
-        if not _mass_and_rhs(kern, ws, q, v, t, p):
+        if not _kkt_and_rhs(kern, ws, q, v, t, p):
             return SINGULAR_MASS
         _contacts_at(kern, ws, q, t, p)
-        delassus(c, n, ws.persistent, ws.WN, ws.WT, ws.M, ws.piv, ws.s, ws.Y, ws.D)
+        WN, WT = _padded(kern, ws)
+        delassus(c, n + m, ws.persistent, WN, WT, ws.K, ws.piv, ws.s, ws.Y, ws.D)
         for k in range(3 * c):
             ws.r[k] = 0.0
             ws.uf[k] = _relative(ws, k, c, v) if ws.persistent[k % c] != 0.0 else 0.0
@@ -637,25 +722,116 @@ def apply_switch(kern, ws, q, v, t, p, settings, extra):
     if status != OK:
         return status
     dop853.start_work(kern, q, v, t, p, ws)      # P at the velocities after the impulses
-    return contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
+    status = contact_acceleration(kern, ws, q, v, t, p, ws.ka[0])
+    _record_constraints(kern, ws, q, v, t, p, extra)
+    return status
+
+
+@njit(inline="always")
+def _record_constraints(kern, ws, q, v, t, p, extra):
+    """The constrained fields of extra (nothing without constraints): the multipliers lam
+    (ws.x[n:], left there by contact_acceleration at (q, v, t), as ws.phi and ws.G), max|Phi|
+    and max|J v + dPhi/dt|."""
+    if kern.N_CONSTRAINTS > 0:
+        constraint_rate(kern, q, t, p, ws.crate)
+        record_constraints(extra, _constraints_at(kern.N_CONTACTS), ws.x, kern.N_COORDS, 1.0,
+                           ws.phi, ws.G, v, ws.crate)
+
+
+@njit(inline="always")
+def _constraints_at(c):
+    """Index of the constrained fields (multipliers (m), constraint_error,
+    velocity_constraint_error) in extra: after last_impact (c)."""
+    return 2 + 5 * c
+
+
+@njit(inline="always")
+def assemble_projection(kern, args, x, F, J):
+    """Newton system of the position projection at a switch: x = (q (n,), mu (m,)),
+    F = (M (q - q_ref) - J(q)^T mu, Phi(q, t)), the point of Phi = 0 nearest q_ref in the
+    kinetic-energy metric M = M(q) (the last iterate's). Its Jacobian is taken as the KKT matrix
+    [[M, -J^T], [J, 0]] at q: the terms left out (dM/dq (q - q_ref), d(J^T mu)/dq) are of the
+    size of the drift, which is the integration error, so the iteration still converges in a
+    step or two."""
+    ws, q_ref, v, t, p = args
+    n, m = kern.N_COORDS, kern.N_CONSTRAINTS
+    q = x[:n]
+    kern.mass_matrix(q, t, p, ws.M)
+    kern.constraints(q, v, t, p, ws.phi, ws.G, ws.gam)
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += ws.M[i, j] * (q[j] - q_ref[j])
+            J[i, j] = ws.M[i, j]
+        for k in range(m):
+            s -= ws.G[k, i] * x[n + k]
+        F[i] = s
+    for k in range(m):
+        F[n + k] = ws.phi[k]
+    assemble_constraint_rows(J, n, ws.G, 0.0)
+
+
+@njit(inline="always")
+def _project_positions(kern, ws, q, v, t, p):
+    """q (n,) <- the point of Phi(q, t) = 0 nearest q in the metric of M (Newton,
+    assemble_projection; ws.qs holds q_ref, ws.xq the unknown). Returns status (OK, or
+    Newton's failure: NEWTON_DIVERGED, SINGULAR_NEWTON, NON_FINITE)."""
+    n, m = kern.N_COORDS, kern.N_CONSTRAINTS
+    x = ws.xq
+    for i in range(n):
+        ws.qs[i] = q[i]
+        x[i] = q[i]
+    for k in range(m):
+        x[n + k] = 0.0
+    status, _, _ = newton.solve(_PROJECTION, kern, (ws, ws.qs, v, t, p), x, ws.F, ws.K, ws.piv,
+                                ws.s, PROJECTION_TOL, PROJECTION_MAX_ITER, n + m)
+    if status != OK:
+        return status
+    for i in range(n):
+        q[i] = x[i]
+    return OK
+
+
+@njit(inline="always")
+def _project_velocities(kern, ws, q, v, t, p):
+    """v (n,) <- v + dv with J dv = -(J v + dPhi/dt), M dv = J^T nu: the velocity on the
+    constraints nearest v in the kinetic-energy metric. ws.K, ws.G hold the factored KKT
+    matrix and J at (q, t) (_kkt_and_rhs)."""
+    n, m = kern.N_COORDS, kern.N_CONSTRAINTS
+    constraint_rate(kern, q, t, p, ws.crate)
+    x = ws.x
+    for i in range(n):
+        x[i] = 0.0
+    for k in range(m):
+        s = -ws.crate[k]
+        for j in range(n):
+            s -= ws.G[k, j] * v[j]
+        x[n + k] = s
+    lu_solve_inplace(ws.K, ws.piv, x, ws.s)
+    for i in range(n):
+        v[i] += x[i]
 
 
 # This module as a value for rk_step and events.refine (modules, not dispatchers, are passed).
 _THIS = sys.modules[__name__]
+# The position projection's Newton system, as a module for newton.solve (see newton.py).
+_PROJECTION = newton.problem(__name__ + "._projection", assemble_projection)
 
 SPEC = Spec(
     name="dop853_impacts", order=8, family="nonsmooth", implicit=False, symplectic=False,
-    symmetric=False, adaptive=True, contacts=True,
+    symmetric=False, adaptive=True, contacts=True, holonomic_too=True,
+    constraint_drift="grows",
     summary="event-driven contacts: dop853 between located impacts (Newton's law), "
             "persistent contacts and stick-slip switches, Zeno guard",
     settings=Settings,
     saved=(("impacts", 1), ("normal_impulse_sum", "c"), ("tangent_impulse_sum", "c"),
            ("tangent2_impulse_sum", "c"), ("contact_mode", "c"), ("contact_work", 1),
-           ("last_impact", "c")),
+           ("last_impact", "c"), ("multipliers", "m"), ("constraint_error", "m1"),
+           ("velocity_constraint_error", "m1")),
     limits={"rtol": (100 * 2.220446049250313e-16, True, False), "atol": (0.0, False, False),
             "h_max": (0.0, False, True), "max_steps": (1, True, False),
             "zeno_interval": (0.0, True, False), "gap_tol": (0.0, True, False),
             "rest_velocity": (0.0, True, False), "contact_tol": (0.0, False, False),
             "max_sweeps": (1, True, False)},
-    kernels=("contacts", "contact_bias", "contact_rates", "dynamics", "forward_dynamics",
-             "power"))
+    kernels=("constraint_rate", "constraints", "contacts", "contact_bias", "contact_rates",
+             "dynamics", "forward_dynamics", "mass_matrix", "power"))
