@@ -131,10 +131,16 @@ def run_{method}_controlled_events(kern, n_saved, {wrapped}):
 _STEPPER_GLUE = '''
 
 @njit(cache=True, error_model="numpy")
-def stepper_new_{method}(kern, q, v, p, clock, info, settings, h, first):
+def stepper_workspace_{method}(kern, n):
+    """{method}'s workspace for n coordinates on the kernel table ``kern``."""
+    return _make_workspace(_stepper_{method}, kern, n)
+
+
+@njit(cache=True, error_model="numpy")
+def stepper_new_{method}(kern, q, v, p, clock, info, settings, ws, first):
     """The StepperState of {method} on the kernel table ``kern``: q, v (n,), p (n_params,),
-    clock [t0, 0, t0], info (2,) shared with the caller."""
-    return _new_stepper_state(_stepper_{method}, kern, q, v, p, clock, info, settings, h, first)
+    clock [t0, 0, t0, h], info (2,) and the workspace ws, shared with the caller."""
+    return _new_stepper_state(kern, q, v, p, clock, info, settings, ws, first)
 
 
 @njit(cache=True, error_model="numpy")
@@ -150,8 +156,8 @@ def stepper_step_{method}(state, u, k):
 '''
 
 _STEPPER_IMPORT = ("\nfrom lagrange_gen.steppers.core.step_api import (\n"
-                   "    new_stepper_state as _new_stepper_state, prepare_state as _prepare_state,\n"
-                   "    step_state as _step_state)\n")
+                   "    make_workspace as _make_workspace, new_stepper_state as _new_stepper_state,\n"
+                   "    prepare_state as _prepare_state, step_state as _step_state)\n")
 
 
 #: The arguments the portable controlled glue takes after the glue's (GLUE_ARGS).
@@ -273,8 +279,8 @@ def portable_glue_source(method: str, digest: str) -> str:
     """Source text of the portable ``run_<method>(kern, n_saved, ...)``,
     ``run_<method>_events`` and, for a fixed-step method, ``run_<method>_controlled(kern,
     n_saved, ..., control, control_data)`` and its ``_events`` twin (_CONTROLLED_GLUE), the
-    step API's ``stepper_new_<method>``, ``stepper_prepare_<method>`` and
-    ``stepper_step_<method>`` (_STEPPER_GLUE) and ``ensemble_<method>(kern, n_saved, ...)``
+    step API's ``stepper_workspace_<method>``, ``stepper_new_<method>``,
+    ``stepper_prepare_<method>`` and ``stepper_step_<method>`` (_STEPPER_GLUE) and ``ensemble_<method>(kern, n_saved, ...)``
     (models without events)
     (lagrange_gen.jit.portable) for the library version ``digest``; deterministic."""
     loop_module, loop = LOOPS[spec(method).adaptive]

@@ -193,7 +193,7 @@ def _symplectic_euler(module, h, q, v, q1, v1, t, p, stepper):
     """H(q) u = H(q) v + h f(q, u, t); q1 = q + h u, p1 = H(q) u, v1 = H(q1)^-1 p1 (at t + h).
     u is the step's Newton solution (its workspace); on the explicit path (v1 = v + h a,
     q1 = q + h v1) u = v1."""
-    u = np.array(stepper._core.ws.u) if _newton_path(module, stepper) else v1
+    u = np.array(stepper.ws.u) if _newton_path(module, stepper) else v1
     dqx, _ = _rows(module)
     du, dp1 = _kick(module, h, q, v, u, t, p)
     return _velocity(module, q1, v1, t + h, p, dqx + h * du, dp1)
@@ -203,7 +203,7 @@ def _verlet(module, h, q, v, q1, v1, t, p, stepper):
     """H(q) u = H(q) v + h/2 f(q, u, t); H(q1) w = H(q) u, q1 = q + h/2 (u + w);
     p1 = H(q) u + h/2 f(q1, w, t + h), v1 = H(q1)^-1 p1. u and w are the step's own
     Newton solutions (its workspace); on the explicit path w = u."""
-    ws = stepper._core.ws
+    ws = stepper.ws
     uu = np.array(ws.u)
     w = np.array(ws.w) if _newton_path(module, stepper) else uu
     dqx, dux = _rows(module)
@@ -226,7 +226,7 @@ def _composition(coeffs, module, h, q, v, q1, v1, t, p, stepper):
     settings = stepper.settings._asdict()
     for g in coeffs:
         sub = Stepper(module, "verlet", abs(g * h), params=p, q0=qi, v0=vi, t0=ti, **settings)
-        sub.h = sub._core.h = g * h
+        sub.h = g * h
         sub.step()
         qn, vn = sub.q.copy(), sub.v.copy()
         F, G = _verlet(module, g * h, qi, vi, qn, vn, ti, p, sub)

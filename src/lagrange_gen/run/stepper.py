@@ -63,14 +63,15 @@ class Stepper:
         if not (is_number(t0) and math.isfinite(t0)):
             raise SimulationError(f"Stepper: t0 must be a finite number, got {t0!r}")
         n, (first, k) = module.N_COORDS, input_slots(module)
-        self.module, self.method, self.h, self.n_inputs = module, method, float(h), k
+        self.module, self.method, self.n_inputs = module, method, k
         self.settings = make_settings(spec, settings)
         p = parameter_vector(module, params)
         # The compiled step indexes q and v up to n - 1 without bounds checks.
         self.q = vector("q0", q0, n, module.COORDS).copy()
         self.v = vector("v0", v0, n, module.COORDS).copy()
         self.p = p
-        self._clock, self._info = np.array([float(t0), 0.0, float(t0)]), np.zeros(2)
+        # [t0, steps done, t, h]: the state's clock, read by the compiled steps
+        self._clock, self._info = np.array([float(t0), 0.0, float(t0), float(h)]), np.zeros(2)
         self._failure = None        # the message of the failure that ended this stepper
         self._label = f"Stepper({method}) for {module.NAME}"
         self._warm = False          # step() has run (its function loaded or compiled)
@@ -78,15 +79,28 @@ class Stepper:
         self._step = glue_function(method, f"stepper_step_{method}")
         self._u = np.zeros(k)        # u of step(), written here (no array made per call)
         with first_use_notice(self._label):
+            table = kernel_table(module, method)
+            #: the method's workspace (its arrays are the compiled state's)
+            self.ws = glue_function(method, f"stepper_workspace_{method}")(table, n)
             self._state = glue_function(method, f"stepper_new_{method}")(
-                kernel_table(module, method), self.q, self.v, p, self._clock, self._info,
-                self.settings, self.h, first)
+                table, self.q, self.v, p, self._clock, self._info, self.settings, self.ws, first)
             status = glue_function(method, f"stepper_prepare_{method}")(self._state)
         self._check(status, 0)
 
     @property
     def t(self):
         return self._clock[2]
+
+    @property
+    def h(self):
+        """The step; it may be changed between calls (a negative one steps back in time)."""
+        return self._clock[3]
+
+    @h.setter
+    def h(self, value):
+        if not (is_number(value) and math.isfinite(value) and value != 0):
+            raise SimulationError(f"Stepper: the step h must be a finite nonzero number, got {value!r}")
+        self._clock[3] = float(value)
 
     @property
     def steps(self):

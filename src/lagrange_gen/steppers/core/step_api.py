@@ -1,6 +1,6 @@
 """The state of a step API (run/stepper.py, ``lg.Stepper``) and the compiled calls on it.
 
-A Stepper holds the method's arrays (q, v, the momentum, p, the clock [t0, steps done, t],
+A Stepper holds the method's arrays (q, v, the momentum, p, the clock [t0, steps done, t, h],
 [iterations, residual]), its settings and workspace, and the kernel table of its model
 (jit/portable.kernel_table), in one numba structref: Python passes one object per call, as
 it passed the instance of a jitclass, but a structref's type can be kept in numba's on-disk
@@ -19,10 +19,12 @@ from ...jit.api import overload, structref, types
 from .options import fast_loop
 from .state_checks import check_state
 
-__all__ = ["StepperStateType", "StepperState", "new_stepper_state", "prepare_state", "step_state"]
+__all__ = ["StepperStateType", "StepperState", "make_workspace", "new_stepper_state", "prepare_state",
+           "step_state"]
 
-#: The fields of a Stepper's state, in order.
-FIELDS = ("kern", "q", "v", "mom", "p", "extra", "clock", "info", "settings", "ws", "h", "first")
+#: The fields of a Stepper's state, in order (the step h is clock[3], so that Python may set it
+#: between calls).
+FIELDS = ("kern", "q", "v", "mom", "p", "extra", "clock", "info", "settings", "ws", "first")
 
 
 @structref.register
@@ -41,34 +43,30 @@ class StepperState(structref.StructRefProxy):
 structref.define_boxing(StepperStateType, StepperState)
 
 
-def new_stepper_state(method, kern, q, v, p, clock, info, settings, h, first):
-    """The StepperState of ``method`` (a stepper module) on the kernel table ``kern`` (jitted:
-    see the overload): the method's workspace made for n = q.shape[0], the momentum zero."""
+@njit
+def make_workspace(method, kern, n):
+    """The workspace of ``method`` (a stepper module) on the kernel table ``kern`` for n
+    coordinates: handed to Python, which keeps it (its arrays are the state's)."""
+    return method.workspace(kern, n)
+
+
+def new_stepper_state(kern, q, v, p, clock, info, settings, ws, first):
+    """The StepperState on the kernel table ``kern`` (jitted: see the overload): q, v (n,),
+    p (n_params,), clock [t0, 0, t0, h], info (2,), the workspace ws (make_workspace), all
+    shared with the caller; the momentum zero."""
 
 
 @overload(new_stepper_state)
-def _new_stepper_state(method, kern, q, v, p, clock, info, settings, h, first):
-    def impl(method, kern, q, v, p, clock, info, settings, h, first):
-        n = q.shape[0]
-        return _assemble(kern, q, v, np.zeros(n), p, np.zeros(0), clock, info, settings,
-                         method.workspace(kern, n), h, first)
-    return impl
+def _new_stepper_state(kern, q, v, p, clock, info, settings, ws, first):
+    vector = types.Array(types.float64, 1, "C")          # the momentum and extra, made here
+    state_type = StepperStateType(fields=list(zip(FIELDS, (kern, q, v, vector, p, vector, clock,
+                                                         info, settings, ws, first))))
 
-
-def _assemble(kern, q, v, mom, p, extra, clock, info, settings, ws, h, first):
-    """structref.new of the type these arguments make, every field set."""
-
-
-@overload(_assemble)
-def _assemble_impl(kern, q, v, mom, p, extra, clock, info, settings, ws, h, first):
-    state_type = StepperStateType(fields=list(zip(FIELDS, (kern, q, v, mom, p, extra, clock, info,
-                                                         settings, ws, h, first))))
-
-    def impl(kern, q, v, mom, p, extra, clock, info, settings, ws, h, first):
+    def impl(kern, q, v, p, clock, info, settings, ws, first):
         state = structref.new(state_type)
-        state.kern, state.q, state.v, state.mom, state.p = kern, q, v, mom, p
-        state.extra, state.clock, state.info, state.settings = extra, clock, info, settings
-        state.ws, state.h, state.first = ws, h, first
+        state.kern, state.q, state.v, state.mom, state.p = kern, q, v, np.zeros(q.shape[0]), p
+        state.extra, state.clock, state.info, state.settings = np.zeros(0), clock, info, settings
+        state.ws, state.first = ws, first
         return state
     return impl
 
@@ -93,14 +91,15 @@ def step_state(method, state, u, k):
         if status != 0:
             return status
     return _advance(method, state.kern, state.q, state.v, state.mom, state.p, state.settings,
-                    state.ws, state.extra, state.clock, state.info, state.h, k)
+                    state.ws, state.extra, state.clock, state.info, k)
 
 
 @fast_loop
-def _advance(method, kern, q, v, mom, p, settings, ws, extra, clock, info, h, k):
-    """k steps; clock = [t0, steps done, t]; info = [iterations, residual]. Apart from the
+def _advance(method, kern, q, v, mom, p, settings, ws, extra, clock, info, k):
+    """k steps; clock = [t0, steps done, t, h]; info = [iterations, residual]. Apart from the
     state's reads, without reference counting: counting every array a step touches costs as
     much as the step itself (options.fast_loop)."""
+    h = clock[3]
     for _ in range(k):
         t = clock[0] + clock[1] * h
         status, iters, resid = method.step(kern, q, v, mom, t, h, p, settings, ws, extra)
