@@ -253,6 +253,22 @@ def test_a_cold_simulate_of_a_generated_module_does_not_import_sympy():
     assert out.returncode == 0, out.stderr
 
 
+def test_lagrange_gen_on_an_unchanged_model_imports_neither_numpy_nor_sympy():
+    """The freshness check of a generated module (codegen.keys, jit.sources) is light: the
+    command on a model whose module is current imports neither numpy, sympy nor numba (the
+    first run may derive it once, when the generator changed since it was last decided)."""
+    first = _run("from lagrange_gen.cli.main import main\n"
+                 "assert main(['models/cart_pendulum.py', '-o', 'generated']) == 0\n")
+    assert first.returncode == 0, first.stderr
+    out = _run("import sys\n"
+               "from lagrange_gen.cli.main import main\n"
+               "assert main(['models/cart_pendulum.py', '-o', 'generated']) == 0\n"
+               "heavy = sorted(m for m in ('numpy', 'sympy', 'numba') if m in sys.modules)\n"
+               "assert not heavy, heavy\n")
+    assert out.returncode == 0, out.stderr
+    assert "is current" in out.stdout + out.stderr, out.stdout + out.stderr
+
+
 def test_gpu_sits_below_run():
     """gpu/ (ensemble(device="cuda")) imports neither run/ nor cli/: run calls it."""
     above = ("run", "cli", "linear", "viz", "analysis", "bench", "identify")

@@ -17,7 +17,6 @@ from .speedups import check_numba_version as _check_numba_version
 _check_numba_version()
 
 from .cache import CALLEE_MODULES, closure_stamp, compiled_for_jitted_callers, njit  # noqa: E402
-from .python_calls import check_python_calls  # noqa: E402
 
 #: numba options of a function that never allocates: no reference counting (every call from a
 #: stepper would pay for it).
@@ -30,3 +29,13 @@ KERNEL_OPTIONS = dict(cache=True, **NO_REFCOUNT, error_model="numpy")
 
 __all__ = ["njit", "closure_stamp", "compiled_for_jitted_callers", "CALLEE_MODULES",
            "KERNEL_OPTIONS", "NO_REFCOUNT", "check_python_calls"]
+
+
+def __getattr__(name):
+    """check_python_calls, imported on first use: it needs numpy, which the freshness check of a
+    generated module (codegen.keys, through jit.sources) does not (``lagrange-gen`` on an
+    unchanged model imports neither)."""
+    if name == "check_python_calls":
+        from .python_calls import check_python_calls
+        return check_python_calls
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
