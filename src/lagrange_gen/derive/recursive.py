@@ -20,6 +20,8 @@ and the module is not used (the H + Cholesky kernels stay).
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 import symengine as se
 import sympy as sp
@@ -37,10 +39,26 @@ def _count(e):
     return own + sum(_count(a) for a in e.args)
 
 
+#: {graph: {node: _count of its definition}}: the generator weighs several programs over the
+#: same nodes (recursive or graph, per kernel), and a definition never changes.
+_NODE_COUNTS = weakref.WeakKeyDictionary()
+
+
+def _node_count(graph, node, definition):
+    counts = _NODE_COUNTS.get(graph)
+    if counts is None:
+        counts = _NODE_COUNTS[graph] = {}
+    found = counts.get(node)
+    if found is None:
+        found = counts[node] = _count(definition)
+    return found
+
+
 def operation_count(graph, exprs):
     """Arithmetic operations and function calls to evaluate ``exprs`` (native) with the graph
     nodes they use: what numba's compile time and the run time follow."""
-    return sum(_count(d) for _, d in graph.used_nodes(exprs)) + sum(_count(se.sympify(e)) for e in exprs)
+    return (sum(_node_count(graph, s, d) for s, d in graph.used_nodes(exprs))
+            + sum(_count(se.sympify(e)) for e in exprs))
 
 
 def column_operation_counts(graph, columns):
@@ -51,10 +69,12 @@ def column_operation_counts(graph, columns):
     plus one pass of each loop; per call: the seed-free nodes plus every pass."""
     seeds = {s for _, column_seeds, _ in columns for s in column_seeds}
     every = [e for _, _, column in columns for e in column]
-    outside = sum(_count(d) for s, d in graph.used_nodes(every) if not graph.inputs_of(s) & seeds)
+    outside = sum(_node_count(graph, s, d) for s, d in graph.used_nodes(every)
+                  if not graph.inputs_of(s) & seeds)
     compiled, per_call = outside, outside
     for _, column_seeds, column in columns:
-        inside = sum(_count(d) for s, d in graph.used_nodes(column) if graph.inputs_of(s) & seeds)
+        inside = sum(_node_count(graph, s, d) for s, d in graph.used_nodes(column)
+                     if graph.inputs_of(s) & seeds)
         inside += sum(_count(se.sympify(e)) for e in column)
         compiled, per_call = compiled + inside, per_call + len(column_seeds) * inside
     return compiled, per_call
