@@ -150,3 +150,20 @@ def write_atomic(path: Path, data: bytes) -> None:
         except OSError:
             pass
         raise
+
+
+def import_file(name: str, path: Path):
+    """The module ``name`` executed from the file ``path`` and registered in sys.modules under
+    that name (numba's cache finds a module's globals by its name); nothing is left registered
+    when its execution fails."""
+    import importlib.util
+    import sys
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[name]
+        raise
+    return module

@@ -32,12 +32,11 @@ from __future__ import annotations
 import collections
 import functools
 import hashlib
-import importlib.util
 import os
 import sys
 from pathlib import Path
 
-from .folders import (DIR_ENV, UNUSED_DAYS, native_dir, portable_dir,  # noqa: F401 (the folders of the glue)
+from .folders import (DIR_ENV, UNUSED_DAYS, import_file, native_dir, portable_dir,  # noqa: F401 (the folders of the glue)
                       remove_unused_versions, write_in_version)
 
 #: The values of simulate(jit=...).
@@ -198,10 +197,7 @@ def _glue_module(method: str):
     name = f"lagrange_gen_portable_{digest}_{method}"
     module = sys.modules.get(name)
     if module is None:
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
+        module = import_file(name, path)
     return module
 
 

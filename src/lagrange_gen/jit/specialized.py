@@ -17,7 +17,6 @@ entries of its earlier KEY in that directory are removed.
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import sys
 from pathlib import Path
@@ -80,14 +79,7 @@ def glue_module(module, method):
     name = f"lagrange_gen_specialized_{digest}_{stem}"
     glue = sys.modules.get(name)
     if glue is None:
-        spec = importlib.util.spec_from_file_location(name, path)
-        glue = importlib.util.module_from_spec(spec)
-        sys.modules[name] = glue
-        try:
-            spec.loader.exec_module(glue)
-        except BaseException:
-            del sys.modules[name]
-            raise
+        glue = folders.import_file(name, path)
     glues[method] = glue
     return glue
 

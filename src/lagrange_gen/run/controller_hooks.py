@@ -19,7 +19,6 @@ text, compiled in this process only.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import sys
 from dataclasses import dataclass
 
@@ -94,13 +93,6 @@ def controller_hooks(controller, with_params: bool) -> ControllerHooks:
     module = sys.modules.get(name)
     if module is None:
         path = folders.write_in_version(version, f"{stem}.py", hook_source(with_params, cache=True))
-        spec = importlib.util.spec_from_file_location(name, path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        try:
-            spec.loader.exec_module(module)
-        except BaseException:
-            del sys.modules[name]
-            raise
+        module = folders.import_file(name, path)
         module.controller = controller
     return ControllerHooks(module.apply, module.probe, cached=True)

@@ -5,7 +5,6 @@ lagrange_gen.jit.njit)."""
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import sys
 from pathlib import Path
 
@@ -13,6 +12,7 @@ from ..codegen.keys import check_current, default_generated_dir, read_key
 from ..errors import GenerationError, StaleModuleError
 from ..codegen import model_cache
 from ..jit.cache import GENERATED_MODULE_PREFIX
+from ..jit.folders import import_file
 
 
 def import_generated(path):
@@ -31,15 +31,7 @@ def import_generated(path):
             check_current(cached.__file__, cached.KEY, cached.SOURCES, cached.MODEL_PATH,
                           cached.OPTIONS, cached.TEXT_SHA)
         return cached
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[name]
-        raise
-    return module
+    return import_file(name, path)
 
 
 def load(path, out_dir=None, methods=None, options=None, regenerate=True, freeze=None,
