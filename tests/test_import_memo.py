@@ -13,7 +13,6 @@ from lagrange_gen.jit import folders, sources
 def memo_dir(tmp_path, monkeypatch):
     monkeypatch.setattr(folders, "portable_dir", lambda: tmp_path)
     monkeypatch.setitem(sources._IMPORT_MEMO, "entries", None)
-    monkeypatch.setitem(sources._IMPORT_MEMO, "changed", False)
     return tmp_path
 
 

@@ -64,8 +64,7 @@ def source_closure(roots) -> tuple:
     Package ``__init__`` files are not followed: they run at import, numba compiles nothing
     from them."""
     seen, files, todo = set(), [], list(roots)
-    known = _import_memo()
-    size = len(known)
+    known, changed = _import_memo(), False
     while todo:
         dotted = todo.pop()
         path = module_path(dotted)
@@ -78,17 +77,17 @@ def source_closure(roots) -> tuple:
         digest = _file_hash(str(path), stat.st_mtime_ns, stat.st_size)
         if known.get(relative, (None,))[0] != digest:
             known[relative] = (digest, list(_imports_of(dotted, str(path), stat.st_mtime_ns, stat.st_size)))
+            changed = True
         todo += known[relative][1]
-    if len(known) != size or _IMPORT_MEMO["changed"]:
+    if changed:
         _save_import_memo(known)
     return tuple(sorted(files))
 
 
 #: The import graph of the package files, by file and content hash: {relative path: (sha256
 #: prefix, imported modules)}, kept on disk (IMPORT_MEMO_FILE in the portable folder) so that a
-#: new process reads it instead of parsing every file its glue compiles from; "changed": an
-#: entry was replaced in this process.
-_IMPORT_MEMO = {"entries": None, "changed": False}
+#: new process reads it instead of parsing every file its glue compiles from.
+_IMPORT_MEMO = {"entries": None}
 
 #: File name of the import graph's memo in the portable folder.
 IMPORT_MEMO_FILE = "imports.json"
@@ -105,17 +104,8 @@ def _import_memo() -> dict:
             entries = {str(k): (str(v[0]), [str(m) for m in v[1]]) for k, v in raw.items()}
         except (OSError, ValueError, TypeError, IndexError, AttributeError):
             pass
-        _IMPORT_MEMO["entries"] = _TrackedDict(entries)
+        _IMPORT_MEMO["entries"] = entries
     return _IMPORT_MEMO["entries"]
-
-
-class _TrackedDict(dict):
-    """A dict that notes, in _IMPORT_MEMO, that an entry was replaced (a file edited)."""
-
-    def __setitem__(self, key, value):
-        if key in self:
-            _IMPORT_MEMO["changed"] = True
-        super().__setitem__(key, value)
 
 
 def _save_import_memo(entries):
@@ -123,7 +113,6 @@ def _save_import_memo(entries):
     try:
         from .folders import portable_dir, write_atomic
         write_atomic(portable_dir() / IMPORT_MEMO_FILE, json.dumps(entries, sort_keys=True).encode())
-        _IMPORT_MEMO["changed"] = False
     except OSError:
         pass
 
