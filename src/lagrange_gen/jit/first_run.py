@@ -247,14 +247,10 @@ def start_background_compile(module, method, stream=None, controlled=False):
     notes = []
     if not take_lock(lock, notes):
         return None
-    package_parent = str(Path(__file__).resolve().parents[2])
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(
-        [package_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
     try:
         pid = spawn_detached(
             [sys.executable, "-m", __name__, method, module.__name__, module.__file__, str(lock)]
-            + (["controlled"] if controlled else []), env)
+            + (["controlled"] if controlled else []), background_env())
     except (OSError, ValueError, subprocess.SubprocessError):
         release_lock(lock)
         return None
@@ -266,6 +262,16 @@ def start_background_compile(module, method, stream=None, controlled=False):
                  f"(process {pid}; {BACKGROUND_ENV}=0 turns this off{took_over})\n")
     stream.flush()
     return pid
+
+
+def background_env() -> dict:
+    """This process's environment with this package's parent first on PYTHONPATH: a background
+    process runs the same lagrange_gen as the one that started it."""
+    package_parent = str(Path(__file__).resolve().parents[2])
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [package_parent] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p])
+    return env
 
 
 #: The launcher of a detached process: it forks, the child starts a session of its own and
