@@ -357,7 +357,7 @@ def tiers_allowed(level: int) -> bool:
     level (not one set by $LAGRANGE_GEN_NATIVE_OPT) and only where background compiles are
     allowed (else nothing would ever compile the better object and every run would keep the
     slower one)."""
-    from .first_run import background_enabled
+    from .background import background_enabled
     return level > 0 and not os.environ.get(OPT_ENV, "").strip() and background_enabled()
 
 

@@ -11,7 +11,7 @@ object cache, with one line on stderr:
     lagrange-gen: compiling 3 kernels of humanoid at LLVM level 1 in the background for the next run (dynamics, mass_matvec_dq, rhs_jacobian; process 4242; LAGRANGE_GEN_BACKGROUND_COMPILE=0 turns this off)
 
 The next process finds them. One such process per generated module text at a time (a lock
-file in the object cache, jit.first_run's lock records); with background compiles off
+file in the object cache, jit.background's lock records); with background compiles off
 ($LAGRANGE_GEN_BACKGROUND_COMPILE=0), or an explicit $LAGRANGE_GEN_NATIVE_OPT, every kernel is
 compiled at its level in the foreground, as before.
 """
@@ -23,8 +23,8 @@ import subprocess
 import sys
 from pathlib import Path
 
-from .first_run import (BACKGROUND_ENV, _write_record, background_enabled, background_env,
-                        release_lock, spawn_detached, take_lock)
+from .background import (BACKGROUND_ENV, background_enabled, background_env, release_lock,
+                         spawn_detached, take_lock, write_record)
 
 
 def lock_path(module, folder: Path) -> Path:
@@ -50,7 +50,7 @@ def compile_later(module, kernels, folder: Path, stream=None):
     except (OSError, ValueError, subprocess.SubprocessError):
         release_lock(lock)
         return None
-    _write_record(lock, pid)
+    write_record(lock, pid)
     took_over = "".join(f"; {note}" for note in notes)
     model = getattr(module, "NAME", None) or str(module.__name__).rsplit(".", 1)[-1]
     stream = stream or sys.stderr
