@@ -23,7 +23,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..steppers.core import status as st
-from ..steppers.sensitivity import SENSITIVITY_METHODS
+from ..steppers.sensitivity import MOMENTUM_FORM, SENSITIVITY_METHODS
 from .trajectory import Trajectory
 
 #: Names of the initial-state sensitivities.
@@ -86,12 +86,11 @@ def check_method(method):
 def check_sensitivities(module, method):
     """SimulationError in one line when ``method`` on ``module`` has no forward sensitivities."""
     check_method(method)
-    if getattr(module, "TRANSPORT", False) and method not in ("explicit_euler", "rk4",
-                                                                "implicit_euler"):
+    if getattr(module, "TRANSPORT", False) and method in MOMENTUM_FORM:
+        others = [m for m in SENSITIVITY_METHODS if m not in MOMENTUM_FORM]
         raise SimulationError(f"simulate: {module.NAME} has a kinetic energy linear in the "
                               f"velocities (canonical momentum H v + b); the sensitivities of "
-                              f"{method} cover p = H v only (use explicit_euler, rk4 or "
-                              f"implicit_euler)")
+                              f"{method} cover p = H v only (use {', '.join(others)})")
     if getattr(module, "N_EVENTS", 0):
         raise SimulationError(f"simulate: {module.NAME} has events; a run with sensitivities "
                               f"does not locate them (remove the events or the sensitivities)")
