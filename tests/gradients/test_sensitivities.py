@@ -179,3 +179,17 @@ def test_bad_input_is_one_line(models):
         assert "\n" not in str(exc.value)
     with pytest.raises(KeyError, match="was not asked for"):
         _run(module, "rk4", q0, v0, sensitivities=["l2"]).sensitivity("m2")
+
+
+def test_a_model_file_is_regenerated_with_sensitivities_when_asked(tmp_path):
+    """A module generated without them gains them (keeping its methods), and keeps them."""
+    from lagrange_gen.codegen.keys import read_header
+    path = MODELS_DIR / "double_pendulum.py"
+    target = generate_model(path, tmp_path, methods=["rk4"]).path
+    assert "sensitivities" not in read_header(target)["OPTIONS"]
+    traj = lg.simulate(path, "rk4", [0.5, 1.0], [0.0, 0.3], t_end=0.05, h=0.01, out_dir=tmp_path,
+                       sensitivities=["g"])
+    assert traj.sensitivity("g").shape == (6, 4)
+    assert read_header(target)["OPTIONS"] == {"build": {}, "methods": ["rk4"], "sensitivities": True}
+    lg.simulate(path, "rk4", [0.5, 1.0], [0.0, 0.3], t_end=0.05, h=0.01, out_dir=tmp_path)
+    assert read_header(target)["OPTIONS"]["sensitivities"] is True

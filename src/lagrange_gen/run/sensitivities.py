@@ -94,8 +94,8 @@ def check_sensitivities(module, method):
     if getattr(module, "N_EVENTS", 0):
         raise SimulationError(f"simulate: {module.NAME} has events; a run with sensitivities "
                               f"does not locate them (remove the events or the sensitivities)")
-    missing = [name for name in ("rhs_dp", "mass_matvec_dp", "momentum_rate_dp")
-               if not hasattr(module, name)]
+    from ..codegen.needs import sensitivity_needs
+    missing = [name for name in sorted(sensitivity_needs(method)) if not hasattr(module, name)]
     if missing:
         from ..codegen.keys import regeneration_command_from
         command = (regeneration_command_from(module.__file__, module.MODEL_PATH,
