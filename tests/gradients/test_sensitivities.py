@@ -39,6 +39,29 @@ model = Model("damped_cart", coords=[x, th], T=T, V=V, inputs=[u],
               dissipation=c * x.d**2 / 2 + d * th.d**2 / 2, forces={x: u * sp.cos(th)})
 '''
 
+#: Two rigid bodies in 3D (sympy.physics.mechanics, lg.kinetic_energy: the graph path, with the
+#: recursive kernels) whose masses, inertias, centre of mass and link length are parameters.
+BODIES = '''
+import sympy.physics.mechanics as me
+import lagrange_gen as lg
+q1, q2, q3 = me.dynamicsymbols("q1 q2 q3")
+m1, m2, l1, c2, I1, I2, g = lg.parameters("m1 m2 l1 c2 I1 I2 g",
+                                          defaults=(1.2, 0.8, 0.6, 0.3, 0.05, 0.02, 9.81))
+N = me.ReferenceFrame("N")
+A = N.orientnew("A", "Axis", [q1, N.z])
+B = A.orientnew("B", "Axis", [q2, A.y])
+C = B.orientnew("C", "Axis", [q3, B.x])
+O = me.Point("O"); O.set_vel(N, 0)
+P = O.locatenew("P", -l1 * B.z)
+G2 = P.locatenew("G2", -c2 * C.z + 0.1 * C.x)
+G1 = O.locatenew("G1", -0.5 * l1 * B.z)
+link1 = me.RigidBody("link1", G1, B, m1, (me.inertia(B, I1, I1, 0.3 * I1), G1))
+link2 = me.RigidBody("link2", G2, C, m2, (me.inertia(C, I2, 1.5 * I2, 0.5 * I2, 0.1 * I2), G2))
+bodies = [link1, link2]
+model = lg.Model("bodies_3d", coords=[q1, q2, q3], T=lg.kinetic_energy(N, bodies),
+                 V=lg.gravity_potential(N, -g * N.z, bodies), frame=N)
+'''
+
 
 def _tree_file(path, name, tree):
     path.write_text("from lagrange_gen.model.joint_tree import model_from_tree\n\n"
@@ -52,10 +75,13 @@ def models(tmp_path_factory):
     out = tmp_path_factory.mktemp("sensitivities")
     damped = out / "damped_cart.py"
     damped.write_text(DAMPED)
+    bodies = out / "bodies_3d.py"
+    bodies.write_text(BODIES)
     tree = _tree_file(out / "random_tree_3.py", "random_tree_3", random_tree(np.random.default_rng(3), 3))
     cases = {"double_pendulum": (MODELS_DIR / "double_pendulum.py", {}, [0.5, 1.0], [0.0, 0.3],
                                  ["l2", "m2"]),
              "damped_cart": (damped, {}, [0.2, 0.4], [0.1, -0.2], ["c", "l", "u"]),
+             "bodies_3d": (bodies, {}, [0.3, 0.5, -0.2], [0.1, -0.2, 0.3], ["m2", "I2", "c2", "l1"]),
              "spatial_chain_3": (MODELS_DIR / "spatial_chain.py", {"n": 3}, [0.3, -0.4, 0.5],
                                  [0.2, 0.1, -0.3], ["g"]),
              "random_tree_3": (tree, {}, [0.2, -0.3, 0.1], [0.1, 0.2, 0.0], ["g"])}
@@ -95,14 +121,16 @@ def _central(module, method, q0, v0, name, direction=None):
     return (_state(plus) - _state(minus)) / (2 * step)
 
 
-LABELS = ("double_pendulum", "damped_cart", "spatial_chain_3", "random_tree_3")
+LABELS = ("double_pendulum", "damped_cart", "bodies_3d", "spatial_chain_3", "random_tree_3")
+#: Models built from bodies share their kernels' kind: one method of each family runs on them.
+GRAPH_LABELS = ("bodies_3d", "spatial_chain_3", "random_tree_3")
 
 
 @pytest.mark.parametrize("method", SENSITIVITY_METHODS)
 @pytest.mark.parametrize("label", LABELS)
 def test_sensitivities_equal_central_differences(models, label, method):
     module, q0, v0, names = models[label]
-    if label in ("spatial_chain_3", "random_tree_3") and method not in ("midpoint", "rk4", "verlet"):
+    if label in GRAPH_LABELS and method not in ("midpoint", "rk4", "verlet"):
         pytest.skip("the graph models: one method of each kind (their kernels are shared)")
     traj = _run(module, method, q0, v0, sensitivities=names + ["q0", "v0"])
     plain = _run(module, method, q0, v0)
@@ -130,7 +158,7 @@ def test_one_step_equals_step_jacobian(models, method):
     assert _rel(S, Fx) < 1e-9
 
 
-@pytest.mark.parametrize("label", ["double_pendulum", "spatial_chain_3"])
+@pytest.mark.parametrize("label", ["double_pendulum", "bodies_3d", "spatial_chain_3"])
 def test_parameter_kernels_equal_central_differences_of_the_kernels(models, label):
     module, q0, v0, _ = models[label]
     n, p = module.N_COORDS, module.DEFAULT_PARAMS.copy()
