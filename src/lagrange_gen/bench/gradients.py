@@ -13,6 +13,7 @@ until the Newton tolerance over eps takes over.
 from __future__ import annotations
 
 import platform
+import tempfile
 import time
 from pathlib import Path
 
@@ -77,7 +78,7 @@ def run_gradients_bench(models_dir, reports_dir, quick=False):
     from ..codegen import generate_model
     from ..run.loader import import_generated
     steps, repeats = (2000, 2) if quick else (20000, 5)
-    gen = Path(reports_dir) / ".gradients_generated"
+    gen = Path(tempfile.mkdtemp(prefix="lagrange_gen_gradients_"))
     lines = ["# Forward sensitivities: cost and agreement", "",
              "Written by `lagrange-gen bench gradients`" + (" --quick" if quick else "") +
              f" ({platform.processor() or platform.machine()}, {time.strftime('%Y-%m-%d')}). "
