@@ -22,6 +22,7 @@ import time
 import numpy as np
 
 from ..errors import SimulationError
+from ..jit.compile_notice import first_use_notice
 from ..steppers.core import status as st
 from ..steppers.sensitivity import MOMENTUM_FORM, SENSITIVITY_METHODS
 from .trajectory import Trajectory
@@ -119,8 +120,10 @@ def simulate_sensitivities(module, method, q, v, p, settings, h, t0, n_steps, sa
     run = importlib.import_module(f"lagrange_gen.steppers.sensitivity.{method}").run
     table = sensitivity_table(module, method)
     start = time.perf_counter()
-    status, done = run(table, q, v, float(t0), float(h), int(n_steps), int(save_every), p,
-                       settings, cols, S0, out_q, out_v, out_S, out_stats)
+    # the first run of a method with sensitivities compiles its loop (then numba's cache has it)
+    with first_use_notice(f"the sensitivities of {method} (all models)"):
+        status, done = run(table, q, v, float(t0), float(h), int(n_steps), int(save_every), p,
+                           settings, cols, S0, out_q, out_v, out_S, out_stats)
     wall = time.perf_counter() - start
     if status != st.OK:
         step = max(int(done), 0)
