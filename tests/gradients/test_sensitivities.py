@@ -18,7 +18,7 @@ from lagrange_gen.errors import SimulationError
 from lagrange_gen.linear.step_derivatives import step_jacobian
 from lagrange_gen.model.model_file import load_model
 from lagrange_gen.run.loader import import_generated
-from lagrange_gen.steppers.sensitivity import SENSITIVITY_METHODS
+from lagrange_gen.steppers.sensitivity import MOMENTUM_FORM, SENSITIVITY_METHODS
 from lg_test_support import MODELS_DIR
 
 #: Agreement of a sensitivity with the central difference of step EPS (relative to the largest
@@ -81,6 +81,7 @@ def models(tmp_path_factory):
     cases = {"double_pendulum": (MODELS_DIR / "double_pendulum.py", {}, [0.5, 1.0], [0.0, 0.3],
                                  ["l2", "m2"]),
              "damped_cart": (damped, {}, [0.2, 0.4], [0.1, -0.2], ["c", "l", "u"]),
+             "driven_pendulum": (MODELS_DIR / "driven_pendulum.py", {}, [2.9], [0.1], ["w", "a", "l"]),
              "bodies_3d": (bodies, {}, [0.3, 0.5, -0.2], [0.1, -0.2, 0.3], ["m2", "I2", "c2", "l1"]),
              "spatial_chain_3": (MODELS_DIR / "spatial_chain.py", {"n": 3}, [0.3, -0.4, 0.5],
                                  [0.2, 0.1, -0.3], ["g"]),
@@ -121,7 +122,7 @@ def _central(module, method, q0, v0, name, direction=None):
     return (_state(plus) - _state(minus)) / (2 * step)
 
 
-LABELS = ("double_pendulum", "damped_cart", "bodies_3d", "spatial_chain_3", "random_tree_3")
+LABELS = ("double_pendulum", "damped_cart", "driven_pendulum", "bodies_3d", "spatial_chain_3", "random_tree_3")
 #: Models built from bodies share their kernels' kind: one method of each family runs on them.
 GRAPH_LABELS = ("bodies_3d", "spatial_chain_3", "random_tree_3")
 
@@ -132,6 +133,8 @@ def test_sensitivities_equal_central_differences(models, label, method):
     module, q0, v0, names = models[label]
     if label in GRAPH_LABELS and method not in ("midpoint", "rk4", "verlet"):
         pytest.skip("the graph models: one method of each kind (their kernels are shared)")
+    if label == "driven_pendulum" and method in MOMENTUM_FORM:
+        pytest.skip("T1 = b . v: the momentum-form tangents are refused (test_bad_input)")
     traj = _run(module, method, q0, v0, sensitivities=names + ["q0", "v0"])
     plain = _run(module, method, q0, v0)
     assert _rel(_state(traj), _state(plain)) < 1e-10        # the same run
@@ -203,7 +206,10 @@ def test_bad_input_is_one_line(models):
         _run(module, "midpoint", q0, v0, sensitivities=["l3"])
     with pytest.raises(SimulationError, match="dop853 has no sensitivities") as bad_method:
         lg.simulate(module, "dop853", q0, v0, t_end=0.1, sensitivities=["l2"])
-    for exc in (bad_name, bad_method):
+    driven, q0d, v0d, _ = models["driven_pendulum"]
+    with pytest.raises(SimulationError, match="linear in the velocities") as transport:
+        _run(driven, "verlet", q0d, v0d, sensitivities=["w"])
+    for exc in (bad_name, bad_method, transport):
         assert "\n" not in str(exc.value)
     with pytest.raises(KeyError, match="was not asked for"):
         _run(module, "rk4", q0, v0, sensitivities=["l2"]).sensitivity("m2")
