@@ -181,11 +181,12 @@ def robot_kernels(dyn) -> dict:
 
 #: The parameter derivatives of the kernels a fixed-step method's step uses: emitted only for a
 #: module generated with sensitivities (codegen.needs.select_kernels), never in a kernel library.
-SENSITIVITY_KERNELS = ("rhs_dp", "momentum_rate_dp", "mass_matvec_dp")
+SENSITIVITY_KERNELS = ("rhs_dp", "momentum_rate_dp", "mass_matvec_dp", "transport_dp")
 
 
 def parameter_kernels(dyn) -> dict:
-    """d rhs/dp, d momentum_rate/dp and d(H(q) w)/dp (n, n_params), one column per entry of p
+    """d rhs/dp, d momentum_rate/dp, d(H(q) w)/dp and d b/dp (n, n_params; b: the T1 = b . qd
+    term of T, zero on most models), one column per entry of p
     (PARAMS order, inputs included): what forward sensitivities (steppers/sensitivity.py) add to
     the step's state Jacobians. A model built from bodies differentiates through its graph, one
     tangent pass along the parameters written as a loop over the columns (as column_kernels);
@@ -202,7 +203,9 @@ def parameter_kernels(dyn) -> dict:
                "momentum_rate_dp": (["q", "qd", "t", "p"], lambda: list(nat["momentum_rate"]),
                                     "d momentum_rate/dp (n, n_params)"),
                "mass_matvec_dp": (["q", "w", "t", "p"], Hw,
-                                  "d(H(q) w)/dp (n, n_params) for a vector w (n,)")}
+                                  "d(H(q) w)/dp (n, n_params) for a vector w (n,)"),
+               "transport_dp": (["q", "t", "p"], lambda: list(nat["b"]),
+                                "d b/dp (n, n_params) of the T1 = b(q, t) . qd term of T")}
     graph = getattr(o, "graph", None) if hasattr(dyn.jac, "columns") else None
     table = {}
     for name, (args, values, doc) in sources.items():

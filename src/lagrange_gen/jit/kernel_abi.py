@@ -70,6 +70,7 @@ ARGUMENTS = {
                          ("Jp", ("n", "n_params"))),
     "mass_matvec_dp": (("q", ("n",)), ("w", ("n",)), ("t", None), ("p", ("n_params",)),
                        ("Jp", ("n", "n_params"))),
+    "transport_dp": (("q", ("n",)), ("t", None), ("p", ("n_params",)), ("Jp", ("n", "n_params"))),
     "input_jacobian": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                        ("Ju", ("n", "n_inputs"))),
     "outputs": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),

@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import SimulationError
 from ..jit.compile_notice import first_use_notice
 from ..steppers.core import status as st
-from ..steppers.sensitivity import MOMENTUM_FORM, SENSITIVITY_METHODS
+from ..steppers.sensitivity import SENSITIVITY_METHODS
 from .trajectory import Trajectory
 
 #: Names of the initial-state sensitivities.
@@ -87,11 +87,6 @@ def check_method(method):
 def check_sensitivities(module, method):
     """SimulationError in one line when ``method`` on ``module`` has no forward sensitivities."""
     check_method(method)
-    if getattr(module, "TRANSPORT", False) and method in MOMENTUM_FORM:
-        others = [m for m in SENSITIVITY_METHODS if m not in MOMENTUM_FORM]
-        raise SimulationError(f"simulate: {module.NAME} has a kinetic energy linear in the "
-                              f"velocities (canonical momentum H v + b); the sensitivities of "
-                              f"{method} cover p = H v only (use {', '.join(others)})")
     if getattr(module, "N_EVENTS", 0):
         raise SimulationError(f"simulate: {module.NAME} has events; a run with sensitivities "
                               f"does not locate them (remove the events or the sensitivities)")

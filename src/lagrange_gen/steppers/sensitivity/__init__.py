@@ -15,5 +15,3 @@ and run/sensitivities.py calls ``run`` (lagrange_gen.simulate(..., sensitivities
 #: The methods with forward sensitivities (their modules here).
 SENSITIVITY_METHODS = ("explicit_euler", "symplectic_euler", "verlet", "midpoint",
                        "implicit_euler", "rk4")
-#: Those written in the momentum p = H(q) v: their tangents assume no T1 = b . v term in T.
-MOMENTUM_FORM = ("symplectic_euler", "verlet", "midpoint")

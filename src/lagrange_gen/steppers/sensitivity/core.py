@@ -21,11 +21,11 @@ from ..core.options import FAST
 from ..core.status import NON_FINITE, OK, SINGULAR_MASS, SINGULAR_NEWTON
 
 #: Scratch of one sensitivity run: the state at the start of a step (q0, v0, m0), the tangents
-#: S (2n, c) and Sm (n, c), matrices H, A (factored), Jq, Jqd, D (n, n), parameter Jacobians
-#: Jp, Jp2 (n, n_params), vectors rhs, a, work (n,), pivots, tangent temporaries T1..T3 (n, c),
-#: and rk4's stage tangents dV, dA (4, n, c) with the stage coordinates Qs (n,).
-Workspace = namedtuple("Workspace", "q0 v0 m0 S Sm H A piv Jq Jqd D Jp Jp2 rhs a work col "
-                                    "T1 T2 T3 dV dA Qs")
+#: S (2n, c) and Sm (n, c), matrices H, A (factored), Jq, Jqd, D, Jb (n, n), parameter Jacobians
+#: Jp, Jp2, Jbp (n, n_params), vectors rhs, a, work (n,), pivots, tangent temporaries T1..T3
+#: (n, c), and rk4's stage tangents dV, dA (4, n, c) with the stage coordinates Qs (n,).
+Workspace = namedtuple("Workspace", "q0 v0 m0 S Sm H A piv Jq Jqd D Jb Jp Jp2 Jbp rhs a work "
+                                    "col T1 T2 T3 dV dA Qs")
 
 
 @njit
@@ -34,7 +34,8 @@ def workspace(n, c, n_params):
     return Workspace(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros((2 * n, c)),
                      np.zeros((n, c)), np.zeros((n, n)), np.zeros((n, n)),
                      np.zeros(n, np.int64), np.zeros((n, n)), np.zeros((n, n)),
-                     np.zeros((n, n)), np.zeros((n, n_params)), np.zeros((n, n_params)),
+                     np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n_params)),
+                     np.zeros((n, n_params)), np.zeros((n, n_params)),
                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                      np.zeros((n, c)), np.zeros((n, c)), np.zeros((n, c)),
                      np.zeros((4, n, c)), np.zeros((4, n, c)), np.zeros(n))
@@ -122,8 +123,26 @@ def acceleration_tangent(kern, q, v, t, p, cols, Sq, Sv, out, tw):
 
 
 @njit(**FAST)
+def transport_tangent(kern, q, t, p, cols, Sq, out, scale, tw):
+    """out (n, c) += scale * d b(q, t) = scale * (db/dq Sq + db/dp E) on a model with a T1 =
+    b . v term in T (the canonical momentum H v + b; nothing otherwise). Leaves db/dq in tw.Jb
+    (the callers' Newton matrices gain it)."""
+    if kern.TRANSPORT:
+        n = kern.N_COORDS
+        for i in range(n):
+            for j in range(n):
+                tw.Jb[i, j] = 0.0
+        kern.transport_dq(q, t, p, tw.Jb)          # accumulates: out_mat += db/dq
+        matmul_add(tw.Jb, Sq, out, scale, n)
+        if cols.shape[0]:
+            kern.transport_dp(q, t, p, tw.Jbp)
+            add_parameter_columns(tw.Jbp, cols, out, scale, n)
+
+
+@njit(**FAST)
 def momentum_tangent(kern, q, v, t, p, cols, Sq, Sv, out, tw):
-    """out (n, c) = d(H(q) v) = D(q; v) Sq + H Sv + d(H v)/dp E (the momentum's tangent)."""
+    """out (n, c) = d(H(q) v + b(q)) = (D(q; v) + db/dq) Sq + H Sv + d(H v + b)/dp E (the
+    momentum's tangent)."""
     n = kern.N_COORDS
     kern.mass_matrix(q, t, p, tw.H)
     kern.mass_matvec_dq(q, v, t, p, tw.D)
@@ -133,12 +152,13 @@ def momentum_tangent(kern, q, v, t, p, cols, Sq, Sv, out, tw):
     if cols.shape[0]:
         kern.mass_matvec_dp(q, v, t, p, tw.Jp2)
         add_parameter_columns(tw.Jp2, cols, out, 1.0, n)
+    transport_tangent(kern, q, t, p, cols, Sq, out, 1.0, tw)
 
 
 @njit(**FAST)
 def velocity_tangent(kern, q, v, t, p, cols, Sq, Sm, Sv, tw):
-    """Sv (n, c) from v = H(q)^-1 m: H Sv = Sm - D(q; v) Sq - d(H v)/dp E. Returns OK or
-    SINGULAR_MASS."""
+    """Sv (n, c) from v = H(q)^-1 (m - b(q)): H Sv = Sm - D(q; v) Sq - d(H v)/dp E - d b.
+    Returns OK or SINGULAR_MASS."""
     n = kern.N_COORDS
     kern.mass_matrix(q, t, p, tw.A)
     kern.mass_matvec_dq(q, v, t, p, tw.D)
@@ -147,6 +167,7 @@ def velocity_tangent(kern, q, v, t, p, cols, Sq, Sm, Sv, tw):
     if cols.shape[0]:
         kern.mass_matvec_dp(q, v, t, p, tw.Jp2)
         add_parameter_columns(tw.Jp2, cols, Sv, -1.0, n)
+    transport_tangent(kern, q, t, p, cols, Sq, Sv, -1.0, tw)
     if not factor(tw.A, tw.piv):
         return SINGULAR_MASS
     solve_columns(tw.A, tw.piv, Sv, tw.col, tw.work, n)
@@ -155,9 +176,10 @@ def velocity_tangent(kern, q, v, t, p, cols, Sq, Sm, Sv, tw):
 
 @njit(**FAST)
 def kick_tangent(kern, q, u, t, hk, p, cols, Sq, Sm, du, tw):
-    """The kick H(q) u = m + hk f(q, u, t) at its solution u: du (n, c) from
-    (H - hk f_v) du = Sm - (D(q; u) - hk f_q) Sq - (d(H u)/dp - hk f_p) E. Leaves H(q) in tw.H
-    and D(q; u) in tw.D (the caller's d(H(q) u)). Returns OK or SINGULAR_NEWTON."""
+    """The kick H(q) u + b(q) = m + hk f(q, u, t) at its solution u: du (n, c) from
+    (H - hk f_v) du = Sm - (D(q; u) - hk f_q) Sq - (d(H u)/dp - hk f_p) E - d b. Leaves H(q) in
+    tw.H and D(q; u) in tw.D (the caller's d(H(q) u + b), with momentum_columns).
+    Returns OK or SINGULAR_NEWTON."""
     n = kern.N_COORDS
     kern.mass_matrix(q, t, p, tw.H)
     kern.mass_matvec_dq(q, u, t, p, tw.D)
@@ -170,6 +192,7 @@ def kick_tangent(kern, q, u, t, hk, p, cols, Sq, Sm, du, tw):
         kern.momentum_rate_dp(q, u, t, p, tw.Jp)
         add_parameter_columns(tw.Jp2, cols, du, -1.0, n)
         add_parameter_columns(tw.Jp, cols, du, hk, n)
+    transport_tangent(kern, q, t, p, cols, Sq, du, -1.0, tw)
     for i in range(n):
         for j in range(n):
             tw.A[i, j] = tw.H[i, j] - hk * tw.Jqd[i, j]

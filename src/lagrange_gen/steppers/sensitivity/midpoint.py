@@ -1,5 +1,6 @@
 """Tangent of the midpoint variational integrator (steppers/methods/midpoint.py), by the implicit
-function theorem at its Newton solution vb (workspace), qb = q + h/2 vb, tm = t + h/2:
+function theorem at its Newton solution vb (workspace), qb = q + h/2 vb, tm = t + h/2 (a T1 =
+b . v term adds d b(qb) as R does, core.transport_tangent):
     A dvb = S_m - (D_b - h/2 f_q) S_q - (d(H vb)/dp - h/2 f_p) E,
     A = H(qb) + h/2 D_b - h^2/4 f_q - h/2 f_v  (D_b = d(H vb)/dq; all at qb, vb, tm),
     S_q+ = S_q + h dvb,  S_m+ = S_m + h (f_q (S_q + h/2 dvb) + f_v dvb + f_p E),
@@ -13,7 +14,7 @@ from ..methods import midpoint as _method
 from ..core.options import FAST
 from ..core.status import OK, SINGULAR_NEWTON
 from .core import (add_parameter_columns, copy_matrix, factor, matmul_add, momentum_tangent,
-                   solve_columns, velocity_tangent, sensitivity_loop)
+                   sensitivity_loop, solve_columns, transport_tangent, velocity_tangent)
 
 
 @njit(**FAST)
@@ -41,9 +42,12 @@ def step(kern, q0, v0, q, v, t, h, p, settings, ws, tw, cols):
         kern.momentum_rate_dp(qb, vb, tm, p, tw.Jp)
         add_parameter_columns(tw.Jp2, cols, dvb, -1.0, n)
         add_parameter_columns(tw.Jp, cols, dvb, hh, n)
+    transport_tangent(kern, qb, tm, p, cols, Sq, dvb, -1.0, tw)     # R gains b(qb)
     for i in range(n):
         for j in range(n):
             A[i, j] = tw.H[i, j] + hh * tw.D[i, j] - hh * hh * tw.Jq[i, j] - hh * tw.Jqd[i, j]
+            if kern.TRANSPORT:
+                A[i, j] += hh * tw.Jb[i, j]
     if not factor(A, tw.piv):
         return SINGULAR_NEWTON
     solve_columns(A, tw.piv, dvb, tw.col, tw.work, n)

@@ -1,6 +1,6 @@
 """Tangent of symplectic Euler (steppers/methods/symplectic_euler.py). Newton path, at the kick's
 solution u (workspace): du from the kick (core.kick_tangent, hk = h), S_q+ = S_q + h du,
-S_m+ = d(H(q) u) = D(q; u) S_q + H du + d(H u)/dp E, S_v+ from v+ = H(q+)^-1 p+. Explicit path
+S_m+ = d(H(q) u + b) = D(q; u) S_q + H du + d(H u)/dp E + d b, S_v+ from v+ = H(q+)^-1 (p+ - b). Explicit path
 (constant H, velocity-free forces: v+ = v + h a(q, t), q+ = q + h v+):
 S_v+ = S_v + h da, S_q+ = S_q + h S_v+."""
 
@@ -11,7 +11,7 @@ from ..methods import symplectic_euler as _method
 from ..core.options import FAST
 from ..core.status import OK
 from .core import (acceleration_tangent, add_parameter_columns, kick_tangent, matmul_add,
-                   momentum_tangent, set_zero, velocity_tangent, sensitivity_loop)
+                   momentum_tangent, sensitivity_loop, set_zero, transport_tangent, velocity_tangent)
 from ..core.options import explicit_path
 
 
@@ -43,11 +43,12 @@ def step(kern, q0, v0, q, v, t, h, p, settings, ws, tw, cols):
     status = kick_tangent(kern, q0, u, t, h, p, cols, Sq, Sm, du, tw)
     if status != OK:
         return status
-    set_zero(Sm)                                   # p+ = H(q) u
+    set_zero(Sm)                                   # p+ = H(q) u + b(q)
     matmul_add(tw.D, Sq, Sm, 1.0, n)
     matmul_add(tw.H, du, Sm, 1.0, n)
     if cols.shape[0]:
         add_parameter_columns(tw.Jp2, cols, Sm, 1.0, n)
+    transport_tangent(kern, q0, t, p, cols, Sq, Sm, 1.0, tw)
     for i in range(n):
         for j in range(c):
             S[i, j] += h * du[i, j]

@@ -2,7 +2,8 @@
 solutions u, w (workspace): the kick's du (core.kick_tangent, hk = h/2), S_* = d(H(q) u); the
 drift H(q+) w = p*, q+ = q + h/2 (u + w):
     (H(q+) + h/2 D(q+; w)) dw = S_* - D(q+; w) (S_q + h/2 du) - d(H w)/dp E,
-S_q+ = S_q + h/2 (du + dw), S_m+ = S_* + h/2 (f_q S_q+ + f_v dw + f_p E) at (q+, w, t + h), and
+S_q+ = S_q + h/2 (du + dw), S_m+ = S_* + h/2 (f_q S_q+ + f_v dw + f_p E) at (q+, w, t + h)
+(a T1 = b . v term adds its d b where H u and H w appear, core.transport_tangent), and
 S_v+ from v+ = H(q+)^-1 p+. Explicit path (velocity Verlet with the acceleration cached between
 steps): S_m holds the cached acceleration's tangent, dv* = S_v + h/2 S_a, S_q+ = S_q + h dv*,
 S_a+ = da at (q+, v*, t + h), S_v+ = dv* + h/2 S_a+."""
@@ -14,8 +15,8 @@ from ..methods import verlet as _method
 from ..core.options import FAST
 from ..core.status import OK, SINGULAR_NEWTON
 from .core import (acceleration_tangent, add_parameter_columns, copy_matrix, factor, kick_tangent,
-                   matmul_add, momentum_tangent, set_zero, solve_columns, velocity_tangent,
-                   sensitivity_loop)
+                   matmul_add, momentum_tangent, sensitivity_loop, set_zero, solve_columns,
+                   transport_tangent, velocity_tangent)
 from ..core.options import explicit_path
 
 
@@ -51,11 +52,12 @@ def step(kern, q0, v0, q, v, t, h, p, settings, ws, tw, cols):
     status = kick_tangent(kern, q0, ws.u, t, hh, p, cols, Sq, Sm, du, tw)
     if status != OK:
         return status
-    set_zero(Sm)                                   # S_* = d(H(q) u)
+    set_zero(Sm)                                   # S_* = d(H(q) u + b(q))
     matmul_add(tw.D, Sq, Sm, 1.0, n)
     matmul_add(tw.H, du, Sm, 1.0, n)
     if cols.shape[0]:
         add_parameter_columns(tw.Jp2, cols, Sm, 1.0, n)
+    transport_tangent(kern, q0, t, p, cols, Sq, Sm, 1.0, tw)
     w, A, dq = ws.w, tw.A, tw.T3
     kern.mass_matrix(q, t1, p, tw.H)
     kern.mass_matvec_dq(q, w, t1, p, tw.D)
@@ -67,9 +69,12 @@ def step(kern, q0, v0, q, v, t, h, p, settings, ws, tw, cols):
     if cols.shape[0]:
         kern.mass_matvec_dp(q, w, t1, p, tw.Jp2)
         add_parameter_columns(tw.Jp2, cols, dw, -1.0, n)
+    transport_tangent(kern, q, t1, p, cols, dq, dw, -1.0, tw)       # the drift's b(q+)
     for i in range(n):
         for j in range(n):
             A[i, j] = tw.H[i, j] + hh * tw.D[i, j]
+            if kern.TRANSPORT:
+                A[i, j] += hh * tw.Jb[i, j]
     if not factor(A, tw.piv):
         return SINGULAR_NEWTON
     solve_columns(A, tw.piv, dw, tw.col, tw.work, n)
