@@ -193,7 +193,7 @@ def test_a_module_without_sensitivities_has_none_of_their_kernels():
     model = load_model(MODELS_DIR / "double_pendulum.py")
     plain, _, _ = generate_text(model, methods=["midpoint", "rk4"])
     with_them, _, _ = generate_text(model, methods=["midpoint", "rk4"], sensitivities=True)
-    for name in ("rhs_dp", "momentum_rate_dp", "mass_matvec_dp"):
+    for name in ("rhs_dp", "momentum_rate_dp", "mass_matvec_dp", "transport_dp"):
         assert f"def {name}(" not in plain and f"def {name}(" in with_them
     assert "sensitivities" not in plain.split("OPTIONS = ", 1)[1].split("\n", 1)[0]
 
