@@ -219,6 +219,9 @@ def test_a_model_file_is_regenerated_with_sensitivities_when_asked(tmp_path):
     traj = lg.simulate(path, "rk4", [0.5, 1.0], [0.0, 0.3], t_end=0.05, h=0.01, out_dir=tmp_path,
                        sensitivities=["g"])
     assert traj.sensitivity("g").shape == (6, 4)
+    traj.save(tmp_path / "run.npz")                       # the sensitivities travel with it
+    assert np.array_equal(lg.Trajectory.load(tmp_path / "run.npz").sensitivity("g"),
+                          traj.sensitivity("g"))
     assert read_header(target)["OPTIONS"] == {"build": {}, "methods": ["rk4"], "sensitivities": True}
     lg.simulate(path, "rk4", [0.5, 1.0], [0.0, 0.3], t_end=0.05, h=0.01, out_dir=tmp_path)
     assert read_header(target)["OPTIONS"]["sensitivities"] is True
