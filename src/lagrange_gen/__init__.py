@@ -31,6 +31,7 @@ _LAZY = {
     "import_generated": "run.loader", "load": "run.loader",
     "simulate": "run.simulate", "Trajectory": "run.trajectory",
     "ensemble": "run.ensemble", "grid": "run.ensemble_inputs", "EnsembleResult": "run.ensemble",
+    "fit": "identify.fit", "Fit": "identify.fit",
 }
 
 __all__ = sorted(_LAZY) + [

@@ -101,6 +101,11 @@ def _contact(args):
     print(run_contact(**_suite_kwargs(args))["report"])
 
 
+def _gradients(args):
+    from .gradients import run_gradients_bench
+    print(run_gradients_bench(args.models, args.reports, quick=args.quick)["report"])
+
+
 def _harness(args):
     from .harness import run_harness_bench
     run_harness_bench(args.reports, thorough=not args.quick)
@@ -134,6 +139,8 @@ SUITES = {
     "contact": ("work-precision of moreau_jean, spook_contacts and dop853_impacts on the bouncing "
                 "ball and the rocking block against closed forms (Siconos when installed)",
                 _contact),
+    "gradients": ("forward sensitivities: cost against the plain run for k parameters and q0/v0, "
+                  "agreement with central differences of simulate", _gradients),
     "harness": ("differential harness, thorough profile (--quick: CI profile); repository checkout only", _harness),
 }
 

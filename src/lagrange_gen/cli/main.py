@@ -62,6 +62,10 @@ def generate_parser():
     p.add_argument("--freeze", action="append", metavar="NAME=VALUE,...",
                    help="fold these parameters into the kernels as constants (e.g. g=9.81,l=1); "
                         "they leave PARAMS and cannot be passed at run time; repeatable")
+    p.add_argument("--sensitivities", action="store_true",
+                   help="also emit the parameter derivatives of the kernels that forward "
+                        "sensitivities need (simulate(..., sensitivities=[...]); see "
+                        "docs/guides/gradients.md)")
     p.add_argument("--set", action="append", metavar="NAME=VALUE,...", dest="options",
                    help="options passed to the model file's build() (e.g. n=8), repeatable")
     p.add_argument("--force", action="store_true",
@@ -97,13 +101,14 @@ def _generate_one(path, args, methods, options, freeze):
     if not args.force:
         # decided before codegen.generated_files is imported: a current module costs no sympy
         from ..codegen.model_cache import generation_current
-        target = generation_current(path, where, methods, options, freeze)
+        target = generation_current(path, where, methods, options, freeze, args.sensitivities)
         if target is not None:
             print(f"{target} is current: not derived again ({time.perf_counter() - start:.2f} s; "
                   "--force derives it again)")
             return True
     from ..codegen.generated_files import generate_model
-    result = generate_model(path, where, methods, options, freeze, force=args.force)
+    result = generate_model(path, where, methods, options, freeze, force=args.force,
+                            sensitivities=args.sensitivities)
     what = "written" if result.written else "unchanged"
     print(f"{result.path}: {what} ({time.perf_counter() - start:.2f} s, key {result.key[:12]})")
     return True
@@ -113,11 +118,11 @@ def _check_one(path, args, methods, options, freeze):
     from ..codegen.generated_files import check_generated
     from ..codegen.keys import regeneration_command
     where = out_dir(path, args.out_dir)
-    target, problem = check_generated(path, where, methods, options, freeze)
+    target, problem = check_generated(path, where, methods, options, freeze, args.sensitivities)
     if problem is None:
         print(f"{target}: current")
         return True
-    command = regeneration_command(path, where, options, methods, freeze)
+    command = regeneration_command(path, where, options, methods, freeze, args.sensitivities)
     print(f"{target}: {problem}; run {command}")
     return False
 

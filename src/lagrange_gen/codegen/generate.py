@@ -82,11 +82,14 @@ class Progress:
             wait = PROGRESS_EVERY
 
 
-def generation_options(build, methods, freeze):
-    """Generation options recorded in the module and hashed into its KEY."""
+def generation_options(build, methods, freeze, sensitivities=False):
+    """Generation options recorded in the module and hashed into its KEY ("sensitivities" only
+    when asked: a module without them is the one generated before they existed)."""
     options = {"build": dict(sorted(build.items())), "methods": list(methods)}
     if freeze:
         options["freeze"] = dict(sorted(freeze.items()))
+    if sensitivities:
+        options["sensitivities"] = True
     return options
 
 
@@ -139,15 +142,16 @@ class GenerationParts:
     seconds: dict
 
 
-def generate_parts(model, out_dir="generated", methods=None, freeze=None, progress=None) -> GenerationParts:
+def generate_parts(model, out_dir="generated", methods=None, freeze=None, progress=None,
+                   sensitivities=False) -> GenerationParts:
     """Derive and emit a loaded Model (nothing is written); see generate_text."""
     progress = progress or Progress(model.source_path or model.name)
     methods, freeze = resolve_methods(methods, model), dict(sorted((freeze or {}).items()))
-    options = generation_options(model.build_options, methods, freeze)
+    options = generation_options(model.build_options, methods, freeze, sensitivities)
     start = time.perf_counter()
     with progress.stage("derive"):
         dyn = derive(model, freeze=freeze)
-        selected = select_kernels(dyn, methods)
+        selected = select_kernels(dyn, methods, sensitivities)
         composed = compositions(dyn, selected, methods_needs(methods)) if methods else {}
         for name, how in composed.items():
             selected[name] = selected[name] + [f"composed from kernels ({how})"]
@@ -174,12 +178,13 @@ def module_sources() -> dict:
     return source_hashes(source_closure(list(COMPILED_IMPORTS)))
 
 
-def generate_text(model, out_dir="generated", methods=None, freeze=None):
+def generate_text(model, out_dir="generated", methods=None, freeze=None, sensitivities=False):
     """Return (module text, KEY, target path) for a loaded Model; nothing is written.
 
     methods: stepper methods the module runs (default: those that apply to the model); only the
     kernels they reach are derived and emitted (codegen.needs). freeze: {parameter: value}
-    folded into the kernels.
+    folded into the kernels. sensitivities: also the parameter derivatives the methods' forward
+    sensitivities need (lagrange_gen.simulate(sensitivities=...)).
     """
-    parts = generate_parts(model, out_dir, methods, freeze)
+    parts = generate_parts(model, out_dir, methods, freeze, sensitivities=sensitivities)
     return parts.text, parts.key, parts.target

@@ -32,7 +32,7 @@ def _label(model_path, options):
 
 
 def generate_model(model_path, out_dir=None, methods=None, options=None,
-                   freeze=None, force=False, model=None) -> GenerationResult:
+                   freeze=None, force=False, model=None, sensitivities=False) -> GenerationResult:
     """Generate out_dir/<name>.py from a model file (atomic; unchanged files are not touched).
     out_dir None: keys.default_generated_dir of the model file.
 
@@ -42,10 +42,11 @@ def generate_model(model_path, out_dir=None, methods=None, options=None,
     the result says ``current``. ``force`` derives and writes it again, and overwrites a file
     generated from another model file (or not by lagrange-gen), which is otherwise refused
     (GenerationError naming both files). ``model``: the Model this model file gave with these
-    ``options``, when the caller has run it already (it is not run a second time)."""
+    ``options``, when the caller has run it already (it is not run a second time).
+    ``sensitivities``: with the parameter derivatives of forward sensitivities."""
     out_dir = default_generated_dir(model_path) if out_dir is None else out_dir
     if not force:
-        known = generation_current(model_path, out_dir, methods, options, freeze)
+        known = generation_current(model_path, out_dir, methods, options, freeze, sensitivities)
         if known is not None:
             return GenerationResult(known, False, read_header(known)["KEY"], current=True)
     progress = Progress(_label(model_path, options))
@@ -55,7 +56,7 @@ def generate_model(model_path, out_dir=None, methods=None, options=None,
     target = output_path(model.name, out_dir)
     if not force:
         refuse_overwrite(model_path, target, model.name)
-    parts = generate_parts(model, out_dir, methods, freeze, progress)
+    parts = generate_parts(model, out_dir, methods, freeze, progress, sensitivities)
     with progress.stage("write"):
         written = write_if_changed(target, parts.text)
     remember_current(target, model, parts.key, read_header(target)["OPTIONS"])
@@ -141,7 +142,8 @@ def module_current(model, target, header) -> bool:
     except (OSError, ValueError):
         pass
     try:
-        text, key, _ = generate_text(model, target.parent, options.get("methods"), options.get("freeze"))
+        text, key, _ = generate_text(model, target.parent, options.get("methods"), options.get("freeze"),
+                                     options.get("sensitivities", False))
     except GenerationError:
         return False                      # e.g. methods that no longer apply
     if text != target.read_text(encoding="utf-8"):
@@ -163,7 +165,8 @@ def is_current(model_path, out_dir=None, methods=None, options=None, freeze=None
     return target, header is not None and header.get("OPTIONS") == wanted and module_current(model, target, header)
 
 
-def check_generated(model_path, out_dir=None, methods=None, options=None, freeze=None):
+def check_generated(model_path, out_dir=None, methods=None, options=None, freeze=None,
+                    sensitivities=False):
     """(target, None) when the file on disk is exactly what generating with these arguments would
     write now, else (target, "missing" or "stale (why)"). Re-derives: a changed data file or
     helper module the model reads is seen when it changes the equations, and only then."""
@@ -176,7 +179,7 @@ def check_generated(model_path, out_dir=None, methods=None, options=None, freeze
     other = other_source(model_path, target, header)
     if other is not None:
         return target, f"stale (generated from {other}, not {model_path})"
-    parts = generate_parts(model, out_dir, methods, freeze)
+    parts = generate_parts(model, out_dir, methods, freeze, sensitivities=sensitivities)
     try:
         on_disk = target.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
@@ -217,5 +220,5 @@ def describe_options(options) -> str:
     """Recorded generation options as command-line options ('--set n=8 --freeze g=1.62'), or
     'default options'."""
     command = regeneration_command("M", None, options.get("build"), options.get("methods"),
-                                   options.get("freeze"))
+                                   options.get("freeze"), options.get("sensitivities", False))
     return command.split(" ", 2)[2] if command.count(" ") >= 2 else "default options"

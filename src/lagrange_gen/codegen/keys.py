@@ -243,7 +243,8 @@ def default_generated_dir(model_path) -> Path:
     return Path(_shown(base / "generated"))
 
 
-def regeneration_command(model_path, out_dir=None, build=None, methods=None, freeze=None) -> str:
+def regeneration_command(model_path, out_dir=None, build=None, methods=None, freeze=None,
+                         sensitivities=False) -> str:
     """The shell command that generates ``model_path`` into ``out_dir`` with these options
     (paths quoted; -o omitted for the model's default_generated_dir, and for out_dir None;
     --methods omitted for the methods that apply to the model, the default): the one source of
@@ -261,6 +262,8 @@ def regeneration_command(model_path, out_dir=None, build=None, methods=None, fre
         args += ["--methods", ",".join(m for m in METHODS if m in set(methods))]
     if freeze:
         args += ["--freeze", ",".join(f"{k}={v!r}" for k, v in sorted(freeze.items()))]
+    if sensitivities:
+        args.append("--sensitivities")
     return shlex.join(args)
 
 
@@ -277,7 +280,8 @@ def regeneration_command_from(module_file, model_relpath, options, methods=()) -
     here = Path(module_file).parent
     have = list(options.get("methods", ()))
     return regeneration_command(_shown(here / model_relpath), _shown(here), options.get("build"),
-                                have + [m for m in methods if m not in have], options.get("freeze"))
+                                have + [m for m in methods if m not in have], options.get("freeze"),
+                                options.get("sensitivities", False))
 
 
 def regeneration_command_for(module, methods=()) -> str:

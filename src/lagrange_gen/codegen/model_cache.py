@@ -54,7 +54,8 @@ def remember_module(model_path, out_dir, options, target):
         pass
 
 
-def current_module(model_path, out_dir, methods=None, options=None, freeze=None):
+def current_module(model_path, out_dir, methods=None, options=None, freeze=None,
+                   sensitivities=False):
     """The path of the generated module in ``out_dir`` that serves load(model_path, ...) without
     running the model file, or None (then load() runs it): current, and it has the ``methods``
     (None: any), the ``freeze`` and the build ``options`` (None: whatever it has)."""
@@ -68,10 +69,13 @@ def current_module(model_path, out_dir, methods=None, options=None, freeze=None)
         return None
     if methods and not set(methods) <= set(disk.get("methods", ())):
         return None
+    if sensitivities and not disk.get("sensitivities", False):
+        return None
     return target
 
 
-def generation_current(model_path, out_dir, methods=None, options=None, freeze=None):
+def generation_current(model_path, out_dir, methods=None, options=None, freeze=None,
+                       sensitivities=False):
     """The path of the generated module in ``out_dir`` that generating ``model_path`` with these
     arguments would write again unchanged, found without running the model file (nor importing
     sympy or the steppers); else None (then generation runs it). Exactly these options: build
@@ -87,7 +91,8 @@ def generation_current(model_path, out_dir, methods=None, options=None, freeze=N
     if (not isinstance(wanted, list)
             or disk.get("build", {}) != dict(options or {})
             or disk.get("freeze", {}) != dict(sorted((freeze or {}).items()))
-            or set(disk.get("methods", ())) != set(wanted)):
+            or set(disk.get("methods", ())) != set(wanted)
+            or disk.get("sensitivities", False) != bool(sensitivities)):
         return None
     return target
 

@@ -56,6 +56,16 @@ def _reached(roots) -> frozenset:
     return frozenset(needs)
 
 
+def sensitivity_needs(method: str) -> frozenset:
+    """Names ``kern.<name>`` a forward-sensitivity run of ``method`` reaches: the method's own
+    step (steppers/methods/<method>.py), its tangent step (steppers/sensitivity/<method>.py)
+    and the loop running both (steppers/sensitivity/core.py sensitivity_loop)."""
+    module = f"steppers.sensitivity.{method}"
+    roots = [(module, name) for name in _parse(module).functions]
+    roots.append(("steppers.sensitivity.core", "sensitivity_loop"))
+    return method_needs(method, with_loop=False) | _reached(roots)
+
+
 def methods_needs(methods) -> dict:
     """{method: sorted tuple of kern attributes} for several methods."""
     return {m: tuple(sorted(method_needs(m))) for m in methods}
@@ -135,12 +145,14 @@ def _parse(dotted):
 MODULE_FUNCTIONS = ("forward_dynamics",)
 
 
-def select_kernels(dyn, methods) -> dict:
+def select_kernels(dyn, methods, sensitivities=False) -> dict:
     """{kernel name: why it is emitted} for a model and the requested methods, in table order.
 
     Why: the methods whose steppers reach it (``kern.<name>``), or the Python-side use that
     every module of this model needs (forward dynamics, saved energy, consistent initial
-    conditions of constrained models, element energy). A method needing a name that is neither
+    conditions of constrained models, element energy); with ``sensitivities``, also what the
+    forward sensitivities of each method that has them reach (sensitivity_needs: the parameter
+    derivatives). A method needing a name that is neither
     a kernel nor a module function is a GenerationError naming both. No methods at all (an
     empty list, not None) asks for a kernel library without steppers: every kernel is emitted.
     """
@@ -169,7 +181,12 @@ def select_kernels(dyn, methods) -> dict:
                      "mass_matvec_dq") + (("constraint_dq",) if dyn.m else ()):
             if name in table:
                 why.setdefault(name, []).append("model inputs/outputs (saved outputs, linearize)")
-    for method, names in methods_needs(methods).items():
+    needs = methods_needs(methods)
+    if sensitivities:
+        from ..steppers.sensitivity import SENSITIVITY_METHODS
+        for method in (m for m in methods if m in SENSITIVITY_METHODS):
+            needs[f"{method} sensitivities"] = tuple(sorted(sensitivity_needs(method)))
+    for method, names in needs.items():
         for name in names:
             if name.isupper() or name in MODULE_FUNCTIONS:
                 continue           # module constants and functions are always present

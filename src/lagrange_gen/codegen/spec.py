@@ -134,6 +134,7 @@ def kernel_table(dyn) -> dict:
                 "steppers/core/events.py locates"),
     }
     table.update(io_kernels(dyn))
+    table.update(parameter_kernels(dyn))
     table.update(contact_kernels(dyn))
     table.update(nonholonomic_kernels(dyn))
     if hasattr(dyn.jac, "columns"):
@@ -176,6 +177,47 @@ def robot_kernels(dyn) -> dict:
             doc="h(q, qd) + g(q) - Q (n,): tau at qdd = 0 (velocity terms, gravity and the "
                 "model's own forces)"),
     }
+
+
+#: The parameter derivatives of the kernels a fixed-step method's step uses: emitted only for a
+#: module generated with sensitivities (codegen.needs.select_kernels), never in a kernel library.
+SENSITIVITY_KERNELS = ("rhs_dp", "momentum_rate_dp", "mass_matvec_dp", "transport_dp")
+
+
+def parameter_kernels(dyn) -> dict:
+    """d rhs/dp, d momentum_rate/dp, d(H(q) w)/dp and d b/dp (n, n_params; b: the T1 = b . qd
+    term of T, zero on most models), one column per entry of p
+    (PARAMS order, inputs included): what forward sensitivities (steppers/sensitivity.py) add to
+    the step's state Jacobians. A model built from bodies differentiates through its graph, one
+    tangent pass along the parameters written as a loop over the columns (as column_kernels);
+    others write the Jacobian out."""
+    o, nat, n = dyn.ops, dyn.native, dyn.n
+    params, w = o.symbols(dyn.params), o.symbols(dyn.aux["w"])
+    H = nat["H"]
+
+    def Hw():
+        return [sum((H[i, j] * w[j] for j in range(n)), o.native(0)) for i in range(n)]
+
+    sources = {"rhs_dp": (["q", "qd", "t", "p"], lambda: list(nat["rhs"]),
+                          "d rhs/dp (n, n_params), rhs = Q - h - g"),
+               "momentum_rate_dp": (["q", "qd", "t", "p"], lambda: list(nat["momentum_rate"]),
+                                    "d momentum_rate/dp (n, n_params)"),
+               "mass_matvec_dp": (["q", "w", "t", "p"], Hw,
+                                  "d(H(q) w)/dp (n, n_params) for a vector w (n,)"),
+               "transport_dp": (["q", "t", "p"], lambda: list(nat["b"]),
+                                "d b/dp (n, n_params) of the T1 = b(q, t) . qd term of T")}
+    graph = getattr(o, "graph", None) if hasattr(dyn.jac, "columns") else None
+    table = {}
+    for name, (args, values, doc) in sources.items():
+        def build(name=name, args=args, values=values, doc=doc):
+            if graph is None or not params:
+                return KernelSpec(name, args, [Output("Jp", o.jacobian(values(), params))], doc=doc)
+            seeds = [se.Symbol(f"{SEED_PREFIX}{i}") for i in range(len(params))]
+            column = graph.tangents(values(), dict(zip(params, seeds)))
+            return KernelSpec(name, args, out_args=["Jp"], columns=[("Jp", seeds, column)],
+                              doc=f"{doc}, column by column (one tangent pass along the parameters)")
+        table[name] = build
+    return table
 
 
 def contact_kernels(dyn) -> dict:
@@ -390,5 +432,7 @@ def event_functions(dyn) -> list:
 
 def default_kernels(dyn) -> tuple:
     """The kernels of a module generated for every method: all of kernel_table except ``rhs``,
-    which is added only for a constant mass matrix (forward dynamics with a pre-factored H)."""
-    return tuple(k for k in kernel_table(dyn) if k != "rhs" or dyn.mass_is_constant)
+    which is added only for a constant mass matrix (forward dynamics with a pre-factored H), and
+    the parameter derivatives (SENSITIVITY_KERNELS), added only when sensitivities are asked."""
+    return tuple(k for k in kernel_table(dyn) if (k != "rhs" or dyn.mass_is_constant)
+                 and k not in SENSITIVITY_KERNELS)

@@ -6,7 +6,7 @@ arguments by it."""
 #: one column is a 1-D array).
 ALWAYS_2D = frozenset({"H", "J", "Jq", "Jqd", "dJw", "dJTlam", "out_mat", "G", "coef", "Ju", "Cq",
                        "Cqd", "Du", "WN", "WT", "A", "dAw", "dATmu", "dc", "dgamma_dq",
-                       "dgamma_dqd"})
+                       "dgamma_dqd", "Jp"})
 
 #: The arguments of every generated kernel, in order: (name, shape), shape None for the scalar
 #: time t, else a tuple of dimension names (see kernel_dimensions). What a call from Python is
@@ -64,6 +64,13 @@ ARGUMENTS = {
                         ("dc", ("r", "n")), ("dgamma_dq", ("r", "n")), ("dgamma_dqd", ("r", "n"))),
     "constraint_gamma_dq": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                             ("dgamma_dq", ("m", "n")), ("dgamma_dqd", ("m", "n"))),
+    "rhs_dp": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
+               ("Jp", ("n", "n_params"))),
+    "momentum_rate_dp": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
+                         ("Jp", ("n", "n_params"))),
+    "mass_matvec_dp": (("q", ("n",)), ("w", ("n",)), ("t", None), ("p", ("n_params",)),
+                       ("Jp", ("n", "n_params"))),
+    "transport_dp": (("q", ("n",)), ("t", None), ("p", ("n_params",)), ("Jp", ("n", "n_params"))),
     "input_jacobian": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),
                        ("Ju", ("n", "n_inputs"))),
     "outputs": (("q", ("n",)), ("qd", ("n",)), ("t", None), ("p", ("n_params",)),

@@ -98,9 +98,23 @@ def table_class(method: str):
     it to the loop), sorted. Defined in this module under a fixed name, so that numba's cache
     can pickle the type by reference."""
     from ..codegen.needs import method_needs
+    return _named_table_class(f"Kernels_{method}", method_needs(method) | {"N_EVENTS"})
+
+
+@functools.lru_cache(maxsize=None)
+def sensitivity_table_class(method: str):
+    """The named tuple class of the kernel table of ``method``'s forward sensitivities
+    (steppers/sensitivity/<method>.py run): one field per ``kern.<name>`` they reach
+    (codegen.needs.sensitivity_needs), the parameter derivatives included."""
+    from ..codegen.needs import sensitivity_needs
+    return _named_table_class(f"SensitivityKernels_{method}", sensitivity_needs(method))
+
+
+def _named_table_class(name, fields):
+    """A named tuple class of kernel-table ``fields`` (sorted), defined in this module under
+    ``name`` (numba's cache pickles the type by reference) and typed by _typeof_table."""
     from numba.core.typing.typeof import typeof_impl
-    name = f"Kernels_{method}"
-    cls = collections.namedtuple(name, sorted(method_needs(method) | {"N_EVENTS"}))
+    cls = collections.namedtuple(name, sorted(fields))
     cls.__module__ = __name__
     globals()[name] = cls
     typeof_impl.register(cls)(_typeof_table)
@@ -136,6 +150,18 @@ def kernel_table(module, method):
         compile_later(module, [getattr(tables[method], field) for field in cls._fields
                                if not field.isupper()], native_dir())
     return tables[method]
+
+
+def sensitivity_table(module, method):
+    """The kernel table of ``module`` for ``method``'s forward sensitivities (cached on the
+    module); the module must have been generated with sensitivities (their kernels)."""
+    tables = module.__dict__.setdefault("_PORTABLE_TABLES", {})
+    key = f"{method} sensitivities"
+    if key not in tables:
+        cls = sensitivity_table_class(method)
+        tables[key] = cls(*(getattr(module, field) if field.isupper()
+                            else table_kernel(module, field) for field in cls._fields))
+    return tables[key]
 
 
 def native_compile_seconds(module, method):

@@ -35,7 +35,7 @@ def import_generated(path):
 
 
 def load(path, out_dir=None, methods=None, options=None, regenerate=True, freeze=None,
-         force=False):
+         force=False, sensitivities=False):
     """Return the generated module for ``path``.
 
     ``path`` is a generated module (it has a KEY line) or a model file. For a model file the
@@ -48,6 +48,8 @@ def load(path, out_dir=None, methods=None, options=None, regenerate=True, freeze
     differs and the command that regenerates it (``force=True`` regenerates it);
     ``regenerate=False`` raises StaleModuleError instead of generating. ``out_dir`` None: the
     model's own place, the same from any working directory (codegen.keys.default_generated_dir).
+    ``sensitivities``: the module must have the parameter derivatives of forward sensitivities
+    (regenerated with them, keeping everything else, when it lacks them).
     """
     path = Path(path)
     if read_key(path) is not None:
@@ -55,24 +57,26 @@ def load(path, out_dir=None, methods=None, options=None, regenerate=True, freeze
     if out_dir is None:
         out_dir = default_generated_dir(path)
     # a module this file gave before, current and complete: import it without running the file
-    known = None if force else model_cache.current_module(path, out_dir, methods, options, freeze)
+    known = None if force else model_cache.current_module(path, out_dir, methods, options, freeze,
+                                                          sensitivities)
     if known is not None:
         return import_generated(known)
     from ..codegen.generated_files import generate_model
-    target, plan, model = _plan(path, out_dir, methods, options, freeze, force)
+    target, plan, model = _plan(path, out_dir, methods, options, freeze, force, sensitivities)
     if plan is not None:
-        why, build, methods, freeze, command = plan
+        why, build, methods, freeze, command, sensitivities = plan
         if not regenerate:
             raise StaleModuleError(f"{target} is {why}: run {command}")
-        generate_model(path, out_dir, methods, build, freeze, force=True, model=model)
+        generate_model(path, out_dir, methods, build, freeze, force=True, model=model,
+                       sensitivities=sensitivities)
     module = import_generated(target)
     model_cache.remember_module(path, out_dir, options, target)
     return module
 
 
-def _plan(path, out_dir, methods, options, freeze, force):
+def _plan(path, out_dir, methods, options, freeze, force, sensitivities=False):
     """(target, None, model) when the module on disk serves the request of load(), else (target,
-    (why, build, methods, freeze, command), model) to generate with; model: the Model the
+    (why, build, methods, freeze, command, sensitivities), model) to generate with; model: the Model the
     model file's last run gave when its build is the one to generate (generation then does not
     run the file again), else None. Requested methods that do not
     apply to the model are not added (simulate refuses them, naming why); whether the module
@@ -92,7 +96,8 @@ def _plan(path, out_dir, methods, options, freeze, force):
     if not isinstance(disk, dict):          # missing (or forced over another model's module)
         build, freeze = dict(options or {}), dict(freeze or {})
         methods = resolve_methods(asked or None, model)
-        return target, ("missing", build, methods, freeze, regeneration_command(path, out_dir, build, methods, freeze)), model
+        command = regeneration_command(path, out_dir, build, methods, freeze, sensitivities)
+        return target, ("missing", build, methods, freeze, command, sensitivities), model
     have = list(disk.get("methods", ()))
     build = dict(disk.get("build", {}) if options is None else options)
     freeze = dict(disk.get("freeze", {}) if freeze is None else freeze)
@@ -102,18 +107,21 @@ def _plan(path, out_dir, methods, options, freeze, force):
     # run again; what it read is recorded as that run found it)
     model_for_build = model if model.build_options == build else None
     methods = resolve_methods(have + list(asked or ()), model, drop_inapplicable=True)
-    wanted = generation_options(build, methods, freeze)
-    command = regeneration_command(path, out_dir, build, methods, freeze)
+    sensitivities = bool(sensitivities or disk.get("sensitivities", False))
+    wanted = generation_options(build, methods, freeze, sensitivities)
+    command = regeneration_command(path, out_dir, build, methods, freeze, sensitivities)
     if not module_current(model, target, header):
-        return target, ("stale", build, methods, freeze, command), model_for_build
+        return target, ("stale", build, methods, freeze, command, sensitivities), model_for_build
     if (wanted["build"], wanted.get("freeze")) != (disk.get("build"), disk.get("freeze")) and not force:
         have_options = {"build": disk.get("build"), "freeze": disk.get("freeze")}
         raise GenerationError(f"{target} was generated with {describe_options(have_options)}, not with "
                               f"{describe_options(wanted | {'methods': None})} as asked: regenerate it "
                               f"with `{command}`, or ask for what it has")
     if wanted != disk:
-        return target, (f"missing method(s) {', '.join(m for m in methods if m not in have)}",
-                        build, methods, freeze, command), model_for_build
+        missing = [m for m in methods if m not in have]
+        why = (f"missing method(s) {', '.join(missing)}" if missing else
+               "without the parameter derivatives of sensitivities")
+        return target, (why, build, methods, freeze, command, sensitivities), model_for_build
     return target, None, model_for_build
 
 

@@ -39,27 +39,30 @@ from .trajectory import Trajectory
 __all__ = ["simulate", "Trajectory", "load_module"]
 
 
-def load_module(module_or_path, out_dir=None, method=None, force=False, options=None):
+def load_module(module_or_path, out_dir=None, method=None, force=False, options=None,
+                sensitivities=False):
     """A generated module from: the module itself, a generated .py, or a model file (generated
     into ``out_dir`` first when missing or stale, keeping the freeze, build options and methods
     of the module on disk, see loader.load). When the module lacks the glue of the method that
     runs ``method`` on it (e.g. nonsmooth_euler for implicit_euler on a model with elements), it
     is regenerated with that method added. ``force`` overwrites a module generated from another
     model file or with another freeze. ``options``: build() options of a model file (None: those
-    of the module on disk)."""
+    of the module on disk). ``sensitivities``: a model file's module has the parameter
+    derivatives of forward sensitivities (regenerated with them when it lacks them)."""
     if isinstance(module_or_path, types.ModuleType):
         return module_or_path
     from .loader import load, read_key
     if options and read_key(Path(module_or_path)) is not None:
         raise SimulationError(f"{module_or_path} is a generated module: build options "
                               f"({', '.join(options)}) apply to model files; pass the model file")
-    module = load(Path(module_or_path), out_dir=out_dir, options=options, force=force)
+    module = load(Path(module_or_path), out_dir=out_dir, options=options, force=force,
+                  sensitivities=sensitivities)
     if method is None or getattr(module, "KEY", None) is None:
         return module
     runs = element_method(module, method)
     if runs in registry.METHODS and not hasattr(module, f"run_{runs}"):
         module = load(Path(module_or_path), out_dir=out_dir, methods=[runs], options=options,
-                      force=force)
+                      force=force, sensitivities=sensitivities)
     return module
 
 
@@ -76,7 +79,7 @@ def _runner(module, method):
 def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None, h=None,
              params=None, save_every=1, t_eval=None, t0=0.0, progress=False, out_dir=None,
              element_state0=None, force=False, keep=None, control=None, control_params=None,
-             jit=None, penetration="project", **settings) -> Trajectory:
+             jit=None, penetration="project", sensitivities=None, **settings) -> Trajectory:
     """Integrate a generated model from t0 to t_end.
 
     module_or_path: a generated module, the path of a generated .py, or a model file (generated
@@ -138,6 +141,13 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
     point with every gap >= 0 and removes the approaching normal velocity there (an inelastic
     impulse: no kinetic energy added), "refuse" raises ContactPenetration, "keep" leaves it
     there (lagrange_gen.run.contact_start).
+    sensitivities: names of parameters, "q0" and "v0" whose forward sensitivities the run
+        computes (run/sensitivities.py; explicit_euler, symplectic_euler, verlet, midpoint,
+        implicit_euler, rk4): ``traj.sensitivity(name)`` is d(q, v)/d name at each saved row,
+        (S, 2n) for a parameter, (S, 2n, n) for q0 and v0; the exact derivative of the
+        method's steps. A model file is generated with the parameter derivatives of its kernels
+        (lagrange-gen --sensitivities). Not with control= or on models with events; the
+        Trajectory then has no work column nor energy warning.
     A fixed-step run ends at t0 + n_steps h with n_steps = (t_end - t0) / h rounded up.
     Raises SimulationError (bad input, one line naming it), NewtonDivergence (its subclass
     SingularNewtonMatrix: a singular Newton matrix), SingularMass, BlowUp (non-finite or past
@@ -149,7 +159,11 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
     if method not in registry.METHODS:
         raise SimulationError(registry.unknown_method(method))
     jit = jit_mode(jit)
-    module = load_module(module_or_path, out_dir, method, force)
+    if sensitivities is not None:
+        from .sensitivities import check_method
+        check_method(method)
+    module = load_module(module_or_path, out_dir, method, force,
+                         sensitivities=sensitivities is not None)
     plan = method_plan(module, method)      # element_method, check_method, spec: once each
     method, spec = plan.runs, plan.spec
     run = _runner(module, method)
@@ -206,6 +220,13 @@ def simulate(module_or_path, method="midpoint", q0=None, v0=None, *, t_end=None,
         warnings.warn(overshoot, stacklevel=2)
     run_checks.check_time_resolution(t0, t0 + n_steps * h, h, n_steps)
     run_checks.check_memory(module.NAME, n_steps, save_every, n, n_saved)
+    if sensitivities is not None:
+        if hook is not None:
+            raise SimulationError("simulate: sensitivities with control= are not covered (give "
+                                  "the inputs as parameters)")
+        from .sensitivities import simulate_sensitivities
+        return simulate_sensitivities(module, method, q, v, p, config, h, t0, n_steps,
+                                      save_every, sensitivities)
     task = _Task(module, spec, run, p, config, h, t0, n_steps, save_every, hook is not None,
                  jit=jit, hook=hook, layout=plan.layout, data=data, loop=loop)
     out = allocate(run_checks.saved_rows(n_steps, save_every), n, n_saved, initial,

@@ -56,6 +56,18 @@ class Trajectory:
     work: np.ndarray | None = None   # W (S,), see above; None when E is conserved
     # the method's settings as the run used them (rtol, atol, newton_tol, ...)
     settings: dict = field(default_factory=dict)
+    # simulate(sensitivities=[...]): {name: (S, 2n) for a parameter, (S, 2n, n) for q0/v0}
+    sensitivities: dict = field(default_factory=dict)
+
+    def sensitivity(self, name) -> np.ndarray:
+        """d(q, v)/d ``name`` at each saved row: (S, 2n) for a parameter, (S, 2n, n) for "q0"
+        or "v0" (columns: the initial coordinates or velocities), from a run with
+        simulate(..., sensitivities=[name, ...]) (run/sensitivities.py)."""
+        if name not in self.sensitivities:
+            have = ", ".join(self.sensitivities) or "none"
+            raise KeyError(f"Trajectory.sensitivity: {name!r} was not asked for in simulate("
+                           f"sensitivities=[...]) (this run has: {have})")
+        return self.sensitivities[name]
 
     @property
     def multipliers(self) -> np.ndarray:
