@@ -5,16 +5,21 @@ models/humanoid.py), each a dict::
 
     {"name": "elbow", "parent": 1,            # index of the parent joint, -1: the fixed base
      "type": "revolute",                      # or "prismatic"
-     "axis": (0, 1, 0),                       # joint axis in the parent joint's frame
+     "axis": (0, 1, 0),                       # joint axis in the joint's frame
      "origin": (0, -0.1197, 0.425),           # the joint in the parent joint's frame
+     "rpy": (0, 0, 0),                        # optional: the joint frame turned as URDF's rpy
+     "mimic": {"joint": "shoulder", "multiplier": 1, "offset": 0},   # optional, below
      "mass": 2.275, "com": (0, 0.0265, 0.11993),     # centre of mass in this body's frame
      "inertia": (ixx, iyy, izz, ixy, iyz, izx)}      # about the com, in this body's frame
 
-Parents come before their children. Body i's frame is the parent's frame moved to ``origin``
-and turned by q_i about ``axis`` (revolute) or slid by q_i along it (prismatic): at q = 0 every
-frame is parallel to the base frame N, whose z axis points up. That is a URDF with rpy = 0
-everywhere (Pinocchio's joint placement with identity rotation), so a peer builds the same
-model from the same table (lagrange_gen.bench.robots_peers.pinocchio_model).
+Parents come before their children. Body i's frame is the parent's frame moved to ``origin``,
+turned by the fixed rotation ``rpy`` (URDF's: Rz(yaw) Ry(pitch) Rx(roll); none when the key is
+absent) and then turned by q_i about ``axis`` (revolute) or slid by q_i along it (prismatic).
+Without rpy every frame is parallel to the base frame N at q = 0 (N's z axis points up), as in
+a URDF with rpy = 0 everywhere, so a peer builds the same model from the same table
+(lagrange_gen.bench.robots_peers.pinocchio_model); model/urdf.py writes tables with rpy. A joint
+with ``mimic`` has no coordinate of its own: it turns (slides) by multiplier * q_joint + offset
+of the named joint (URDF's mimic joints). A link may have no mass (mass 0, inertia 0).
 
 ``tree_bodies`` is what a robotics engineer writes with sympy.physics.mechanics: frames oriented
 with ``orientnew(..., "Axis", ...)``, points placed with ``locatenew`` from the fixed base point O
@@ -54,12 +59,18 @@ def check_tree(tree):
             raise ValueError(f"tree: joint {name}: zero axis")
         if len(joint["origin"]) != 3 or len(joint["com"]) != 3 or len(joint["inertia"]) != 6:
             raise ValueError(f"tree: joint {name}: origin and com need 3 numbers, inertia 6")
-        if not float(joint["mass"]) > 0:
-            raise ValueError(f"tree: joint {name}: mass must be positive")
+        if not float(joint["mass"]) >= 0 or len(joint.get("rpy", (0, 0, 0))) != 3:
+            raise ValueError(f"tree: joint {name}: mass must be >= 0, rpy 3 numbers")
+    for joint in tree:
+        mimic = joint.get("mimic")
+        if mimic is not None and not any(j["name"] == mimic["joint"] and "mimic" not in j for j in tree):
+            raise ValueError(f"tree: joint {joint['name']}: mimics {mimic['joint']!r}, which is not a "
+                             "joint with its own coordinate")
 
 
 def n_dof(tree):
-    return len(tree)
+    """The number of joint coordinates (mimic joints have none)."""
+    return sum("mimic" not in joint for joint in tree)
 
 
 def _vector(frame, xyz):
@@ -76,22 +87,40 @@ def _unit(axis):
     return [a / norm for a in values]
 
 
+def _rotation(rpy):
+    """URDF's rotation matrix of rpy (sympy, columns the turned axes), entries within 1e-14 of
+    0 or +-1 made exact (cos(pi/2) is 6e-17 in floating point, a term sympy would keep)."""
+    from .urdf import rpy_matrix, snapped
+    return sp.Matrix([[int(x) if x in (0.0, 1.0, -1.0) else sp.Float(x) for x in row]
+                      for row in snapped(rpy_matrix(rpy))])
+
+
 def tree_bodies(tree, q=None):
     """(N, O, q, bodies): the base frame N (z up), the fixed base point O, the joint coordinates
-    (``me.dynamicsymbols`` named after the joints unless given) and one RigidBody per joint."""
+    (``me.dynamicsymbols`` named after the joints unless given; none for a mimic joint) and one
+    RigidBody per joint."""
     import sympy.physics.mechanics as me
     check_tree(tree)
+    own = [j for j in tree if "mimic" not in j]
     if q is None:
-        q = list(me.dynamicsymbols(" ".join(f"q_{j['name']}" for j in tree), seq=True))
+        q = list(me.dynamicsymbols(" ".join(f"q_{j['name']}" for j in own), seq=True)) if own else []
+    coordinate = {j["name"]: qi for j, qi in zip(own, q)}
+    for joint in tree:
+        if "mimic" in joint:
+            mimic = joint["mimic"]
+            coordinate[joint["name"]] = (sp.Float(float(mimic.get("multiplier", 1))) * coordinate[mimic["joint"]]
+                                         + sp.Float(float(mimic.get("offset", 0))))
     N = me.ReferenceFrame("N")
     O = me.Point("O")
     O.set_vel(N, 0)
     frames, origins, bodies = [], [], []
     for i, joint in enumerate(tree):
-        name, qi = joint["name"], q[i]
+        name, qi = joint["name"], coordinate[joint["name"]]
         parent = joint["parent"]
         P, Po = (N, O) if parent < 0 else (frames[parent], origins[parent])
         J = Po.locatenew(f"J_{name}", _vector(P, joint["origin"]))    # the joint, fixed in P
+        if any(float(a) for a in joint.get("rpy", (0, 0, 0))):
+            P = P.orientnew(f"F_{name}", "DCM", _rotation(joint["rpy"]))   # the joint frame
         axis = _vector(P, _unit(joint["axis"]))
         if joint["type"] == "revolute":
             B = P.orientnew(f"B_{name}", "Axis", [qi, axis])
@@ -116,4 +145,4 @@ def model_from_tree(name, tree, g=9.81, description=None):
     T = kinetic_energy(N, bodies)
     V = gravity_potential(N, -g_sym * N.z, bodies)
     return Model(name, coords=q, T=T, V=V,
-                 description=description or f"{len(tree)}-joint tree, mechanics bodies, gravity -g z")
+                 description=description or f"{n_dof(tree)}-joint tree, mechanics bodies, gravity -g z")
