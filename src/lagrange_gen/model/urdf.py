@@ -228,6 +228,8 @@ def read_urdf(path) -> Robot:
         if name in links:
             raise ModelError(f"{path}:{link.line}: link {name!r} defined twice (first on line {lines[name]})")
         links[name], lines[name] = _inertial(path, link), link.line
+    if not links:
+        raise ModelError(f"{path}:{root.line}: <robot> has no <link>")
     joints, seen = [], {}
     for element in root.findall("joint"):
         joint = _joint(path, element)
@@ -408,6 +410,7 @@ def _resolve_mimics(where, rows, index_of_joint, robot):
     """Each row's "mimic" (URDF joint name, multiplier, offset, line) -> {"joint": the row name of
     a joint with its own coordinate, "multiplier", "offset"} (a mimic of a mimic composed)."""
     kinds = {j.name: j.kind for j in robot.joints}
+    urdf_name = {j.child: j.name for j in robot.joints}
     resolved = {}
 
     def resolve(k, seen):
@@ -416,12 +419,13 @@ def _resolve_mimics(where, rows, index_of_joint, robot):
             return row["name"], 1.0, 0.0
         if k not in resolved:
             other, multiplier, offset, line = row["mimic"]
+            name = urdf_name[row["link"]]
             if other not in index_of_joint:
                 why = "no joint of that name" if other not in kinds else f"it is a {kinds[other]} joint"
-                raise ModelError(f"{where}:{line}: joint {row['name']!r}: <mimic joint=\"{other}\">: {why}")
+                raise ModelError(f"{where}:{line}: joint {name!r}: <mimic joint=\"{other}\">: {why}")
             j = index_of_joint[other]
             if j in seen:
-                raise ModelError(f"{where}:{line}: joint {row['name']!r}: <mimic> joints mimic each other in a loop")
+                raise ModelError(f"{where}:{line}: joint {name!r}: <mimic> joints mimic each other in a loop")
             base, m2, o2 = resolve(j, seen | {j})
             resolved[k] = (base, multiplier * m2, multiplier * o2 + offset)
         return resolved[k]
@@ -438,10 +442,11 @@ def _check_masses(where, rows, parts, robot):
     for k in range(len(rows) - 1, -1, -1):
         if rows[k]["parent"] >= 0:
             below[rows[k]["parent"]] += below[k]
-    line_of = {j.child: j.line for j in robot.joints}
+    joint_of = {j.child: j for j in robot.joints}
     for k, row in enumerate(rows):
         if below[k] <= 0:
-            raise ModelError(f"{where}:{line_of[row['link']]}: joint {row['name']!r} moves link "
+            joint = joint_of[row["link"]]
+            raise ModelError(f"{where}:{joint.line}: joint {joint.name!r} moves link "
                              f"{row['link']!r} and nothing with mass (a missing <inertial>?): "
                              "its column of the mass matrix would be zero")
 
