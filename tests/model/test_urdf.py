@@ -17,7 +17,8 @@ import pytest
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen.generated_files import generate_model
 from lagrange_gen.errors import ModelError
-from lagrange_gen.model.urdf import from_urdf, matrix_rpy, model_file_text, rpy_matrix, urdf_tree
+from lagrange_gen.model.joint_tree import rpy_matrix
+from lagrange_gen.model.urdf import from_urdf, matrix_rpy, model_file_text, urdf_tree
 from lagrange_gen.run.loader import import_generated
 
 ARM = Path(__file__).parent / "data" / "arm_mimic.urdf"

@@ -33,9 +33,9 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
-    from ..model.urdf import _identifier, model_file_text, read_urdf
+    from ..model.urdf import make_identifier, model_file_text, read_urdf
     text = model_file_text(args.urdf, mimic=not args.no_mimic, g=args.g)
-    out = Path(args.out) if args.out else Path("models") / f"{_identifier(read_urdf(args.urdf).name, set())}.py"
+    out = Path(args.out) if args.out else Path("models") / f"{make_identifier(read_urdf(args.urdf).name, set())}.py"
     if out.exists() and not args.force:
         raise ModelError(f"{out} exists: --force overwrites it")
     out.parent.mkdir(parents=True, exist_ok=True)

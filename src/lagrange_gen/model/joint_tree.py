@@ -31,13 +31,16 @@ centre per joint.
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import sympy as sp
 
 from .bodies import gravity_potential, kinetic_energy
 from .model import Model
 from .symbols import parameters
 
-__all__ = ["tree_bodies", "model_from_tree", "check_tree", "n_dof"]
+__all__ = ["tree_bodies", "model_from_tree", "check_tree", "n_dof", "rpy_matrix"]
 
 KINDS = ("revolute", "prismatic")
 
@@ -87,10 +90,32 @@ def _unit(axis):
     return [a / norm for a in values]
 
 
+def rpy_matrix(rpy):
+    """URDF's rotation (3, 3) of roll, pitch, yaw: Rz(yaw) Ry(pitch) Rx(roll), the columns the
+    rotated frame's axes in the parent's frame."""
+    r, p, y = (float(a) for a in rpy)
+    cr, sr, cp, sp_, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([[cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr],
+                     [sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr],
+                     [-sp_, cp * sr, cp * cr]])
+
+
+#: entries of a rotation or an inertia this close to 0 (relative) or to +-1 are those numbers:
+#: cos(pi/2) in floating point is 6e-17, and a term multiplied by it is kept by sympy
+SNAP = 1e-14
+
+
+def snapped(values, scale=1.0):
+    """``values`` with entries within SNAP * scale of 0, 1 or -1 set to them (exactly)."""
+    out = np.array(values, dtype=float)
+    for target in (0.0, 1.0, -1.0):
+        out[np.abs(out - target) < SNAP * scale] = target
+    return out
+
+
 def _rotation(rpy):
-    """URDF's rotation matrix of rpy (sympy, columns the turned axes), entries within 1e-14 of
-    0 or +-1 made exact (cos(pi/2) is 6e-17 in floating point, a term sympy would keep)."""
-    from .urdf import rpy_matrix, snapped
+    """URDF's rotation matrix of rpy (sympy, columns the turned axes), entries within SNAP of
+    0 or +-1 made exact."""
     return sp.Matrix([[int(x) if x in (0.0, 1.0, -1.0) else sp.Float(x) for x in row]
                       for row in snapped(rpy_matrix(rpy))])
 

@@ -45,14 +45,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
+from .joint_tree import model_from_tree, rpy_matrix, snapped
 
-__all__ = ["from_urdf", "urdf_tree", "model_file_text", "read_urdf", "rpy_matrix", "matrix_rpy"]
+__all__ = ["from_urdf", "urdf_tree", "model_file_text", "read_urdf", "matrix_rpy", "make_identifier"]
 
 MOVING = ("revolute", "continuous", "prismatic")
 SUPPORTED = MOVING + ("fixed",)
-#: entries of a rotation or an inertia this close to 0 (relative) or to +-1 are those numbers:
-#: cos(pi/2) in floating point is 6e-17, and a term multiplied by it is kept by sympy
-SNAP = 1e-14
 
 
 @dataclass
@@ -247,16 +245,6 @@ def read_urdf(path) -> Robot:
 # ------------------------------------------------------------------------------ rotations
 
 
-def rpy_matrix(rpy):
-    """URDF's rotation (3, 3) of roll, pitch, yaw: Rz(yaw) Ry(pitch) Rx(roll), the columns the
-    rotated frame's axes in the parent's frame."""
-    r, p, y = (float(a) for a in rpy)
-    cr, sr, cp, sp_, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-    return np.array([[cy * cp, cy * sp_ * sr - sy * cr, cy * sp_ * cr + sy * sr],
-                     [sy * cp, sy * sp_ * sr + cy * cr, sy * sp_ * cr - cy * sr],
-                     [-sp_, cp * sr, cp * cr]])
-
-
 def matrix_rpy(R):
     """(roll, pitch, yaw) with rpy_matrix(rpy) = R to rounding, also near pitch = +-pi/2: pitch
     and yaw are read from R, then roll from Ry(pitch)^T Rz(yaw)^T R, which is a rotation about x
@@ -269,18 +257,10 @@ def matrix_rpy(R):
     return np.array([roll, pitch, yaw])
 
 
-def snapped(values, scale=1.0):
-    """``values`` with entries within SNAP * scale of 0, 1 or -1 set to them (exactly)."""
-    out = np.array(values, dtype=float)
-    for target in (0.0, 1.0, -1.0):
-        out[np.abs(out - target) < SNAP * scale] = target
-    return out
-
-
 # ------------------------------------------------------------------------ the joint table
 
 
-def _identifier(name, used):
+def make_identifier(name, used):
     """``name`` as a Python identifier (other characters -> _), unique among ``used``."""
     ident = re.sub(r"\W", "_", name)
     if not ident or ident[0].isdigit() or keyword.iskeyword(ident):
@@ -375,7 +355,7 @@ def urdf_tree(path, mimic=True):
                 continue
             identity = np.array_equal(R, np.eye(3))
             rpy = joint.rpy if identity else matrix_rpy(R_c)
-            row = {"name": _identifier(joint.name, used), "link": joint.child, "parent": body,
+            row = {"name": make_identifier(joint.name, used), "link": joint.child, "parent": body,
                    "type": "prismatic" if joint.kind == "prismatic" else "revolute",
                    "axis": tuple(_table_number(a) for a in joint.axis),
                    "origin": tuple(_table_number(a) for a in snapped(p_c, max(1.0, float(np.abs(p_c).max())))),
@@ -458,14 +438,13 @@ def from_urdf(path, floating_base=False, g=9.81, mimic=True, name=None, descript
     """The Model of the robot in the URDF at ``path``: a fixed base, gravity -g along the base's
     z, the joint table of ``urdf_tree`` built with sympy.physics.mechanics (model_from_tree).
     name: the model's name (default: the robot's name, made an identifier)."""
-    from .joint_tree import model_from_tree
     if floating_base:
         raise ModelError(f"{path}: floating_base=True is not supported yet (fixed-base robots only)")
     robot = read_urdf(path)
     tree = urdf_tree(robot, mimic=mimic)
     if not tree:
         raise ModelError(f"{path}: the robot has no moving joint")
-    return model_from_tree(name or _identifier(robot.name, set()), tree, g=g,
+    return model_from_tree(name or make_identifier(robot.name, set()), tree, g=g,
                            description=description or f"{robot.name} from {Path(str(path)).name}: "
                                                       f"{len(tree)} joints, fixed base, gravity -g z")
 
@@ -490,7 +469,7 @@ def model_file_text(path, mimic=True, g=9.81):
     tree = urdf_tree(robot, mimic=mimic)
     if not tree:
         raise ModelError(f"{path}: the robot has no moving joint")
-    name = _identifier(robot.name, set())
+    name = make_identifier(robot.name, set())
     n = sum("mimic" not in row for row in tree)
     rows = "\n".join(_row_text(row) for row in tree)
     return f'''"""{robot.name}: {n} joint coordinates, fixed base (written by `lagrange-gen urdf {Path(str(path)).name}`).

@@ -1,0 +1,111 @@
+"""Robots from example-robot-data's URDFs (the ``peers`` extra: pin, example-robot-data) against
+Pinocchio's own URDF parser (fixed base, mimic joints as Pinocchio's mimic=True).
+
+Each URDF goes through `lagrange-gen urdf` (a model file) and the generator; at random states the
+module's mass matrix (dynamics), inverse dynamics (RNEA), forward dynamics with torques (ABA) and
+without must equal pin.crba, pin.rnea and pin.aba to 1e-10 (relative to max(1, |value|)), the
+coordinates must be Pinocchio's joints in Pinocchio's order, and a 7-DoF arm without mimic joints
+must take its forward dynamics from the articulated-body algorithm. A few robots run by default;
+``pytest --all-robots`` runs every URDF of the package (docs/guides/from-urdf.md lists them).
+URDFs that have no moving joint or no robot in them are refused in one line.
+"""
+
+import importlib.metadata
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lagrange_gen.cli.main import main
+from lagrange_gen.codegen.generated_files import generate_model
+from lagrange_gen.errors import ModelError
+from lagrange_gen.model.urdf import model_file_text
+from lagrange_gen.run.loader import import_generated
+
+pin = pytest.importorskip("pinocchio")
+
+from lagrange_gen.bench.robots_peers import pinocchio_urdf  # noqa: E402  (needs pinocchio)
+
+
+def _robots_dir():
+    try:
+        folder = importlib.metadata.distribution("example-robot-data").locate_file(
+            "cmeel.prefix/share/example-robot-data/robots")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    return Path(folder) if Path(folder).is_dir() else None
+
+
+ROBOTS = _robots_dir()
+if ROBOTS is None:
+    pytest.skip("example-robot-data is not installed", allow_module_level=True)
+
+#: run by default: a 6-DoF arm, mimic fingers, continuous joints, the 7-DoF arm, a branching tree
+FEW = ["ur_description/urdf/ur5_robot.urdf", "panda_description/urdf/panda.urdf",
+       "kinova_description/robots/kinova.urdf", "xarm_description/urdf/xarm7.urdf",
+       "solo_description/robots/solo12.urdf"]
+#: refused here (Pinocchio loads them with no joint, or not at all): the reason in the message
+REFUSED = {"hector_description/robots/quadrotor_base.urdf": "no moving joint",
+           "iris_description/robots/iris_simple.urdf": "no moving joint",
+           "ur_description/urdf/ur3.urdf": "has no <link>"}
+ALL = sorted(str(p.relative_to(ROBOTS)) for p in ROBOTS.rglob("*.urdf"))
+TOL = 1e-10
+STATES = 3
+
+
+def pytest_generate_tests(metafunc):
+    if "robot" in metafunc.fixturenames:
+        every = metafunc.config.getoption("--all-robots", default=False)
+        cases = [r for r in (ALL if every else FEW) if r not in REFUSED]
+        metafunc.parametrize("robot", cases, ids=[Path(r).stem for r in cases], indirect=True)
+
+
+@pytest.fixture
+def robot(request, tmp_path):
+    """(path, generated module, Pinocchio peer) of one URDF."""
+    path = ROBOTS / request.param
+    src = tmp_path / f"{Path(request.param).stem.replace('-', '_')}.py"
+    assert main(["urdf", str(path), "-o", str(src)]) == 0
+    mod = import_generated(generate_model(src, tmp_path / "gen", methods=["rk4"]).path)
+    return path, mod, pinocchio_urdf(path, mod.COORDS)
+
+
+def _err(ours, theirs):
+    theirs = np.asarray(theirs)
+    return float(np.abs(np.asarray(ours) - theirs).max() / max(1.0, np.abs(theirs).max()))
+
+
+def test_equals_pinocchio(robot):
+    path, mod, peer = robot
+    n, p = mod.N_COORDS, mod.DEFAULT_PARAMS
+    assert list(mod.COORDS) == peer.names, "Pinocchio's joint order"
+    rng = np.random.default_rng(44)
+    for _ in range(STATES):
+        q, v, a, tau = rng.uniform(-2, 2, n), rng.normal(size=n), rng.normal(size=n), rng.normal(size=n)
+        H, rhs = np.zeros((n, n)), np.zeros(n)
+        mod.dynamics.py_func(q, v, 0.0, p, H, rhs)
+        assert _err(H, peer.crba(q)) < TOL
+        out = np.zeros(n)
+        mod.inverse_dynamics.py_func(q, v, a, 0.0, p, out)
+        assert _err(out, peer.rnea(q, v, a)) < TOL
+        if hasattr(mod, "forward_dynamics_torques"):
+            assert mod.forward_dynamics_torques.py_func(q, v, tau, 0.0, p, np.zeros((n, n)), out) == 0
+        else:                                       # a constant H: no recursive kernels
+            out = np.linalg.solve(H, rhs + tau)
+        assert _err(out, peer.aba(q, v, tau)) < TOL
+        assert mod.forward_dynamics.py_func(q, v, 0.0, p, np.zeros((n, n)), out) == 0
+        assert _err(out, peer.aba(q, v, np.zeros(n))) < TOL
+
+
+def test_a_7_dof_arm_takes_the_articulated_body_algorithm(tmp_path):
+    src = tmp_path / "xarm7.py"
+    assert main(["urdf", str(ROBOTS / "xarm_description/urdf/xarm7.urdf"), "-o", str(src)]) == 0
+    mod = import_generated(generate_model(src, tmp_path / "gen", methods=["rk4"]).path)
+    assert mod.N_COORDS == 7 and "articulated-body" in mod.forward_dynamics.__doc__
+
+
+@pytest.mark.parametrize("name", sorted(REFUSED))
+def test_urdfs_without_a_moving_joint_are_refused_in_one_line(name):
+    with pytest.raises(ModelError, match=REFUSED[name]) as info:
+        model_file_text(ROBOTS / name)
+    assert "\n" not in str(info.value)
