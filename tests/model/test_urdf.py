@@ -226,6 +226,24 @@ def test_from_urdf_builds_the_model():
         from_urdf(ARM, floating_base=True)
 
 
+def test_joint_limits_become_contacts_on_request():
+    """<limit lower upper> of the joints with a coordinate (not the continuous elbow, not the
+    mimic finger): gaps q - lower and upper - q."""
+    assert not from_urdf(ARM).contacts
+    model = from_urdf(ARM, limits=True, restitution=0.5)
+    expected = {"shoulder": (-2, 2), "slide": (0, 0.1), "wrist_roll": (-3, 3), "wrist_pitch": (-3, 3)}
+    assert [c.name for c in model.contacts] == [f"{j}_{side}" for j in expected for side in ("lower", "upper")]
+    at = dict(zip(model.coords, [0.5, 0.1, 0.02, -1.0, 2.5]))
+    values = dict(zip(["shoulder", "elbow", "slide", "wrist_roll", "wrist_pitch"], at.values()))
+    for contact in model.contacts:
+        joint, side = contact.name.rsplit("_", 1)
+        lower, upper = expected[joint]
+        gap = values[joint] - lower if side == "lower" else upper - values[joint]
+        assert float(contact.gap.xreplace(at)) == pytest.approx(gap, abs=1e-15)
+        assert float(contact.restitution) == 0.5
+    assert "limits=True" in model_file_text(ARM, limits=True)
+
+
 def test_rpy_of_a_matrix_near_gimbal_lock():
     for pitch in (math.pi / 2, math.pi / 2 - 1e-9, -math.pi / 2 + 3e-8, 0.3):
         R = rpy_matrix((0.7, pitch, -1.1)) @ rpy_matrix((0.2, 0.1, 0.3))

@@ -19,7 +19,7 @@ def add_parser(subparsers):
     p = subparsers.add_parser(
         "urdf", help="write a model file from a robot's URDF",
         description="Read ROBOT.urdf (revolute, continuous, prismatic, fixed and mimic joints; "
-                    "meshes, limits and damping are not read) and write a model file holding its "
+                    "meshes and damping are not read) and write a model file holding its "
                     "joint table, built into sympy.physics.mechanics bodies: a fixed base, gravity "
                     "-g along the base's z, one coordinate per moving joint named after it.")
     p.add_argument("urdf", metavar="ROBOT.urdf")
@@ -27,6 +27,8 @@ def add_parser(subparsers):
                    help="the model file to write (default: models/<robot name>.py)")
     p.add_argument("--no-mimic", action="store_true",
                    help="give mimic joints their own coordinates (as Pinocchio does by default)")
+    p.add_argument("--limits", action="store_true",
+                   help="the joints' <limit> lower and upper as contacts (for the contact methods)")
     p.add_argument("--g", type=float, default=9.81, help="the default of the parameter g (9.81)")
     p.add_argument("--force", action="store_true", help="overwrite an existing file")
     return p
@@ -34,7 +36,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     from ..model.urdf import make_identifier, model_file_text, read_urdf
-    text = model_file_text(args.urdf, mimic=not args.no_mimic, g=args.g)
+    text = model_file_text(args.urdf, mimic=not args.no_mimic, g=args.g, limits=args.limits)
     out = Path(args.out) if args.out else Path("models") / f"{make_identifier(read_urdf(args.urdf).name, set())}.py"
     if out.exists() and not args.force:
         raise ModelError(f"{out} exists: --force overwrites it")

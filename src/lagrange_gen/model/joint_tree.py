@@ -9,6 +9,7 @@ models/humanoid.py), each a dict::
      "origin": (0, -0.1197, 0.425),           # the joint in the parent joint's frame
      "rpy": (0, 0, 0),                        # optional: the joint frame turned as URDF's rpy
      "mimic": {"joint": "shoulder", "multiplier": 1, "offset": 0},   # optional, below
+     "limits": (-3.1, 3.1),                   # optional: contacts with model_from_tree(limits=True)
      "mass": 2.275, "com": (0, 0.0265, 0.11993),     # centre of mass in this body's frame
      "inertia": (ixx, iyy, izz, ixy, iyz, izx)}      # about the com, in this body's frame
 
@@ -64,6 +65,8 @@ def check_tree(tree):
             raise ValueError(f"tree: joint {name}: origin and com need 3 numbers, inertia 6")
         if not float(joint["mass"]) >= 0 or len(joint.get("rpy", (0, 0, 0))) != 3:
             raise ValueError(f"tree: joint {name}: mass must be >= 0, rpy 3 numbers")
+        if "limits" in joint and not float(joint["limits"][0]) < float(joint["limits"][1]):
+            raise ValueError(f"tree: joint {name}: limits must be (lower, upper) with lower < upper")
     for joint in tree:
         mimic = joint.get("mimic")
         if mimic is not None and not any(j["name"] == mimic["joint"] and "mimic" not in j for j in tree):
@@ -162,12 +165,22 @@ def tree_bodies(tree, q=None):
     return N, O, q, bodies
 
 
-def model_from_tree(name, tree, g=9.81, description=None):
+def model_from_tree(name, tree, g=9.81, description=None, limits=False, restitution=0.0):
     """The lagrange_gen Model of a tree: T = lg.kinetic_energy(N, bodies), V = gravity, the one
-    parameter g (default ``g``)."""
+    parameter g (default ``g``). limits=True: the "limits" (lower, upper) of each joint with a
+    coordinate are two contacts, q - lower >= 0 and upper - q >= 0 (Newton's ``restitution``)."""
+    from .contacts import Contact
     g_sym = parameters("g", defaults=(float(g),))
     N, O, q, bodies = tree_bodies(tree)
     T = kinetic_energy(N, bodies)
     V = gravity_potential(N, -g_sym * N.z, bodies)
-    return Model(name, coords=q, T=T, V=V,
+    contacts = []
+    if limits:
+        own = [j for j in tree if "mimic" not in j]
+        for joint, qi in zip(own, q):
+            if "limits" in joint:
+                lower, upper = (sp.Float(float(x)) for x in joint["limits"])
+                contacts += [Contact(qi - lower, restitution, name=f"{joint['name']}_lower"),
+                             Contact(upper - qi, restitution, name=f"{joint['name']}_upper")]
+    return Model(name, coords=q, T=T, V=V, contacts=contacts,
                  description=description or f"{n_dof(tree)}-joint tree, mechanics bodies, gravity -g z")

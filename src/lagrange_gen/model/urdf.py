@@ -21,7 +21,8 @@ What each URDF element becomes:
   whose child and every link below it has no mass is refused (its column of the mass matrix
   would be zero);
 * visuals, collisions (``package://`` meshes), transmissions, gazebo and other elements are
-  not read; neither are ``<dynamics>`` damping and friction nor ``<limit>``.
+  not read; neither are ``<dynamics>`` damping and friction. A ``<limit>``'s lower and upper
+  (revolute, prismatic) are kept as the row's ``"limits"``: two contacts when asked for.
 
 Coordinates are named after the joints (made identifiers: ``q_<joint>``) and ordered as
 Pinocchio's URDF parser orders them: depth first from the root link, the child joints of a
@@ -45,7 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError
-from .joint_tree import model_from_tree, rpy_matrix, snapped
+from .joint_tree import model_from_tree, n_dof, rpy_matrix, snapped
 
 __all__ = ["from_urdf", "urdf_tree", "model_file_text", "read_urdf", "matrix_rpy", "make_identifier"]
 
@@ -89,6 +90,7 @@ class Joint:
     axis: np.ndarray
     mimic: tuple | None          # (joint name, multiplier, offset, line)
     line: int
+    limits: tuple | None = None  # (lower, upper) of a revolute or prismatic joint's <limit>
 
 
 @dataclass
@@ -204,7 +206,14 @@ def _joint(path, element):
         multiplier = float(_numbers(path, mimic_element, "multiplier", 1, (1,))[0])
         offset = float(_numbers(path, mimic_element, "offset", 1, (0,))[0])
         mimic = (other, multiplier, offset, mimic_element.line)
-    return Joint(name, kind, links[0], links[1], xyz, rpy, axis, mimic, element.line)
+    limits = None
+    limit = element.find("limit")
+    if limit is not None and kind in ("revolute", "prismatic"):
+        lower = float(_numbers(path, limit, "lower", 1, (0,))[0])
+        upper = float(_numbers(path, limit, "upper", 1, (0,))[0])
+        if lower < upper:
+            limits = (lower, upper)
+    return Joint(name, kind, links[0], links[1], xyz, rpy, axis, mimic, element.line, limits)
 
 
 def read_urdf(path) -> Robot:
@@ -362,6 +371,8 @@ def urdf_tree(path, mimic=True):
                    "rpy": tuple(_table_number(a) for a in rpy)}
             if joint.mimic is not None and mimic:
                 row["mimic"] = joint.mimic
+            elif joint.limits is not None:
+                row["limits"] = joint.limits
             index_of_joint[joint.name] = len(rows)
             rows.append(row)
             parts.append([] if inertial is None else [(inertial.mass, inertial.com, inertial.inertia)])
@@ -379,7 +390,8 @@ def urdf_tree(path, mimic=True):
         row["inertia"] = tuple(_table_number(x) for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[2, 0]))
         if not any(row["rpy"]):
             del row["rpy"]
-        order = ["name", "link", "parent", "type", "axis", "origin", "rpy", "mimic", "mass", "com", "inertia"]
+        order = ["name", "link", "parent", "type", "axis", "origin", "rpy", "mimic", "limits", "mass", "com",
+                 "inertia"]
         ordered = {k: row[k] for k in order if k in row}
         row.clear()
         row.update(ordered)
@@ -434,19 +446,29 @@ def _check_masses(where, rows, parts, robot):
 # ------------------------------------------------------------------- Model and model file
 
 
-def from_urdf(path, floating_base=False, g=9.81, mimic=True, name=None, description=None):
-    """The Model of the robot in the URDF at ``path``: a fixed base, gravity -g along the base's
-    z, the joint table of ``urdf_tree`` built with sympy.physics.mechanics (model_from_tree).
-    name: the model's name (default: the robot's name, made an identifier)."""
+def from_urdf(path, floating_base=False, g=9.81, mimic=True, limits=False, restitution=0.0, name=None,
+              description=None):
+    """The Model of the robot in the URDF file at ``path``, fixed to the ground: one coordinate
+    ``q_<joint>`` per revolute, continuous or prismatic joint, in Pinocchio's order; fixed joints
+    merged into their parent link; a mimic joint moved by the joint it mimics (mimic=False: a
+    coordinate of its own, as Pinocchio's parser gives by default); T = lg.kinetic_energy of
+    sympy.physics.mechanics RigidBodies, V = gravity -g along the base's z (the parameter g,
+    default ``g``). limits=True: each <limit lower upper> of a joint with its own coordinate is
+    two contacts (lg.Contact q - lower >= 0 and upper - q >= 0, Newton's ``restitution``), for
+    the contact methods. Meshes and damping are not read. name: the model's name (default:
+    the robot's, made an identifier). floating_base=True is not supported yet. ModelError, one
+    line naming the file, line and element, for a URDF that is malformed or not a tree of
+    supported joints; ``lagrange-gen urdf`` writes the same model as an editable model file
+    (docs/guides/from-urdf.md)."""
     if floating_base:
         raise ModelError(f"{path}: floating_base=True is not supported yet (fixed-base robots only)")
     robot = read_urdf(path)
     tree = urdf_tree(robot, mimic=mimic)
     if not tree:
         raise ModelError(f"{path}: the robot has no moving joint")
-    return model_from_tree(name or make_identifier(robot.name, set()), tree, g=g,
-                           description=description or f"{robot.name} from {Path(str(path)).name}: "
-                                                      f"{len(tree)} joints, fixed base, gravity -g z")
+    return model_from_tree(name or make_identifier(robot.name, set()), tree, g=g, limits=limits,
+                           restitution=restitution, description=description or f"{robot.name} from {Path(str(path)).name}: "
+                                                      f"{n_dof(tree)} joints, fixed base, gravity -g z")
 
 
 def _row_text(row):
@@ -457,12 +479,12 @@ def _row_text(row):
             return "(" + ", ".join(value(v) for v in x) + ("," if len(x) == 1 else "") + ")"
         return repr(x)
     head = ", ".join(f"{k!r}: {value(row[k])}" for k in ("name", "link", "parent", "type", "axis", "origin",
-                                                           "rpy", "mimic") if k in row)
+                                                           "rpy", "mimic", "limits") if k in row)
     body = ", ".join(f"{k!r}: {value(row[k])}" for k in ("mass", "com", "inertia"))
     return f"    {{{head},\n     {body}}},"
 
 
-def model_file_text(path, mimic=True, g=9.81):
+def model_file_text(path, mimic=True, g=9.81, limits=False):
     """The text of a model file that builds the URDF's robot from its joint table: edit TREE (or
     replace model_from_tree by your own mechanics code) and run lagrange-gen on it."""
     robot = read_urdf(path)
@@ -470,16 +492,17 @@ def model_file_text(path, mimic=True, g=9.81):
     if not tree:
         raise ModelError(f"{path}: the robot has no moving joint")
     name = make_identifier(robot.name, set())
-    n = sum("mimic" not in row for row in tree)
+    n = n_dof(tree)
     rows = "\n".join(_row_text(row) for row in tree)
     return f'''"""{robot.name}: {n} joint coordinates, fixed base (written by `lagrange-gen urdf {Path(str(path)).name}`).
 
 The joint table of the URDF, one row per moving joint in Pinocchio's order (depth first from the
 root link): parent (row index, -1: the fixed base), type (revolute or prismatic), origin (m) and
 rpy (rad) of the joint frame in the parent's frame, axis in the joint frame, mimic (q = multiplier
-* q_joint + offset: no coordinate of its own); the child link's mass (kg), mass centre (m) in
-the joint frame and central inertia (ixx, iyy, izz, ixy, iyz, izx) (kg m^2) in that frame,
-with the links of fixed joints merged in. Meshes, limits and damping are not read.
+* q_joint + offset: no coordinate of its own), limits (lower, upper: contacts with limits=True);
+the child link's mass (kg), mass centre (m) in the joint frame and central inertia (ixx, iyy,
+izz, ixy, iyz, izx) (kg m^2) in that frame, with the links of fixed joints merged in. Meshes
+and damping are not read.
 lagrange_gen.model.joint_tree.tree_bodies builds sympy.physics.mechanics frames and RigidBodies
 from it; T = lg.kinetic_energy of the bodies, V = gravity -g along the base's z.
 """
@@ -489,6 +512,6 @@ TREE = [
 {rows}
 ]
 
-model = model_from_tree({name!r}, TREE, g={float(g)!r},
+model = model_from_tree({name!r}, TREE, g={float(g)!r},{" limits=True, restitution=0.0," if limits else ""}
                         description={f"{robot.name} from {Path(str(path)).name}: {n} joints, fixed base, gravity -g z"!r})
 '''
