@@ -19,7 +19,7 @@ import pytest
 from lagrange_gen.cli.main import main
 from lagrange_gen.codegen.generated_files import generate_model
 from lagrange_gen.errors import ModelError
-from lagrange_gen.model.urdf import model_file_text
+from lagrange_gen.model.urdf import model_file_text, urdf_tree
 from lagrange_gen.run.loader import import_generated
 
 pin = pytest.importorskip("pinocchio")
@@ -109,3 +109,15 @@ def test_urdfs_without_a_moving_joint_are_refused_in_one_line(name):
     with pytest.raises(ModelError, match=REFUSED[name]) as info:
         model_file_text(ROBOTS / name)
     assert "\n" not in str(info.value)
+
+
+def test_child_joints_come_in_the_order_of_their_names_as_in_pinocchio(tmp_path):
+    """tests/model/data/arm_mimic.urdf with the branch joint renamed so that it sorts before its
+    sibling listed first in the file: Pinocchio (through urdfdom's map of joints) puts it first,
+    and so does urdf_tree (mimic off: Pinocchio wants a mimicked joint before its mimic)."""
+    text = (Path(__file__).parents[1] / "model" / "data" / "arm_mimic.urdf").read_text()
+    path = tmp_path / "renamed.urdf"
+    path.write_text(text.replace('name="finger"', 'name="aaa_finger"'))
+    names = [name.replace("-", "_") for name in list(pin.buildModelFromUrdf(str(path)).names)[1:]]
+    assert names[1] == "aaa_finger"
+    assert [row["name"] for row in urdf_tree(path, mimic=False)] == names
