@@ -279,6 +279,9 @@ BAD = {
     "loop": (lambda: _with('</robot>', '<joint name="back" type="fixed"><parent link="link4"/>'
                                        '<child link="link2"/></joint>\n</robot>'),
              "link 'link2' already has the parent joint 'elbow'", 'name="back"'),
+    "cycle": (lambda: _with('</robot>', '<joint name="around" type="fixed"><parent link="link4"/>'
+                                        '<child link="base_link"/></joint>\n</robot>'),
+              "joint 'shoulder' is on a loop of joints", 'name="shoulder"'),
     "missing inertial": (lambda: _with('<mass value="0.3"/>', '<mass value="0.0"/>'),
                          "joint 'wrist-roll' moves link 'link5' and nothing with mass", 'name="wrist-roll"'),
     "unknown mimic": (lambda: _with('<mimic joint="elbow"', '<mimic joint="elbo"'),

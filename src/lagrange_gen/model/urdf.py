@@ -294,8 +294,13 @@ def _children(robot):
         parent_of[joint.child] = joint
     roots = [name for name in robot.links if name not in parent_of]
     if not roots:
-        joint = robot.joints[0]
-        raise ModelError(f"{path}:{joint.line}: every link has a parent joint: the joints form a loop, not a tree")
+        link, seen = robot.joints[0].child, set()
+        while link not in seen:                 # up the parents until a link comes back
+            seen.add(link)
+            link = parent_of[link].parent
+        joint = parent_of[link]
+        raise ModelError(f"{path}:{joint.line}: joint {joint.name!r} is on a loop of joints (every link has a "
+                         "parent joint): not a tree")
     children = {name: [] for name in robot.links}
     for joint in robot.joints:
         children[joint.parent].append(joint)
