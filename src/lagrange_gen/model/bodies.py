@@ -71,7 +71,7 @@ def kinetic_energy(frame, *bodies):
             total += body.mass * v.dot(v) / 2
             if isinstance(body, me.RigidBody):
                 w = tree.w(body.frame)
-                inertia = tree._coords(body.central_inertia.to_matrix(body.frame))
+                inertia = tree.dyadic_components(body.central_inertia, body.frame)
                 inertias.append(inertia)
                 total += (w.T * inertia * w)[0, 0] / 2
         remember(total, frame, bodies, tree, inertias)

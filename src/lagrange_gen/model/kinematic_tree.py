@@ -128,6 +128,17 @@ class KinematicTree:
                 out += self.R(frame).T * (self.R(where) * comps)
         return out
 
+    def dyadic_components(self, dyadic, frame):
+        """Components (3, 3) of a mechanics Dyadic in ``frame`` (converted to Coordinates): the
+        sum over its outer products c a b of c A B^T, A and B the components of a and b
+        (components() above). sympy's Dyadic.to_matrix dots every pair of unit vectors through
+        the frame records, a product of 3x1 matrices per pair, which made the central inertias
+        the largest part of building a 30-body tree."""
+        out = sp.zeros(3, 3)
+        for coefficient, a, b in dyadic.args:
+            out += self._coords(coefficient) * self.components(a, frame) * self.components(b, frame).T
+        return out
+
     def in_N(self, vector):
         """Components (3, 1) in N of a mechanics Vector, each term through R of its frame."""
         out = sp.zeros(3, 1)
