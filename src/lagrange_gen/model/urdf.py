@@ -434,14 +434,20 @@ def _resolve_mimics(where, rows, index_of_joint, robot):
 
 
 def _check_masses(where, rows, parts, robot):
-    """ModelError for a moving joint under which nothing has mass."""
+    """ModelError for a coordinate that moves nothing with mass: neither below its own joint
+    nor below the joints that mimic it (a mimic joint over massless links is no trouble: it
+    has no column of its own)."""
     below = [sum(m for m, _, _ in body) for body in parts]
     for k in range(len(rows) - 1, -1, -1):
         if rows[k]["parent"] >= 0:
             below[rows[k]["parent"]] += below[k]
-    joint_of = {j.child: j for j in robot.joints}
+    moved = {row["name"]: below[k] for k, row in enumerate(rows) if "mimic" not in row}
     for k, row in enumerate(rows):
-        if below[k] <= 0:
+        if "mimic" in row:
+            moved[row["mimic"]["joint"]] += below[k]
+    joint_of = {j.child: j for j in robot.joints}
+    for row in rows:
+        if "mimic" not in row and moved[row["name"]] <= 0:
             joint = joint_of[row["link"]]
             raise ModelError(f"{where}:{joint.line}: joint {joint.name!r} moves link "
                              f"{row['link']!r} and nothing with mass (a missing <inertial>?): "
