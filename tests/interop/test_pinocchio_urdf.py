@@ -44,10 +44,19 @@ if ROBOTS is None:
 FEW = ["ur_description/urdf/ur5_robot.urdf", "panda_description/urdf/panda.urdf",
        "kinova_description/robots/kinova.urdf", "xarm_description/urdf/xarm7.urdf",
        "solo_description/robots/solo12.urdf"]
-#: refused here (Pinocchio loads them with no joint, or not at all): the reason in the message
+#: refused here, the reason in the message: no moving joint (Pinocchio: nq = 0), no robot
+#: (Pinocchio fails too), a coordinate moving only massless links (Pinocchio loads them with a
+#: singular mass matrix), a mimic of a joint that does not exist (Pinocchio's mimic=True fails)
 REFUSED = {"hector_description/robots/quadrotor_base.urdf": "no moving joint",
            "iris_description/robots/iris_simple.urdf": "no moving joint",
-           "ur_description/urdf/ur3.urdf": "has no <link>"}
+           "ur_description/urdf/ur3.urdf": "has no <link>",
+           "romeo_description/urdf/romeo.urdf": "joint 'LHand' moves link 'LFinger11Link' and nothing with mass",
+           "romeo_description/urdf/romeo_laas_small.urdf": "joint 'l_gripper_joint' moves link 'l_gripper' and nothing",
+           "alex_description/urdf/alex_psyonic_hands.urdf": "<mimic joint=\"index_q1\">: no joint of that name"}
+#: compared with mimic joints as coordinates of their own on both sides (--no-mimic, Pinocchio's
+#: mimic=False): Pinocchio's mimic=True wants a mimicked joint before its mimic in its order
+OWN_COORDINATES = {"talos_data/robots/talos_full_v2.urdf", "talos_data/robots/talos_full_v2_box.urdf",
+                   "alex_description/urdf/alex_psyonic_hands.urdf"}
 ALL = sorted(str(p.relative_to(ROBOTS)) for p in ROBOTS.rglob("*.urdf"))
 TOL = 1e-10
 STATES = 3
@@ -56,18 +65,18 @@ STATES = 3
 def pytest_generate_tests(metafunc):
     if "robot" in metafunc.fixturenames:
         every = metafunc.config.getoption("--all-robots", default=False)
-        cases = [r for r in (ALL if every else FEW) if r not in REFUSED]
+        cases = [r for r in (ALL if every else FEW) if r not in REFUSED or r in OWN_COORDINATES]
         metafunc.parametrize("robot", cases, ids=[Path(r).stem for r in cases], indirect=True)
 
 
 @pytest.fixture
 def robot(request, tmp_path):
     """(path, generated module, Pinocchio peer) of one URDF."""
-    path = ROBOTS / request.param
+    path, mimic = ROBOTS / request.param, request.param not in OWN_COORDINATES
     src = tmp_path / f"{Path(request.param).stem.replace('-', '_')}.py"
-    assert main(["urdf", str(path), "-o", str(src)]) == 0
+    assert main(["urdf", str(path), "-o", str(src)] + ([] if mimic else ["--no-mimic"])) == 0
     mod = import_generated(generate_model(src, tmp_path / "gen", methods=["rk4"]).path)
-    return path, mod, pinocchio_urdf(path, mod.COORDS)
+    return path, mod, pinocchio_urdf(path, mod.COORDS, mimic=mimic)
 
 
 def _err(ours, theirs):
@@ -121,3 +130,37 @@ def test_child_joints_come_in_the_order_of_their_names_as_in_pinocchio(tmp_path)
     names = [name.replace("-", "_") for name in list(pin.buildModelFromUrdf(str(path)).names)[1:]]
     assert names[1] == "aaa_finger"
     assert [row["name"] for row in urdf_tree(path, mimic=False)] == names
+
+
+@pytest.mark.parametrize("name", ["panda_description/urdf/panda.urdf", "talos_data/robots/talos_full_v2.urdf"],
+                         ids=["panda", "talos_full_v2"])
+def test_mimic_joints_equal_pinocchio_without_mimic_projected(request, tmp_path, name):
+    """Our mimic joints (no coordinate of their own) against Pinocchio's model with every joint
+    a coordinate (mimic=False), projected on q_full = G q + c: M = G^T M_full G, the inverse
+    dynamics G^T rnea_full(G q + c, G v, G a). Talos's grippers (12 mimic joints) Pinocchio's
+    mimic=True does not load; it runs with --all-robots."""
+    if name != FEW[1] and not request.config.getoption("--all-robots"):
+        pytest.skip("--all-robots")
+    path = ROBOTS / name
+    src = tmp_path / "robot.py"
+    assert main(["urdf", str(path), "-o", str(src)]) == 0
+    mod = import_generated(generate_model(src, tmp_path / "gen", methods=["rk4"]).path)
+    rows = urdf_tree(path)
+    peer = pinocchio_urdf(path, ["q_" + row["name"] for row in rows], mimic=False)
+    n, p, own = mod.N_COORDS, mod.DEFAULT_PARAMS, list(mod.COORDS)
+    G, c = np.zeros((len(rows), n)), np.zeros(len(rows))
+    for k, row in enumerate(rows):
+        mimic = row.get("mimic", {"joint": row["name"], "multiplier": 1.0, "offset": 0.0})
+        G[k, own.index("q_" + mimic["joint"])], c[k] = mimic["multiplier"], mimic["offset"]
+    assert n < len(rows)
+    rng = np.random.default_rng(45)
+    for _ in range(STATES):
+        q, v, a = rng.uniform(-2, 2, n), rng.normal(size=n), rng.normal(size=n)
+        H, rhs, out = np.zeros((n, n)), np.zeros(n), np.zeros(n)
+        mod.dynamics.py_func(q, v, 0.0, p, H, rhs)
+        M = G.T @ peer.crba(G @ q + c) @ G
+        assert _err(H, M) < TOL
+        mod.inverse_dynamics.py_func(q, v, a, 0.0, p, out)
+        assert _err(out, G.T @ peer.rnea(G @ q + c, G @ v, G @ a)) < TOL
+        assert mod.forward_dynamics.py_func(q, v, 0.0, p, np.zeros((n, n)), out) == 0
+        assert _err(out, np.linalg.solve(M, -G.T @ peer.rnea(G @ q + c, G @ v, np.zeros(len(rows))))) < TOL
