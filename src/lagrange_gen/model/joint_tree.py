@@ -4,6 +4,7 @@ A tree is a list of joints (``TREE`` in models/ur5.py, models/spatial_chain.py,
 models/humanoid.py), each a dict::
 
     {"name": "elbow", "parent": 1,            # index of the parent joint, -1: the fixed base
+     "link": "forearm_link",                  # optional: the URDF link it moves (a label)
      "type": "revolute",                      # or "prismatic"
      "axis": (0, 1, 0),                       # joint axis in the joint's frame
      "origin": (0, -0.1197, 0.425),           # the joint in the parent joint's frame
