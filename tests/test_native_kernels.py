@@ -9,6 +9,7 @@ cache, survive a corrupt cache file, and hand a kernel they cannot lower to numb
 """
 
 import json
+import os
 import types
 import warnings
 
@@ -260,3 +261,97 @@ def test_a_strided_argument_from_python_goes_to_numba(generated):
     q = np.ascontiguousarray(q2)
     qd, p = np.array([0.2, 0.7]), mod.DEFAULT_PARAMS
     assert mod.energy(q2, qd, 0.0, p) == mod.energy(q, qd, 0.0, p)
+
+
+def _tiered(monkeypatch, tmp_path):
+    """An empty object cache, background compiles allowed, every kernel 'big'."""
+    _fresh(monkeypatch, tmp_path)
+    monkeypatch.setenv("LAGRANGE_GEN_BACKGROUND_COMPILE", "1")
+    monkeypatch.delenv("LAGRANGE_GEN_NATIVE_OPT", raising=False)
+    monkeypatch.setattr(native, "FAST_FIRST_BYTES", 0)
+
+
+def _outputs(kernel, args):
+    mine = [a.copy() if isinstance(a, np.ndarray) else a for a in args]
+    result = _caller(len(mine))(kernel, *mine)
+    return result, [a for a in mine if isinstance(a, np.ndarray)]
+
+
+def test_a_big_kernel_runs_at_level_0_first_then_at_level_1_equal_bits(generated, monkeypatch,
+                                                                     tmp_path):
+    """With its level-1 object not cached, a big kernel is compiled at LLVM's level 0 (fast) and
+    wants level 1; the background compile (run here in this process) writes the level-1 object,
+    which the next lookup loads. Both levels give the same bits: no fast-math, the same
+    operations in the same order."""
+    from lagrange_gen.jit import native_background
+    mod = generated("ur5")
+    _tiered(monkeypatch, tmp_path)
+    folder = portable.native_dir()
+    names = ("forward_dynamics", "rhs_jacobian", "energy")
+    first = [native.native_kernel(mod, name, folder) for name in names]
+    assert [(k.level, k.wanted, k.cached) for k in first] == [(0, 1, False)] * 3
+    started = []     # the "background process" is this one: a live process holds the lock
+    monkeypatch.setattr(native_background, "spawn_detached",
+                        lambda argv, env: started.append(argv) or os.getpid())
+    assert native_background.compile_later(mod, first, folder) == os.getpid()
+    argv = started[0]
+    assert argv[argv.index("-m") + 1] == "lagrange_gen.jit.native_background"
+    assert sorted(argv[-3:]) == sorted(names)
+    # a second run while that compile holds the module's lock starts none
+    assert native_background.compile_later(mod, first, folder) is None
+    native_background.release_lock(native_background.lock_path(mod, folder))
+    native_background.compile_kernels(mod.__name__, mod.__file__, folder, 1, list(names))
+    monkeypatch.setattr(native, "_KERNELS", {})
+    best = [native.native_kernel(mod, name, folder) for name in names]
+    assert [(k.level, k.cached) for k in best] == [(1, True)] * 3
+    rng = np.random.default_rng(5)
+    for fast, slow in zip(first, best):
+        args = _inputs(mod, fast.name, rng)
+        (r0, out0), (r1, out1) = _outputs(fast, args), _outputs(slow, args)
+        assert r0 == r1 and all(np.array_equal(a, b) for a, b in zip(out0, out1)), fast.name
+    # a new process before the background compile ends finds the level-0 object
+    (folder / f"{best[2].key}.json").unlink()
+    monkeypatch.setattr(native, "_KERNELS", {})
+    again = native.native_kernel(mod, "energy", folder)
+    assert (again.level, again.wanted, again.cached) == (0, 1, True)
+
+
+@pytest.mark.parametrize("setting", ["background off", "explicit level"])
+def test_no_level_0_first_without_background_compiles_or_with_an_explicit_level(
+        setting, generated, monkeypatch, tmp_path):
+    """With nothing to compile the better object later (background compiles off), or a level
+    asked for by $LAGRANGE_GEN_NATIVE_OPT, the kernel is compiled at that level at once."""
+    mod = generated("cart_pendulum")
+    _tiered(monkeypatch, tmp_path)
+    if setting == "background off":
+        monkeypatch.setenv("LAGRANGE_GEN_BACKGROUND_COMPILE", "0")
+    else:
+        monkeypatch.setenv("LAGRANGE_GEN_NATIVE_OPT", "1")
+    kernel = native.native_kernel(mod, "forward_dynamics", portable.native_dir())
+    assert (kernel.level, kernel.wanted) == (1, 1)
+
+
+def test_the_background_compile_of_kernels_runs_detached_and_leaves_level_1_objects(
+        generated, monkeypatch, tmp_path):
+    """The real thing: a detached process (no child of this one), at low priority, compiles
+    the kernels into the object cache and removes its lock; one line said so."""
+    import io
+    import time
+    from lagrange_gen.jit import native_background
+    mod = generated("cart_pendulum")
+    _tiered(monkeypatch, tmp_path)
+    folder = portable.native_dir()
+    kernels = [native.native_kernel(mod, name, folder) for name in ("forward_dynamics", "energy")]
+    stream = io.StringIO()
+    pid = native_background.compile_later(mod, kernels, folder, stream=stream)
+    assert pid and "compiling 2 kernels of cart_pendulum at LLVM level 1 in the background" \
+        in stream.getvalue() and stream.getvalue().count("\n") == 1
+    lock = native_background.lock_path(mod, folder)
+    deadline = time.time() + 120
+    while lock.exists() and time.time() < deadline:
+        time.sleep(0.2)
+    assert not lock.exists()
+    monkeypatch.setattr(native, "_KERNELS", {})
+    for name in ("forward_dynamics", "energy"):
+        kernel = native.native_kernel(mod, name, folder)
+        assert (kernel.level, kernel.cached) == (1, True), name

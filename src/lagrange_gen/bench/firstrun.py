@@ -3,8 +3,12 @@
 
 Every measurement is one fresh child process (``python -m lagrange_gen.bench.firstrun --child``)
 with its own NUMBA_CACHE_DIR and LAGRANGE_GEN_PORTABLE_DIR and a fresh folder for the generated
-module, LAGRANGE_GEN_BACKGROUND_COMPILE=0 (nothing else runs) and LAGRANGE_GEN_INTERPRETED=0
-(the first step is a compiled one, not the interpreted tier). The variants of a case:
+module, and LAGRANGE_GEN_INTERPRETED=0 (the first step is a compiled one, not the interpreted
+tier). Background compiles are on, as for a user: a big kernel runs at LLVM's level 0 in the
+child while a detached process compiles it at level 1 (jit/native_background.py); the parent
+waits for that process before it starts the next child, so that no two measurements overlap
+and the ``again`` variant finds what a user's next process finds. With the interpreted tier off
+nothing else runs in the background. The variants of a case:
 
 - ``empty``: empty caches, the first model after an install: the portable glue of the method is
   compiled too;
@@ -142,16 +146,30 @@ GOALS = (
 
 
 def child_env(dirs, native=True):
-    """The environment of a child: its caches (``dirs`` {"numba", "portable"}), nothing in the
-    background, compiled first steps, native kernels on or off."""
-    from ..jit.first_run import BACKGROUND_ENV, INTERPRETED_ENV
-    from ..jit.native import NATIVE_ENV
+    """The environment of a child: its caches (``dirs`` {"numba", "portable"}), background
+    compiles on (module docstring), compiled first steps, native kernels on or off."""
+    from ..jit.background import BACKGROUND_ENV
+    from ..jit.first_run import INTERPRETED_ENV
+    from ..jit.native import NATIVE_ENV, OPT_ENV
     from ..jit.portable import DIR_ENV, JIT_ENV
     env = dict(os.environ, NUMBA_CACHE_DIR=str(dirs["numba"]),
-               **{DIR_ENV: str(dirs["portable"]), BACKGROUND_ENV: "0", INTERPRETED_ENV: "0",
+               **{DIR_ENV: str(dirs["portable"]), BACKGROUND_ENV: "1", INTERPRETED_ENV: "0",
                   NATIVE_ENV: "1" if native else "0"})
     env.pop(JIT_ENV, None)          # the default choice (bench/cli.py sets "specialized")
+    env.pop(OPT_ENV, None)          # LLVM's default level, and with it the level-0 first tier
     return env
+
+
+def wait_for_background(portable_dir, timeout=900.0):
+    """Wall seconds spent waiting until no background compile holds a lock under
+    ``portable_dir`` (jit.background: ``*.compiling`` files), at most ``timeout``."""
+    from ..jit.background import lock_held
+    start = time.perf_counter()
+    while time.perf_counter() - start < timeout:
+        if not any(lock_held(lock) for lock in Path(portable_dir).rglob(".*.compiling")):
+            break
+        time.sleep(0.2)
+    return time.perf_counter() - start
 
 
 def run_child(spec, env, timeout, work):
@@ -187,6 +205,8 @@ def run_child(spec, env, timeout, work):
         row["done"] = True
     row.update(cpu=usage.ru_utime + usage.ru_stime, rss_mb=usage.ru_maxrss / 1024,
                wall=time.perf_counter() - start)
+    from ..jit.folders import DIR_ENV
+    row["background_wait"] = wait_for_background(env[DIR_ENV]) if DIR_ENV in env else 0.0
     if timed_out:
         row["timeout"] = timeout
     elif proc.returncode != 0 or "done" not in row:
@@ -309,7 +329,10 @@ def measure_percall(root, models_dir, quick=False, timeout=900):
     dirs = {"numba": Path(root) / "percall" / "numba", "portable": Path(root) / "percall" / "portable"}
     spec = {"kind": "percall", "models_dir": str(models_dir), "quick": quick,
             "out_dir": str(Path(root) / "percall" / "gen")}
-    return run_child(spec, child_env(dirs, True), timeout, Path(root) / "percall")
+    from ..jit.background import BACKGROUND_ENV
+    # every kernel at LLVM's level 1 at once: the cost per call of what every later run loads
+    env = dict(child_env(dirs, True), **{BACKGROUND_ENV: "0"})
+    return run_child(spec, env, timeout, Path(root) / "percall")
 
 
 def run_firstrun_bench(models_dir="models", reports_dir="reports", quick=False, cases=None,
@@ -370,11 +393,15 @@ class _Phases:
 
 
 def _kernel_stats(table):
-    """{"native_new", "native_cached", "native_s", "numba_kernels"} of a kernel table."""
-    stats = {"native_new": 0, "native_cached": 0, "native_s": 0.0, "numba_kernels": 0}
+    """{"native_new", "native_cached", "native_level0", "native_s", "numba_kernels"} of a
+    kernel table (native_level0: kernels running at LLVM's level 0 while a background process
+    compiles their better level)."""
+    stats = {"native_new": 0, "native_cached": 0, "native_level0": 0, "native_s": 0.0,
+             "numba_kernels": 0}
     for entry in table:
         if hasattr(entry, "cached") and hasattr(entry, "seconds"):
             stats["native_cached" if entry.cached else "native_new"] += 1
+            stats["native_level0"] += int(getattr(entry, "level", 1) < getattr(entry, "wanted", 1))
             stats["native_s"] += entry.seconds
         elif hasattr(entry, "dispatcher"):
             stats["numba_kernels"] += 1

@@ -54,6 +54,12 @@ class Graph:
         self.order: list = []
         self._intern: dict = {}
         self._deps: dict = {}
+        # per node, kept because every pass over the graph (reachability, the n forward passes
+        # of a Jacobian, the emitted text) reads them again: its position in ``order``, the
+        # nodes its definition uses, and its local partial derivatives {symbol: d def/d symbol}
+        self._index: dict = {}
+        self._uses: dict = {}
+        self._partials: dict = {}
         self._forward: dict = {}        # direction key -> [{node: derivative}, nodes processed]
 
     def __len__(self):
@@ -80,16 +86,25 @@ class Graph:
             if found is not None:
                 return found
         sym = se.Symbol(f"{NODE_PREFIX}{len(self.order)}")
+        free = expr.free_symbols
+        self._index[sym] = len(self.order)
         self.defs[sym] = expr
         self.order.append(sym)
         self._intern[expr] = sym
-        self._deps[sym] = self.inputs_of(expr)
+        self._uses[sym] = tuple(u for u in free if u in self.defs and u != sym)
+        self._deps[sym] = self._inputs_of_symbols(free)
         return sym
 
     def inputs_of(self, expr) -> frozenset:
         """The input symbols ``expr`` depends on, through its nodes."""
+        deps = self._deps.get(expr)
+        if deps is not None:            # a node
+            return deps
+        return self._inputs_of_symbols(expr.free_symbols)
+
+    def _inputs_of_symbols(self, symbols) -> frozenset:
         out = set()
-        for s in expr.free_symbols:
+        for s in symbols:
             deps = self._deps.get(s)
             if deps is None:
                 out.add(s)
@@ -97,11 +112,31 @@ class Graph:
                 out |= deps
         return frozenset(out)
 
+    def _local_partials(self, sym) -> dict:
+        """{symbol: d definition / d symbol} of a node's definition, non-zero ones only."""
+        partials = self._partials.get(sym)
+        if partials is None:
+            definition = self.defs[sym]
+            partials = {}
+            for s in definition.free_symbols:
+                local = definition.diff(s)
+                if local != 0:
+                    partials[s] = local
+            self._partials[sym] = partials
+        return partials
+
     # -- derivatives ----------------------------------------------------------------------
-    def _chain(self, expr, seeds, derivatives):
+    def _chain(self, expr, seeds, derivatives, partials=None):
         """sum over the free symbols s of expr of d expr/ds * ds/dx, where ds/dx is seeds[s] for
-        an input and derivatives[s] for a node (absent: zero)."""
+        an input and derivatives[s] for a node (absent: zero); ``partials``: expr's
+        {s: d expr/ds} when known (a node's, _local_partials)."""
         terms = []
+        if partials is not None:
+            for s, local in partials.items():
+                ds = derivatives.get(s) if s in self.defs else seeds.get(s)
+                if ds is not None and ds != 0:
+                    terms.append(local * ds)
+            return se.Add(*terms) if terms else se.Integer(0)
         for s in expr.free_symbols:
             ds = derivatives.get(s) if s in self.defs else seeds.get(s)
             if ds is None or ds == 0:
@@ -128,7 +163,8 @@ class Graph:
                 continue
             done.add(sym)
             if self._deps[sym] & seeded:
-                value = self.node(self._chain(self.defs[sym], seeds, derivatives))
+                value = self.node(self._chain(self.defs[sym], seeds, derivatives,
+                                              self._local_partials(sym)))
                 if value != 0:
                     derivatives[sym] = value
         return derivatives
@@ -173,25 +209,22 @@ class Graph:
             if not parts:
                 continue
             bar = self.node(se.Add(*parts))
-            definition = self.defs[sym]
-            for s in definition.free_symbols:
-                add(s, bar * definition.diff(s))
+            for s, local in self._local_partials(sym).items():
+                add(s, bar * local)
         return [self.node(se.Add(*adjoint[x])) if x in adjoint else se.Integer(0)
                 for x in (se.sympify(x) for x in xs)]
 
     def _reachable(self, *exprs):
         """The nodes ``exprs`` use (directly or through other nodes), in definition order."""
-        seen, stack = set(), [s for e in exprs for s in e.free_symbols if s in self.defs]
+        uses = self._uses
+        seen, stack = set(), [s for e in exprs for s in e.free_symbols if s in uses]
         while stack:
             s = stack.pop()
             if s in seen:
                 continue
             seen.add(s)
-            stack.extend(u for u in self.defs[s].free_symbols if u in self.defs and u not in seen)
-        index = {s: i for i, s in enumerate(self.order)} if len(seen) > 64 else None
-        if index is None:
-            return [s for s in self.order if s in seen]
-        return sorted(seen, key=index.__getitem__)
+            stack.extend(u for u in uses[s] if u not in seen)
+        return sorted(seen, key=self._index.__getitem__)
 
     def used_nodes(self, exprs):
         """[(node, definition)] that evaluating ``exprs`` needs, in evaluation order."""

@@ -21,10 +21,10 @@ compiles it with numba and says so in one line. $LAGRANGE_GEN_NATIVE=0 turns nat
 
 from __future__ import annotations
 
-import ast
 import functools
 import hashlib
 import json
+import marshal
 import os
 import threading
 from pathlib import Path
@@ -43,6 +43,12 @@ OPT_ENV = "LAGRANGE_GEN_NATIVE_OPT"
 #: LLVM optimization level: level 1 compiles the big kernels several times faster than 2 or 3
 #: and costs about what numba's kernels cost per call (reports/firstrun.md measures both).
 OPT_LEVEL = 1
+
+#: A kernel with more IR than this (bytes of its text) whose object at the default level is not
+#: cached is compiled at level 0 first (tiers_allowed): LLVM's code generation at level 1 takes
+#: about a second per MB of IR, at level 0 a sixth of that, for two to three times the time per
+#: call, the same numbers (no fast-math: the same operations in the same order).
+FAST_FIRST_BYTES = 300_000
 
 #: The exported symbol of a kernel in its LLVM module.
 EXPORT_PREFIX = "lagrange_gen_native_"
@@ -129,9 +135,13 @@ def _writer_hash() -> str:
 
 
 def _closure(fn):
-    """[(name, source, constants)] of ``fn`` and every function it calls by a global name,
-    each once: what a kernel's object code is made of. constants: the int/float/bool module
-    constants its names read."""
+    """[(name, identity, constants)] of ``fn`` and every function it calls by a global name,
+    each once: what a kernel's object code is made of. identity: a function of a generated
+    module, that module's TEXT_SHA (the hash of its whole text, checked when it is imported:
+    codegen.keys.check_current) and its code object's bytes, so a cached kernel is found
+    without reading its source;
+    another function, the hash of its source. constants: the int/float/bool/array values of
+    the global names its code reads (its nested code objects' too)."""
     seen, out, todo = set(), [], [fn]
     while todo:
         f = todo.pop()
@@ -139,10 +149,18 @@ def _closure(fn):
         if id(py) in seen:
             continue
         seen.add(id(py))
-        source, node, globs = function_source(py)
+        globs = py.__globals__
+        text_sha = globs.get("TEXT_SHA") if "KEY" in globs and "check_current" in globs else None
+        if isinstance(text_sha, str) and len(text_sha) == 64:
+            # the text it is lowered from, and the code it runs (a function put in the
+            # module's namespace by hand has the module's TEXT_SHA but code of its own)
+            identity = ("module text", text_sha,
+                        hashlib.sha256(marshal.dumps(py.__code__)).hexdigest())
+        else:
+            source, _, _ = function_source(py)
+            identity = hashlib.sha256(source.encode()).hexdigest()
         constants = {}
-        names = {sub.id for sub in ast.walk(node) if isinstance(sub, ast.Name)}
-        for name in sorted(names & globs.keys()):
+        for name in sorted(_global_names(py.__code__) & globs.keys()):
             value = globs[name]
             if isinstance(value, (bool, int, float)):
                 constants[name] = repr(value)
@@ -151,13 +169,31 @@ def _closure(fn):
                                    hashlib.sha256(value.tobytes()).hexdigest())
             elif callable(value) and (hasattr(value, "py_func") or hasattr(value, "__code__")):
                 todo.append(value)
-        out.append((f"{py.__module__}.{py.__qualname__}",
-                    hashlib.sha256(source.encode()).hexdigest(), sorted(constants.items())))
+        out.append((f"{py.__module__}.{py.__qualname__}", identity, sorted(constants.items())))
     return out
 
 
-def kernel_key(fn, arg_kinds, level) -> str:
-    """The object cache key of kernel ``fn`` compiled for ``arg_kinds`` at ``level``."""
+def _global_names(code) -> set:
+    """The names ``code`` and the code objects nested in it (comprehensions) load from
+    globals or as attributes (co_names): a superset of the globals it reads."""
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if hasattr(const, "co_names"):
+            names |= _global_names(const)
+    return names
+
+
+def closure_digest(fn) -> str:
+    """sha256 of _closure(fn): the part of a kernel's key that depends on its code."""
+    digest = hashlib.sha256()
+    for item in _closure(fn):
+        digest.update(repr(item).encode())
+    return digest.hexdigest()
+
+
+def kernel_key(fn, arg_kinds, level, closure=None) -> str:
+    """The object cache key of kernel ``fn`` compiled for ``arg_kinds`` at ``level``
+    (closure: closure_digest(fn) when the caller has it)."""
     llvm = _llvm()
     import llvmlite
     digest = hashlib.sha256()
@@ -165,8 +201,7 @@ def kernel_key(fn, arg_kinds, level) -> str:
                         llvm.get_host_cpu_features().flatten(), level, tuple(arg_kinds),
                         native_ir.CHUNK_STATEMENTS,
                         native_ir.LOOP_CHUNK_STATEMENTS)).encode())
-    for item in _closure(fn):
-        digest.update(repr(item).encode())
+    digest.update((closure or closure_digest(fn)).encode())
     return digest.hexdigest()[:32]
 
 
@@ -291,59 +326,96 @@ def _signature(ret, arg_types):
     return restype(*arg_types)
 
 
-def native_kernel(module, name, folder: Path):
+def _read_object(folder: Path, key: str):
+    """(object code, return kind, compile seconds) of ``key`` in the object cache, or None when
+    it is missing, unreadable or not what its meta says (a truncated or foreign file must not
+    reach LLVM's loader, which aborts the process)."""
+    try:
+        meta = json.loads((folder / f"{key}.json").read_text())
+        obj, ret = (folder / f"{key}.o").read_bytes(), meta["ret"]
+        if hashlib.sha256(obj).hexdigest() != meta["sha256"] or ret not in _RETURN_KINDS:
+            return None
+        return obj, ret, float(meta.get("seconds", 0.0))
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def _write_object(folder: Path, key: str, name: str, obj: bytes, ret, seconds: float) -> None:
+    try:
+        # the object first: a reader trusts an object only through its meta's hash
+        write_atomic(folder / f"{key}.o", obj)
+        write_atomic(folder / f"{key}.json", json.dumps({
+            "ret": ret, "kernel": name, "sha256": hashlib.sha256(obj).hexdigest(),
+            "seconds": round(seconds, 4)}).encode())
+    except OSError:          # an unwritable cache: compiled again next time
+        pass
+
+
+def tiers_allowed(level: int) -> bool:
+    """Whether a big kernel whose level-``level`` object is not cached may run at level 0 while
+    a background process compiles it at ``level`` (native_background): only at the default
+    level (not one set by $LAGRANGE_GEN_NATIVE_OPT) and only where background compiles are
+    allowed (else nothing would ever compile the better object and every run would keep the
+    slower one)."""
+    from .background import background_enabled
+    return level > 0 and not os.environ.get(OPT_ENV, "").strip() and background_enabled()
+
+
+def native_kernel(module, name, folder: Path, level=None):
     """The kernel ``name`` of generated ``module`` compiled natively (a NativeKernel), from the
     object cache in ``folder`` when it holds it (jit.folders.native_dir). Raises
     native_ir.Unsupported when the kernel is outside the subset, or llvmlite lacks what is used
-    (then the caller compiles it with numba)."""
+    (then the caller compiles it with numba).
+
+    level: LLVM's level, exactly (default opt_level(): then a big kernel whose object at that
+    level is not cached yet is compiled at level 0 (tiers_allowed, FAST_FIRST_BYTES): its ``level`` is then 0 and ``wanted`` the
+    default level, which native_background.compile_later asks a background process for)."""
     import time
     from numba import types
     fn = getattr(module, name)
     py = getattr(fn, "py_func", fn)
     arg_types = kernel_arg_types(fn)
     arg_kinds = tuple("t" if ty == types.float64 else ty.ndim for ty in arg_types)
-    level = opt_level()
+    requested, level = level, opt_level() if level is None else level
     try:
-        key = kernel_key(fn, arg_kinds, level)
+        closure = closure_digest(fn)
+        key = kernel_key(fn, arg_kinds, level, closure)
     except Unsupported:
         raise
     except Exception as exc:     # llvmlite's binding or a source missing: numba compiles
         raise Unsupported(f"{type(exc).__name__}: {exc}".splitlines()[0]) from None
-    memo = (getattr(module, "__file__", None), name, key)
+    # a lookup at the default level may hold a level-0 kernel (tiers); one at an exact level not
+    memo = (getattr(module, "__file__", None), name, key, requested is None)
     with _LOCK:
         if memo in _KERNELS:
             return _KERNELS[memo]
         start = time.perf_counter()
-        obj_path, meta_path = folder / f"{key}.o", folder / f"{key}.json"
-        obj = ret = None
-        compile_seconds = 0.0
-        try:
-            meta = json.loads(meta_path.read_text())
-            obj, ret = obj_path.read_bytes(), meta["ret"]
-            compile_seconds = float(meta.get("seconds", 0.0))
-            # a truncated or foreign file must not reach LLVM's loader, which aborts the process
-            if hashlib.sha256(obj).hexdigest() != meta["sha256"] or ret not in _RETURN_KINDS:
-                obj = None
-        except (OSError, ValueError, KeyError, TypeError):
-            obj = None
-        cached = obj is not None
-        symbol = f"{EXPORT_PREFIX}{name}_{key[:16]}"
-        if not cached:
+        found = _read_object(folder, key)
+        built, tiers = level, found is None and requested is None and tiers_allowed(level)
+        if tiers:                       # a level-0 object made by an earlier fast first run
+            key0 = kernel_key(fn, arg_kinds, 0, closure)
+            found = _read_object(folder, key0)
+            if found is not None:
+                key, built = key0, 0
+        cached = found is not None
+        if found is not None:
+            obj, ret, compile_seconds = found
+        else:
             cpu = time.process_time()
-            ir_text, ret = lower_kernel(py, arg_kinds, symbol[len(EXPORT_PREFIX):])
+            name_in_ir = f"{name}_{key[:16]}"
+            ir_text, ret = lower_kernel(py, arg_kinds, name_in_ir)
+            if tiers and len(ir_text) > FAST_FIRST_BYTES:
+                key, built = key0, 0
+                # the same IR under the level-0 key's symbol (a token of its own in the text)
+                ir_text = ir_text.replace(f"{EXPORT_PREFIX}{name_in_ir}",
+                                          f"{EXPORT_PREFIX}{name}_{key[:16]}")
             try:
-                obj = _compile(ir_text, level)
+                obj = _compile(ir_text, built)
             except Exception as exc:        # LLVM refused the IR: a bug here, numba compiles
                 raise Unsupported(f"LLVM: {exc}".splitlines()[0]) from None
             compile_seconds = time.process_time() - cpu
-            try:
-                # the object first: a reader trusts an object only through its meta's hash
-                write_atomic(obj_path, obj)
-                write_atomic(meta_path, json.dumps({
-                    "ret": ret, "kernel": name, "sha256": hashlib.sha256(obj).hexdigest(),
-                    "seconds": round(compile_seconds, 4)}).encode())
-            except OSError:          # an unwritable cache: compiled again next time
-                pass
+            _write_object(folder, key, name, obj, ret, compile_seconds)
+        symbol = f"{EXPORT_PREFIX}{name}_{key[:16]}"
         try:
             address = _load_object(obj, symbol)
         except Unsupported:
@@ -354,5 +426,6 @@ def native_kernel(module, name, folder: Path):
                                         time.perf_counter() - start, cached)
         kernel.compile_seconds = compile_seconds
         kernel.ret_kind = ret
+        kernel.level, kernel.wanted = built, level
         _KERNELS[memo] = kernel
         return kernel

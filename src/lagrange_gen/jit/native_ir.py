@@ -115,15 +115,58 @@ def function_source(fn):
     entry = _PARSED.get(id(py))
     if entry is not None and entry[0] is py:
         return entry[1]
-    try:
-        source = textwrap.dedent(inspect.getsource(py))
-    except (OSError, TypeError) as exc:
-        raise Unsupported(f"no source for {getattr(py, '__name__', py)!r}: {exc}") from None
-    node = ast.parse(source).body[0]
+    source = _top_level_source(py)
+    node = _parsed_function(source, py)
+    if node is None:
+        try:
+            source = textwrap.dedent(inspect.getsource(py))
+        except (OSError, TypeError) as exc:
+            raise Unsupported(f"no source for {getattr(py, '__name__', py)!r}: {exc}") from None
+        node = ast.parse(source).body[0]
     if not isinstance(node, ast.FunctionDef):
         raise Unsupported(f"{py.__name__} is not a plain function")
     _PARSED[id(py)] = (py, (source, node, py.__globals__))
     return source, node, py.__globals__
+
+
+def _top_level_source(py):
+    """The text of a top-level function of a generated module, from its first line (decorator)
+    to the next line that starts in column 0: inspect.getsource finds the same end by
+    tokenizing the whole function, most of the time a big kernel's parse took. None for a
+    function of any other file (inspect reads it)."""
+    globs = getattr(py, "__globals__", {})
+    code = getattr(py, "__code__", None)
+    if code is None or "TEXT_SHA" not in globs or "check_current" not in globs \
+            or "." in py.__qualname__:
+        return None
+    import linecache
+    lines = linecache.getlines(code.co_filename, globs)
+    start = code.co_firstlineno - 1
+    if not 0 <= start < len(lines):
+        return None
+    first = start
+    while first < len(lines) and lines[first].startswith("@"):      # its decorators
+        first += 1
+    if first >= len(lines) or not lines[first].startswith("def "):
+        return None
+    end = first + 1
+    while end < len(lines) and (lines[end][:1] in (" ", "\t", "#") or not lines[end].strip()):
+        end += 1
+    return "".join(lines[start:end])
+
+
+def _parsed_function(source, py):
+    """The FunctionDef of ``py`` parsed from ``source``, or None when the text is not that
+    function alone (then inspect reads it)."""
+    if source is None:
+        return None
+    try:
+        body = ast.parse(source).body
+    except SyntaxError:
+        return None
+    if len(body) != 1 or not isinstance(body[0], ast.FunctionDef) or body[0].name != py.__name__:
+        return None
+    return body[0]
 
 
 def parse_function(fn):
@@ -572,8 +615,8 @@ class FunctionLowering:
         """The body of a loop whose entry branch ends ``preheader``: its long runs as pieces
         (_statements), their loop-invariant inputs stored in the preheader."""
         before = {n for n, v in self.vars.items() if isinstance(v, tuple)}
-        assigned = {t.id for sub in node.body for t in ast.walk(sub)
-                    if isinstance(t, ast.Name) and isinstance(t.ctx, ast.Store)}
+        assigned = {t.id for sub in node.body for t in _walk(sub)
+                    if type(t) is ast.Name and type(t.ctx) is ast.Store}
         assigned.add(node.target.id)
         self.loops.append(_Loop(preheader, before, assigned))
         try:
@@ -994,8 +1037,38 @@ class _Loop:
 _PURE_BUILTINS = ("abs", "max", "min", "float")
 
 
+#: Fields of AST nodes that never hold a node _walk needs: contexts, operators, names.
+_LEAF_FIELDS = frozenset(("ctx", "op", "ops", "kind", "type_comment", "id", "arg", "attr",
+                          "name", "module", "level", "is_async", "conversion"))
+_CHILD_FIELDS: dict = {}
+
+
+def _walk(node) -> list:
+    """Every node under ``node`` (itself included) but the context and operator nodes: what
+    ast.walk gives, without its generators (a big kernel's statements are walked several
+    times, and ast.walk was most of lowering one)."""
+    out, i = [node], 0
+    append = out.append
+    while i < len(out):
+        n = out[i]
+        i += 1
+        cls = type(n)
+        fields = _CHILD_FIELDS.get(cls)
+        if fields is None:
+            fields = _CHILD_FIELDS[cls] = tuple(f for f in cls._fields if f not in _LEAF_FIELDS)
+        for field in fields:
+            value = getattr(n, field, None)
+            if type(value) is list:
+                for item in value:
+                    if isinstance(item, ast.AST):
+                        append(item)
+            elif isinstance(value, ast.AST):
+                append(value)
+    return out
+
+
 def _names_read(node):
-    return {n.id for n in ast.walk(node) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+    return {n.id for n in _walk(node) if type(n) is ast.Name and type(n.ctx) is ast.Load}
 
 
 def _plain_assignment(stmt):
@@ -1007,7 +1080,7 @@ def _plain_assignment(stmt):
         if not (isinstance(t, ast.Name) or (isinstance(t, ast.Subscript)
                                             and isinstance(t.value, ast.Name))):
             return False
-    for node in ast.walk(stmt.value):
+    for node in _walk(stmt.value):
         if isinstance(node, ast.Call):
             f = node.func
             if isinstance(f, ast.Name) and f.id in _PURE_BUILTINS:
@@ -1203,7 +1276,7 @@ def _single_assignments(fn_node):
             for e in t.elts:
                 yield from targets(e)
 
-    for node in ast.walk(fn_node):
+    for node in _statements_in(fn_node):
         names = []
         if isinstance(node, ast.Assign):
             for t in node.targets:
@@ -1219,6 +1292,20 @@ def _single_assignments(fn_node):
                 top.update(targets(t))
     params = {a.arg for a in fn_node.args.args}
     return frozenset(n for n in top if counts.get(n) == 1 and n not in params)
+
+
+def _statements_in(fn_node) -> list:
+    """Every statement of a function, those in branches and loops included (assignments are
+    statements: the subset has no assignment expressions)."""
+    out, todo = [], list(fn_node.body)
+    while todo:
+        stmt = todo.pop()
+        out.append(stmt)
+        for field in ("body", "orelse", "finalbody"):
+            todo.extend(getattr(stmt, field, ()) or ())
+        for handler in getattr(stmt, "handlers", ()) or ():
+            todo.extend(handler.body)
+    return out
 
 
 def _float_array(value):

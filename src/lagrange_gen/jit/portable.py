@@ -132,6 +132,9 @@ def kernel_table(module, method):
         cls = table_class(method)
         tables[method] = cls(*(getattr(module, field) if field.isupper()
                                else table_kernel(module, field) for field in cls._fields))
+        from .native_background import compile_later
+        compile_later(module, [getattr(tables[method], field) for field in cls._fields
+                               if not field.isupper()], native_dir())
     return tables[method]
 
 

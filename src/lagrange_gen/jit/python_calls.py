@@ -126,8 +126,10 @@ class _NativeCall:
                     from .native_ir import Unsupported
                     from .folders import native_dir
                     try:
-                        self.call = native.native_kernel(module, self.kernel,
-                                                         native_dir()).python_call()
+                        kernel = native.native_kernel(module, self.kernel, native_dir())
+                        self.call = kernel.python_call()
+                        from .native_background import compile_later
+                        compile_later(module, [kernel], native_dir())
                     except Unsupported as exc:
                         native.warn_numba_compiles(module, self.kernel, exc)
         return self.call
