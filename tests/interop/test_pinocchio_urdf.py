@@ -164,3 +164,29 @@ def test_mimic_joints_equal_pinocchio_without_mimic_projected(request, tmp_path,
         assert _err(out, G.T @ peer.rnea(G @ q + c, G @ v, G @ a)) < TOL
         assert mod.forward_dynamics.py_func(q, v, 0.0, p, np.zeros((n, n)), out) == 0
         assert _err(out, np.linalg.solve(M, -G.T @ peer.rnea(G @ q + c, G @ v, np.zeros(len(rows))))) < TOL
+
+
+@pytest.mark.parametrize("name", ["solo_description/robots/solo12.urdf", "ur_description/urdf/ur5_robot.urdf"],
+                         ids=["solo12", "ur5"])
+def test_floating_base_equals_pinocchio_in_the_same_chart(tmp_path, name):
+    """--floating-base: the root link's x, y, z and angles about its own x, y, z against
+    Pinocchio with a composite root joint PX PY PZ RX RY RZ (the same chart), by ABA."""
+    path = ROBOTS / name
+    src = tmp_path / "robot.py"
+    assert main(["urdf", str(path), "-o", str(src), "--floating-base"]) == 0
+    mod = import_generated(generate_model(src, tmp_path / "gen", methods=["rk4"]).path)
+    assert list(mod.COORDS[:6]) == [f"q_base_{c}" for c in ("x", "y", "z", "rx", "ry", "rz")]
+    assert "articulated-body" in mod.forward_dynamics.__doc__
+    peer = pinocchio_urdf(path, mod.COORDS, floating=True)
+    n, p = mod.N_COORDS, mod.DEFAULT_PARAMS
+    rng = np.random.default_rng(46)
+    for _ in range(STATES):
+        q, v, a, tau = (rng.uniform(-1.2, 1.2, n), rng.normal(size=n), rng.normal(size=n),
+                        rng.normal(size=n))
+        H, rhs, out = np.zeros((n, n)), np.zeros(n), np.zeros(n)
+        mod.dynamics.py_func(q, v, 0.0, p, H, rhs)
+        assert _err(H, peer.crba(q)) < TOL
+        mod.inverse_dynamics.py_func(q, v, a, 0.0, p, out)
+        assert _err(out, peer.rnea(q, v, a)) < TOL
+        assert mod.forward_dynamics_torques.py_func(q, v, tau, 0.0, p, H, out) == 0
+        assert _err(out, peer.aba(q, v, tau)) < TOL

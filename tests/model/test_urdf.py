@@ -50,9 +50,11 @@ def _axis_angle(axis, angle):
 
 class Reference:
     """Forward kinematics of the URDF over the coordinates ``coords`` (joint names; a mimic
-    joint not among them follows its joint)."""
+    joint not among them follows its joint). floating: the root link carried by six joints
+    base_x, _y, _z (slides along the world's axes) and base_rx, _ry, _rz (turns about the
+    moved frame's x, then y, then z)."""
 
-    def __init__(self, path, coords):
+    def __init__(self, path, coords, floating=False):
         root = ET.parse(path).getroot()
         self.coords = coords
         self.inertials = {}
@@ -79,6 +81,15 @@ class Reference:
                                                   float(mimic.get("offset", 0)))))
         children = {j["child"] for j in self.joints}
         self.root = next(link.get("name") for link in root.findall("link") if link.get("name") not in children)
+        if floating:
+            chain = ["world", "bx", "by", "bz", "brx", "bry", self.root]
+            for k, (kind, axis) in enumerate([("prismatic", (1, 0, 0)), ("prismatic", (0, 1, 0)),
+                                              ("prismatic", (0, 0, 1)), ("revolute", (1, 0, 0)),
+                                              ("revolute", (0, 1, 0)), ("revolute", (0, 0, 1))]):
+                self.joints.insert(k, dict(name=f"base_{['x', 'y', 'z', 'rx', 'ry', 'rz'][k]}", type=kind,
+                                           parent=chain[k], child=chain[k + 1], xyz=np.zeros(3), rpy=np.zeros(3),
+                                           axis=np.array(axis, dtype=float), mimic=None))
+            self.root = "world"
 
     def _value(self, joint, q):
         """(joint value, {coordinate index: d value / d q}) of a joint."""
@@ -149,17 +160,21 @@ class Reference:
 # ------------------------------------------------------------------------ the modules
 
 
+FLOATING = ["base_x", "base_y", "base_z", "base_rx", "base_ry", "base_rz"]
+
+
 @pytest.fixture(scope="module")
 def modules(tmp_path_factory):
-    """{mimic: (generated module, Reference)}: the model file written by `lagrange-gen urdf`
-    (with and without --no-mimic), generated once each."""
+    """{case: (generated module, Reference)}: the model file written by `lagrange-gen urdf`
+    (True: as it is; False: --no-mimic; "floating": --floating-base), generated once each."""
     out, built = tmp_path_factory.mktemp("urdf"), {}
-    for mimic in (True, False):
-        src = out / f"arm_{mimic}.py"
-        assert main(["urdf", str(ARM), "-o", str(src)] + ([] if mimic else ["--no-mimic"])) == 0
-        mod = import_generated(generate_model(src, out / f"gen_{mimic}", methods=["rk4"]).path)
-        coords = ORDER[:-1] if mimic else ORDER
-        built[mimic] = (mod, Reference(ARM, [c.replace("wrist_roll", "wrist-roll") for c in coords]))
+    for case, options in ((True, []), (False, ["--no-mimic"]), ("floating", ["--floating-base"])):
+        src = out / f"arm_{case}.py"
+        assert main(["urdf", str(ARM), "-o", str(src)] + options) == 0
+        mod = import_generated(generate_model(src, out / f"gen_{case}", methods=["rk4"]).path)
+        coords = (FLOATING if case == "floating" else []) + (ORDER if case is False else ORDER[:-1])
+        built[case] = (mod, Reference(ARM, [c.replace("wrist_roll", "wrist-roll") for c in coords],
+                                      floating=case == "floating"))
     return built
 
 
@@ -172,14 +187,18 @@ def _rel(a, b):
     return float(np.abs(np.asarray(a) - np.asarray(b)).max() / max(np.abs(b).max(), 1e-12))
 
 
-@pytest.mark.parametrize("mimic", [True, False], ids=["mimic", "no-mimic"])
+CASES = [True, False, "floating"]
+IDS = ["mimic", "no-mimic", "floating"]
+
+
+@pytest.mark.parametrize("mimic", CASES, ids=IDS)
 def test_coordinates_are_the_joints_in_pinocchios_order(modules, mimic):
     mod, _ = modules[mimic]
-    expected = ORDER[:-1] if mimic else ORDER
+    expected = (FLOATING if mimic == "floating" else []) + (ORDER if mimic is False else ORDER[:-1])
     assert list(mod.COORDS) == [f"q_{name}" for name in expected]
 
 
-@pytest.mark.parametrize("mimic", [True, False], ids=["mimic", "no-mimic"])
+@pytest.mark.parametrize("mimic", CASES, ids=IDS)
 def test_mass_matrix_equals_the_links_jacobians(modules, mimic):
     mod, ref = modules[mimic]
     n = mod.N_COORDS
@@ -189,7 +208,7 @@ def test_mass_matrix_equals_the_links_jacobians(modules, mimic):
         assert _rel(H, ref.mass_matrix(q)) < 1e-12
 
 
-@pytest.mark.parametrize("mimic", [True, False], ids=["mimic", "no-mimic"])
+@pytest.mark.parametrize("mimic", CASES, ids=IDS)
 def test_gravity_and_bias_forces_equal_differenced_energies(modules, mimic):
     mod, ref = modules[mimic]
     n, p = mod.N_COORDS, mod.DEFAULT_PARAMS
@@ -208,6 +227,7 @@ def test_a_tree_without_mimic_takes_the_articulated_body_algorithm(modules):
     """rpy rows keep the recursive path; a mimic joint (one coordinate moving two joints) keeps
     H + Cholesky."""
     assert "articulated-body" in modules[False][0].forward_dynamics.__doc__
+    assert "floating base" in modules["floating"][0].__doc__
     assert "articulated-body" not in modules[True][0].forward_dynamics.__doc__
 
 
@@ -222,8 +242,7 @@ def test_the_table_merges_the_fixed_joint_and_keeps_the_massless_link():
 def test_from_urdf_builds_the_model():
     model = from_urdf(ARM, g=3.0)
     assert [str(q) for q in model.coords] == [f"q_{name}" for name in ORDER[:-1]]
-    with pytest.raises(ModelError, match="floating_base"):
-        from_urdf(ARM, floating_base=True)
+    assert len(from_urdf(ARM, floating_base=True).coords) == 6 + len(ORDER) - 1
 
 
 def test_joint_limits_become_contacts_on_request():
@@ -305,3 +324,17 @@ def test_bad_input_is_one_line_with_its_line_number(tmp_path, capsys, case):
     assert main(["urdf", str(path), "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err and not out.exists()
+
+
+def test_the_floating_base_chart_is_singular_only_at_pitch_90_degrees(modules):
+    """One chart of the rotations: at q_base_ry = pi/2 the angle rates do not determine the
+    angular velocity, H is singular and forward_dynamics says so (SINGULAR_MASS) instead of
+    returning accelerations; a tenth of a radian away it solves."""
+    mod, _ = modules["floating"]
+    n = mod.N_COORDS
+    q = np.random.default_rng(3).uniform(-1, 1, n)
+    for pitch, solves in ((math.pi / 2, False), (math.pi / 2 - 0.1, True), (-math.pi / 2, False)):
+        q[4] = pitch
+        qdd = np.zeros(n)
+        status = mod.forward_dynamics.py_func(q, np.zeros(n), 0.0, mod.DEFAULT_PARAMS, np.zeros((n, n)), qdd)
+        assert (status == 0) == solves

@@ -175,8 +175,8 @@ class PinocchioUrdf:
             out[qi], out[qi + 1] = np.cos(v[vi]), np.sin(v[vi])
             plain[vi] = False
         for joint in self.model.joints[1:]:
-            if joint.nv == 1 and plain[joint.idx_v]:
-                out[joint.idx_q] = v[joint.idx_v]
+            if joint.nv and joint.nq == joint.nv and plain[joint.idx_v]:
+                out[joint.idx_q:joint.idx_q + joint.nq] = v[joint.idx_v:joint.idx_v + joint.nv]
         return out
 
     def v_pin(self, x):
@@ -200,16 +200,29 @@ class PinocchioUrdf:
         return np.array(_pin().rnea(self.model, self.data, self.q_pin(q), self.v_pin(v), self.v_pin(a)))[self.columns]
 
 
-def pinocchio_urdf(path, coords, mimic=True, g=9.81):
+def pinocchio_urdf(path, coords, mimic=True, g=9.81, floating=False):
     """PinocchioUrdf of the URDF file ``path`` (fixed base, gravity (0, 0, -g)); ``coords``: our
     coordinate names (``q_<joint>``, the joint made an identifier), matched to Pinocchio's joints
-    by name. mimic: Pinocchio's mimic joints (pin >= 3.4), else every joint its own coordinate."""
+    by name. mimic: Pinocchio's mimic joints (pin >= 3.4), else every joint its own coordinate.
+    floating: the root joint a composite of PX, PY, PZ, RX, RY, RZ (our floating row's position
+    and angles about the body's x, then y, then z), matched to the first six of ``coords``."""
     import re
     pin = _pin()
-    model = pin.buildModelFromUrdf(str(path), mimic=mimic)
+    if floating:
+        root = pin.JointModelComposite()
+        for kind in ("PX", "PY", "PZ", "RX", "RY", "RZ"):
+            root.addJoint(getattr(pin, f"JointModel{kind}")())
+        model = pin.buildModelFromUrdf(str(path), root, mimic=mimic)
+    else:
+        model = pin.buildModelFromUrdf(str(path), mimic=mimic)
     model.gravity.linear = np.array([0.0, 0.0, -float(g)])
     by_name, continuous, names = {}, [], []
     for joint, name in zip(model.joints[1:], list(model.names)[1:]):
+        if joint.nv == 6 and floating and joint.idx_v == 0:
+            for k in range(6):
+                by_name[coords[k]] = k
+                names.append(coords[k])
+            continue
         if joint.nv == 0:
             continue
         ident = "q_" + re.sub(r"\W", "_", name)

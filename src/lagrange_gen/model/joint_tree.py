@@ -44,7 +44,10 @@ from .symbols import parameters
 
 __all__ = ["tree_bodies", "model_from_tree", "check_tree", "n_dof", "rpy_matrix"]
 
-KINDS = ("revolute", "prismatic")
+KINDS = ("revolute", "prismatic", "floating")
+#: the coordinates of a floating joint, after its name: the position of its origin in N, then the
+#: angles of its frame, turned about its own x, then y, then z (sympy's "Body" XYZ)
+FLOATING = ("x", "y", "z", "rx", "ry", "rz")
 
 
 def check_tree(tree):
@@ -60,9 +63,12 @@ def check_tree(tree):
         if not -1 <= int(joint["parent"]) < i:
             raise ValueError(f"tree: joint {name}: parent {joint['parent']} must be -1 or an "
                              f"earlier joint (< {i})")
-        if sum(float(a) ** 2 for a in joint["axis"]) < 1e-24:
+        if joint["type"] == "floating" and (int(joint["parent"]) != -1 or "mimic" in joint):
+            raise ValueError(f"tree: joint {name}: a floating joint has the base as parent and no mimic")
+        if joint["type"] != "floating" and sum(float(a) ** 2 for a in joint["axis"]) < 1e-24:
             raise ValueError(f"tree: joint {name}: zero axis")
-        if len(joint["origin"]) != 3 or len(joint["com"]) != 3 or len(joint["inertia"]) != 6:
+        if len(joint.get("origin", ())) != 3 and joint["type"] != "floating" or len(joint["com"]) != 3 \
+                or len(joint["inertia"]) != 6:
             raise ValueError(f"tree: joint {name}: origin and com need 3 numbers, inertia 6")
         if not float(joint["mass"]) >= 0 or len(joint.get("rpy", (0, 0, 0))) != 3:
             raise ValueError(f"tree: joint {name}: mass must be >= 0, rpy 3 numbers")
@@ -76,8 +82,17 @@ def check_tree(tree):
 
 
 def n_dof(tree):
-    """The number of joint coordinates (mimic joints have none)."""
-    return sum("mimic" not in joint for joint in tree)
+    """The number of joint coordinates (mimic joints have none, a floating joint 6)."""
+    return sum(len(_coordinate_names(joint)) for joint in tree)
+
+
+def _coordinate_names(joint):
+    """The names of a row's coordinates: none (mimic), q_<name> or six (floating)."""
+    if "mimic" in joint:
+        return []
+    if joint["type"] == "floating":
+        return [f"q_{joint['name']}_{c}" for c in FLOATING]
+    return [f"q_{joint['name']}"]
 
 
 def _vector(frame, xyz):
@@ -130,10 +145,15 @@ def tree_bodies(tree, q=None):
     RigidBody per joint."""
     import sympy.physics.mechanics as me
     check_tree(tree)
-    own = [j for j in tree if "mimic" not in j]
+    names = [name for joint in tree for name in _coordinate_names(joint)]
     if q is None:
-        q = list(me.dynamicsymbols(" ".join(f"q_{j['name']}" for j in own), seq=True)) if own else []
-    coordinate = {j["name"]: qi for j, qi in zip(own, q)}
+        q = list(me.dynamicsymbols(" ".join(names), seq=True)) if names else []
+    coordinate, k = {}, 0
+    for joint in tree:
+        count = len(_coordinate_names(joint))
+        if count:
+            coordinate[joint["name"]] = q[k] if joint["type"] != "floating" else q[k:k + count]
+        k += count
     for joint in tree:
         if "mimic" in joint:
             mimic = joint["mimic"]
@@ -147,7 +167,17 @@ def tree_bodies(tree, q=None):
         name, qi = joint["name"], coordinate[joint["name"]]
         parent = joint["parent"]
         P, Po = (N, O) if parent < 0 else (frames[parent], origins[parent])
-        J = Po.locatenew(f"J_{name}", _vector(P, joint["origin"]))    # the joint, fixed in P
+        J = Po.locatenew(f"J_{name}", _vector(P, joint.get("origin", (0, 0, 0))))   # fixed in P
+        if joint["type"] == "floating":            # moved by x, y, z in N, turned by three angles
+            x, y, z, a, b, c = qi
+            B = N.orientnew(f"B_{name}", "Body", [a, b, c], "XYZ")
+            Bo = J.locatenew(f"Bo_{name}", x * N.x + y * N.y + z * N.z)
+            G = Bo.locatenew(f"G_{name}", _vector(B, joint["com"]))
+            ixx, iyy, izz, ixy, iyz, izx = (float(c) for c in joint["inertia"])
+            bodies.append(me.RigidBody(name, G, B, float(joint["mass"]), (me.inertia(B, ixx, iyy, izz, ixy, iyz, izx), G)))
+            frames.append(B)
+            origins.append(Bo)
+            continue
         if any(float(a) for a in joint.get("rpy", (0, 0, 0))):
             P = P.orientnew(f"F_{name}", "DCM", _rotation(joint["rpy"]))   # the joint frame
         axis = _vector(P, _unit(joint["axis"]))
@@ -177,9 +207,10 @@ def model_from_tree(name, tree, g=9.81, description=None, limits=False, restitut
     V = gravity_potential(N, -g_sym * N.z, bodies)
     contacts = []
     if limits:
-        own = [j for j in tree if "mimic" not in j]
-        for joint, qi in zip(own, q):
-            if "limits" in joint:
+        of_name = dict(zip((name for joint in tree for name in _coordinate_names(joint)), q))
+        for joint in tree:
+            qi = of_name.get(f"q_{joint['name']}")
+            if "limits" in joint and "mimic" not in joint and qi is not None:
                 lower, upper = (sp.Float(float(x)) for x in joint["limits"])
                 contacts += [Contact(qi - lower, restitution, name=f"{joint['name']}_lower"),
                              Contact(upper - qi, restitution, name=f"{joint['name']}_upper")]

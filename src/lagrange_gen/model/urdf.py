@@ -345,10 +345,11 @@ def _table_number(x):
     return float(x) + 0.0
 
 
-def urdf_tree(path, mimic=True):
+def urdf_tree(path, mimic=True, floating_base=False):
     """The joint table (model/joint_tree.py) of the URDF at ``path``: one row per moving joint
     in Pinocchio's order (module docstring). mimic=False: a mimic joint gets its own coordinate
-    (as Pinocchio's parser without mimic=True does)."""
+    (as Pinocchio's parser without mimic=True does). floating_base=True: a first row "base" of
+    type floating moves the root link (with the links fixed to it) freely."""
     robot = path if isinstance(path, Robot) else read_urdf(path)
     where = robot.path
     children, root = _children(robot)
@@ -383,7 +384,11 @@ def urdf_tree(path, mimic=True):
             parts.append([] if inertial is None else [(inertial.mass, inertial.com, inertial.inertia)])
             walk(joint.child, len(rows) - 1, np.eye(3), np.zeros(3))
 
-    walk(root, -1, np.eye(3), np.zeros(3))
+    if floating_base:
+        rows.append({"name": make_identifier("base", used), "link": root, "parent": -1, "type": "floating"})
+        inertial = robot.links[root]
+        parts.append([] if inertial is None else [(inertial.mass, inertial.com, inertial.inertia)])
+    walk(root, 0 if floating_base else -1, np.eye(3), np.zeros(3))
     _resolve_mimics(where, rows, index_of_joint, robot)
     _check_masses(where, rows, parts, robot)
     for row, body in zip(rows, parts):
@@ -393,7 +398,7 @@ def urdf_tree(path, mimic=True):
         row["mass"] = _table_number(mass)
         row["com"] = tuple(_table_number(c) for c in snapped(com, max(1.0, float(np.abs(com).max())) if mass else 1.0))
         row["inertia"] = tuple(_table_number(x) for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[1, 2], I[2, 0]))
-        if not any(row["rpy"]):
+        if "rpy" in row and not any(row["rpy"]):
             del row["rpy"]
         order = ["name", "link", "parent", "type", "axis", "origin", "rpy", "mimic", "limits", "mass", "com",
                  "inertia"]
@@ -448,6 +453,8 @@ def _check_masses(where, rows, parts, robot):
     joint_of = {j.child: j for j in robot.joints}
     for row in rows:
         if "mimic" not in row and moved[row["name"]] <= 0:
+            if row["type"] == "floating":
+                raise ModelError(f"{where}: nothing in the robot has mass (no <inertial>)")
             joint = joint_of[row["link"]]
             raise ModelError(f"{where}:{joint.line}: joint {joint.name!r} moves link "
                              f"{row['link']!r} and nothing with mass (a missing <inertial>?): "
@@ -467,19 +474,19 @@ def from_urdf(path, floating_base=False, g=9.81, mimic=True, limits=False, resti
     default ``g``). limits=True: each <limit lower upper> of a joint with its own coordinate is
     two contacts (lg.Contact q - lower >= 0 and upper - q >= 0, Newton's ``restitution``), for
     the contact methods. Meshes and damping are not read. name: the model's name (default:
-    the robot's, made an identifier). floating_base=True is not supported yet. ModelError, one
+    the robot's, made an identifier). floating_base=True: the root link moves freely, six
+    coordinates first (q_base_x, _y, _z: its origin in the base frame; q_base_rx, _ry, _rz:
+    its angles about its own x, then y, then z), one chart of the rotations, singular at
+    q_base_ry = +-pi/2 (forward_dynamics returns SINGULAR_MASS there). ModelError, one
     line naming the file, line and element, for a URDF that is malformed or not a tree of
     supported joints; ``lagrange-gen urdf`` writes the same model as an editable model file
     (docs/guides/from-urdf.md)."""
-    if floating_base:
-        raise ModelError(f"{path}: floating_base=True is not supported yet (fixed-base robots only)")
     robot = read_urdf(path)
-    tree = urdf_tree(robot, mimic=mimic)
+    tree = urdf_tree(robot, mimic=mimic, floating_base=floating_base)
     if not tree:
         raise ModelError(f"{path}: the robot has no moving joint")
     return model_from_tree(name or make_identifier(robot.name, set()), tree, g=g, limits=limits,
-                           restitution=restitution, description=description or f"{robot.name} from {Path(str(path)).name}: "
-                                                      f"{n_dof(tree)} joints, fixed base, gravity -g z")
+                           restitution=restitution, description=description or _description(robot, path, tree))
 
 
 def _row_text(row):
@@ -495,20 +502,29 @@ def _row_text(row):
     return f"    {{{head},\n     {body}}},"
 
 
-def model_file_text(path, mimic=True, g=9.81, limits=False):
+def _description(robot, path, tree):
+    base = "floating base (one chart: singular at q_base_ry = +-pi/2)" if tree[0]["type"] == "floating" \
+        else "fixed base"
+    return f"{robot.name} from {Path(str(path)).name}: {n_dof(tree)} coordinates, {base}, gravity -g z"
+
+
+def model_file_text(path, mimic=True, g=9.81, limits=False, floating_base=False):
     """The text of a model file that builds the URDF's robot from its joint table: edit TREE (or
     replace model_from_tree by your own mechanics code) and run lagrange-gen on it."""
     robot = read_urdf(path)
-    tree = urdf_tree(robot, mimic=mimic)
+    tree = urdf_tree(robot, mimic=mimic, floating_base=floating_base)
     if not tree:
         raise ModelError(f"{path}: the robot has no moving joint")
     name = make_identifier(robot.name, set())
+    base = ("\nThe first row, floating, moves the root link freely: q_base_x, _y, _z its origin in the base\n"
+            "frame, q_base_rx, _ry, _rz its angles about its own x, then y, then z (one chart of the\n"
+            "rotations: singular at q_base_ry = +-pi/2).\n" if floating_base else "")
     n = n_dof(tree)
     rows = "\n".join(_row_text(row) for row in tree)
-    return f'''"""{robot.name}: {n} joint coordinates, fixed base (written by `lagrange-gen urdf {Path(str(path)).name}`).
+    return f'''"""{robot.name}: {n} coordinates, {"floating" if floating_base else "fixed"} base (written by `lagrange-gen urdf {Path(str(path)).name}`).
 
 The joint table of the URDF, one row per moving joint in Pinocchio's order (depth first from the
-root link): parent (row index, -1: the fixed base), type (revolute or prismatic), origin (m) and
+root link): parent (row index, -1: the base), type, origin (m) and
 rpy (rad) of the joint frame in the parent's frame, axis in the joint frame, mimic (q = multiplier
 * q_joint + offset: no coordinate of its own), limits (lower, upper: contacts with limits=True);
 the child link's mass (kg), mass centre (m) in the joint frame and central inertia (ixx, iyy,
@@ -516,7 +532,7 @@ izz, ixy, iyz, izx) (kg m^2) in that frame, with the links of fixed joints merge
 and damping are not read.
 lagrange_gen.model.joint_tree.tree_bodies builds sympy.physics.mechanics frames and RigidBodies
 from it; T = lg.kinetic_energy of the bodies, V = gravity -g along the base's z.
-"""
+{base}"""
 from lagrange_gen.model.joint_tree import model_from_tree
 
 TREE = [
@@ -524,5 +540,5 @@ TREE = [
 ]
 
 model = model_from_tree({name!r}, TREE, g={float(g)!r},{" limits=True, restitution=0.0," if limits else ""}
-                        description={f"{robot.name} from {Path(str(path)).name}: {n} joints, fixed base, gravity -g z"!r})
+                        description={_description(robot, path, tree)!r})
 '''
