@@ -25,6 +25,9 @@ def pytest_addoption(parser):
     group.addoption("--printer-bug", action="store_true",
                     help="put the old a/x**2 -> a/x*x printer bug back and count failing examples")
     group.addoption("--harness-summary", metavar="PATH", help="write the harness counts as JSON here")
+    parser.addoption("--all-robots", action="store_true",
+                     help="tests/interop/test_pinocchio_urdf.py: every URDF of example-robot-data, "
+                          "not a few")
 
 
 @pytest.fixture(scope="session")

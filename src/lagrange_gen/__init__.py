@@ -23,6 +23,7 @@ _LAZY = {
     "parameters": "model.model", "t": "model.model", "SaintVenant": "model.model",
     "DryFriction": "model.model", "Contact": "model.model", "Event": "model.model", "Drawing": "model.model",
     "inputs": "model.model", "load_model": "model.model_file", "kinetic_energy": "model.bodies", "gravity_potential": "model.bodies",
+    "from_urdf": "model.urdf",
     "equations": "derive.equations", "Equations": "derive.equations",
     "Signal": "run.control", "linearize": "linear.linearize", "equilibrium": "linear.linearize",
     "linearize_nonholonomic": "linear.nonholonomic", "rolling_contact": "model.rolling",

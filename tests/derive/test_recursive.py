@@ -399,3 +399,88 @@ def test_a_12_link_chain_takes_its_jacobians_and_mass_kernels_from_rnea():
     assert sources == {**RECURSIVE_SOURCES, "momentum_rate_jacobian": ""}
     table = kernel_table(dyn)
     assert table["mass_matrix"]().columns and table["dynamics"]().columns
+
+
+# ------------------------------------------------------- joints of several coordinates (ABA)
+
+
+def _ball_or_floating_body_with_a_hinge(floating):
+    """Body A on a ball joint at the fixed point O (Euler angles a, b, c: 'Body' XYZ) or free
+    (x, y, z of its origin and the same angles: a floating base in one chart), body B on a hinge
+    about A.y: one joint of 3 (6) coordinates and one of 1. Returns (model, plain (H, rhs))."""
+    import sympy.physics.mechanics as me
+    g = parameters("g", defaults=(9.81,))
+    syms = me.dynamicsymbols("x y z a b c d" if floating else "a b c d")
+    trans, (a, b, c, d) = (syms[:3], syms[3:]) if floating else ((0, 0, 0), syms)
+    N, O = me.ReferenceFrame("N"), me.Point("O")
+    O.set_vel(N, 0)
+    A = N.orientnew("A", "Body", [a, b, c], "XYZ")
+    Ao = O.locatenew("Ao", trans[0] * N.x + trans[1] * N.y + trans[2] * N.z) if floating else O
+    GA = Ao.locatenew("GA", 0.05 * A.x + 0.3 * A.z)
+    IA = (0.05, 0.04, 0.02, 0.003, -0.002, 0.001)
+    body_A = me.RigidBody("A", GA, A, 2.0, (me.inertia(A, *IA), GA))
+    B = A.orientnew("B", "Axis", [d, A.y])
+    GB = Ao.locatenew("J", 0.6 * A.z).locatenew("GB", 0.2 * B.x + 0.1 * B.z)
+    IB = (0.01, 0.02, 0.015, 0.001, 0.0, -0.002)
+    body_B = me.RigidBody("B", GB, B, 1.0, (me.inertia(B, *IB), GB))
+    model = Model("several", coords=list(syms), T=kinetic_energy(N, body_A, body_B),
+                  V=gravity_potential(N, -g * N.z, body_A, body_B))
+
+    # the same bodies with explicit rotation matrices, no mechanics and no lagrange_gen
+    n = len(syms)
+    q, qd = sp.symbols(f"q0:{n}"), sp.symbols(f"qd0:{n}")
+    x = q[:3] if floating else (0, 0, 0)
+    ea, eb, ec, ed = q[-4:]
+
+    def rot(axis, angle):
+        return _rodrigues([1 if k == axis else 0 for k in range(3)], angle)
+    R_A = rot(0, ea) * rot(1, eb) * rot(2, ec)
+    R_B = R_A * rot(1, ed)
+    p_A = sp.Matrix(x)
+    L = sp.S.Zero
+    for R, c_body, m, (ixx, iyy, izz, ixy, iyz, izx) in (
+            (R_A, p_A + R_A * sp.Matrix([0.05, 0, 0.3]), 2.0, IA),
+            (R_B, p_A + R_A * sp.Matrix([0, 0, 0.6]) + R_B * sp.Matrix([0.2, 0, 0.1]), 1.0, IB)):
+        vel = c_body.jacobian(q) * sp.Matrix(qd)
+        W = R.T * sum((R.diff(q[j]) * qd[j] for j in range(n)), sp.zeros(3, 3))
+        w = sp.Matrix([W[2, 1], W[0, 2], W[1, 0]])
+        I = sp.Matrix([[ixx, ixy, izx], [ixy, iyy, iyz], [izx, iyz, izz]])
+        L += m * vel.dot(vel) / 2 + (w.T * I * w)[0] / 2 - m * 9.81 * c_body[2]
+    dL_dqd = sp.Matrix([L.diff(v) for v in qd])
+    H = dL_dqd.jacobian(qd)
+    rhs = sp.Matrix([L.diff(v) for v in q]) - dL_dqd.jacobian(q) * sp.Matrix(qd)
+    fH, frhs = sp.lambdify([q], H, cse=True), sp.lambdify([q, qd], rhs, cse=True)
+    return model, (lambda s: np.array(fH(s), dtype=float), lambda s, v: np.array(frhs(s, v), dtype=float).ravel())
+
+
+@pytest.mark.parametrize("floating", [False, True], ids=["ball-joint", "floating-euler"])
+def test_aba_over_joints_of_several_coordinates_equals_plain_sympy(floating):
+    """A joint of k > 1 coordinates (S of k columns, depending on q) in ABA: D = S^T I^A S is
+    k x k (its LDL^T pivots checked), I^a = I^A - U D^-1 U^T; accelerations and RNEA equal
+    Lagrange's equations written with explicit rotation matrices."""
+    import sympy.physics.mechanics as me
+    model, (H_ref, rhs_ref) = _ball_or_floating_body_with_a_hinge(floating)
+    links = joint_form(model.T)
+    assert [len(link.coords) for link in links] == [6 if floating else 3, 1]
+    dyn = derive(model)
+    assert dyn.recursive is not None and uses_aba(dyn)
+    n, o = dyn.n, dyn.ops
+    aba, pivots = dyn.recursive.forward_dynamics(o.symbols(dyn.aux["w"]))
+    assert len(pivots) == n
+    rnea = dyn.recursive.inverse_dynamics(o.symbols(dyn.aux["qdd"]))
+    f = _evaluate(dyn, [*aba, *rnea, *pivots])
+    # the reference's convention: sympy's 'Body' XYZ is R = Rx(a) Ry(b) Rz(c)
+    N = me.ReferenceFrame("N")
+    angles = (0.3, -0.7, 1.1)
+    A = N.orientnew("A", "Body", list(angles), "XYZ")
+    R = _rodrigues([1, 0, 0], angles[0]) * _rodrigues([0, 1, 0], angles[1]) * _rodrigues([0, 0, 1], angles[2])
+    assert np.allclose(np.array(N.dcm(A), dtype=float), np.array(R, dtype=float), atol=1e-15)
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        q, v, x = rng.uniform(-1.2, 1.2, (3, n))
+        values = f(q, v, x)
+        acc, tau, d = values[:n], values[n:2 * n], values[2 * n:]
+        H, rhs = H_ref(q), rhs_ref(q, v)
+        assert _rel(acc, np.linalg.solve(H, rhs + x)) < 1e-11
+        assert _rel(tau, H @ x - rhs) < 1e-11
+        assert (d > 0).all()

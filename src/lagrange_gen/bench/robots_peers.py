@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["available", "pinocchio_model", "PinocchioTree", "crba", "aba", "rnea", "aba_derivatives",
+           "pinocchio_urdf", "PinocchioUrdf",
            "depth_first"]
 
 
@@ -149,3 +150,87 @@ def rnea(peer, q, v, a):
 
 def aba_derivatives(peer, q, v, tau):
     return peer.aba_derivatives(q, v, tau)
+
+
+@dataclass
+class PinocchioUrdf:
+    """A pin.Model read by Pinocchio's own URDF parser (fixed base), its Data, and the layout of
+    its q and v: ``columns[k]`` is the v index of our coordinate k, ``continuous`` the joints
+    whose q is (cos, sin) (RUBX/Y/Z: (q index, v index)). The methods take and return vectors
+    in our coordinate order, q as joint angles."""
+
+    model: object
+    data: object
+    names: list
+    columns: list
+    continuous: list
+
+    def q_pin(self, q):
+        pin = _pin()
+        v = np.zeros(self.model.nv)
+        v[self.columns] = q
+        out = pin.neutral(self.model)
+        plain = np.ones(self.model.nv, dtype=bool)
+        for qi, vi in self.continuous:
+            out[qi], out[qi + 1] = np.cos(v[vi]), np.sin(v[vi])
+            plain[vi] = False
+        for joint in self.model.joints[1:]:
+            if joint.nv and joint.nq == joint.nv and plain[joint.idx_v]:
+                out[joint.idx_q:joint.idx_q + joint.nq] = v[joint.idx_v:joint.idx_v + joint.nv]
+        return out
+
+    def v_pin(self, x):
+        out = np.zeros(self.model.nv)
+        out[self.columns] = x
+        return out
+
+    def crba(self, q):
+        M = np.array(_pin().crba(self.model, self.data, self.q_pin(q)))
+        M = np.triu(M) + np.triu(M, 1).T
+        return M[np.ix_(self.columns, self.columns)]
+
+    def aba(self, q, v, tau):
+        """pin.aba; with mimic joints (which Pinocchio's aba refuses) crba's M solved for
+        tau - rnea(q, v, 0)."""
+        if any(j.nv == 0 for j in self.model.joints[1:]):
+            return np.linalg.solve(self.crba(q), np.asarray(tau) - self.rnea(q, v, np.zeros(len(self.columns))))
+        return np.array(_pin().aba(self.model, self.data, self.q_pin(q), self.v_pin(v), self.v_pin(tau)))[self.columns]
+
+    def rnea(self, q, v, a):
+        return np.array(_pin().rnea(self.model, self.data, self.q_pin(q), self.v_pin(v), self.v_pin(a)))[self.columns]
+
+
+def pinocchio_urdf(path, coords, mimic=True, g=9.81, floating=False):
+    """PinocchioUrdf of the URDF file ``path`` (fixed base, gravity (0, 0, -g)); ``coords``: our
+    coordinate names (``q_<joint>``, the joint made an identifier), matched to Pinocchio's joints
+    by name. mimic: Pinocchio's mimic joints (pin >= 3.4), else every joint its own coordinate.
+    floating: the root joint a composite of PX, PY, PZ, RX, RY, RZ (our floating row's position
+    and angles about the body's x, then y, then z), matched to the first six of ``coords``."""
+    import re
+    pin = _pin()
+    if floating:
+        root = pin.JointModelComposite()
+        for kind in ("PX", "PY", "PZ", "RX", "RY", "RZ"):
+            root.addJoint(getattr(pin, f"JointModel{kind}")())
+        model = pin.buildModelFromUrdf(str(path), root, mimic=mimic)
+    else:
+        model = pin.buildModelFromUrdf(str(path), mimic=mimic)
+    model.gravity.linear = np.array([0.0, 0.0, -float(g)])
+    by_name, continuous, names = {}, [], []
+    for joint, name in zip(model.joints[1:], list(model.names)[1:]):
+        if joint.nv == 6 and floating and joint.idx_v == 0:
+            for k in range(6):
+                by_name[coords[k]] = k
+                names.append(coords[k])
+            continue
+        if joint.nv == 0:
+            continue
+        ident = "q_" + re.sub(r"\W", "_", name)
+        by_name[ident] = joint.idx_v
+        names.append(ident)
+        if joint.nq == 2 and joint.nv == 1:
+            continuous.append((joint.idx_q, joint.idx_v))
+    missing = [c for c in coords if c not in by_name]
+    if missing or len(coords) != model.nv:
+        raise ValueError(f"{path}: Pinocchio's joints {names} do not match ours {list(coords)}")
+    return PinocchioUrdf(model, model.createData(), names, [by_name[c] for c in coords], continuous)

@@ -14,12 +14,13 @@ import time
 from ..errors import LagrangeGenError
 from .options import BUILD, NUMBER, one_line_warnings, out_dir, parse_assignments
 
-SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate", "examples")
+SUBCOMMANDS = ("simulate", "sweep", "bench", "identify", "equations", "animate", "examples", "urdf")
 
 _EPILOG = """\
 examples:
   lagrange-gen examples                           list the example model files
   lagrange-gen examples cart_pendulum --to models copy one into models/
+  lagrange-gen urdf ur5.urdf -o models/ur5_robot.py   a model file from a robot's URDF
   lagrange-gen models/cart_pendulum.py            write generated/cart_pendulum.py
   lagrange-gen models/*.py                        every model
   lagrange-gen models/n_link_pendulum.py --set n=8
@@ -48,7 +49,7 @@ def generate_parser():
         prog="lagrange-gen",
         description="Derive equations of motion from SymPy model files and write numba kernels "
                     "into generated/ (see -o). Subcommands: simulate, sweep, equations, "
-                    "examples, bench, identify, animate (lagrange-gen SUBCOMMAND --help).",
+                    "examples, urdf, bench, identify, animate (lagrange-gen SUBCOMMAND --help).",
         epilog=_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("models", nargs="+", metavar="MODEL.py", help="model files (e.g. models/*.py)")
     p.add_argument("-o", "--out-dir", "--gen-dir", metavar="DIR", dest="out_dir",
@@ -165,6 +166,8 @@ def _subcommand_parser(name):
         from .animate import add_parser
     elif name == "examples":
         from .examples import add_parser
+    elif name == "urdf":
+        from .urdf import add_parser
     else:
         from ..bench.cli import add_parser
     add_parser(sub)
@@ -184,6 +187,8 @@ def _run_subcommand(args) -> int:
         from .animate import run
     elif args.command == "examples":
         from .examples import run
+    elif args.command == "urdf":
+        from .urdf import run
     else:
         from ..bench.cli import run
     return run(args)

@@ -276,9 +276,11 @@ class RecursiveDynamics:
         for i in reversed(range(len(self.links))):
             link, (_, c) = self.links[i], kinematics[i]
             Ia, pa = IA[i], pA[i]
-            if link["joint"]:
-                if len(link["joint"]) > 1:
-                    raise NotImplementedError("joints of several coordinates")
+            if len(link["joint"]) > 1:
+                solved[i] = self._several(link, IA[i], pA[i], tau)
+                if link["parent"] >= 0:
+                    Ia, pa = self._articulated_several(IA[i], pA[i], c, *solved[i][:4])
+            elif link["joint"]:
                 (S,), j = link["S"], link["joint"][0]
                 U = self._times(IA[i], S)
                 D = self.graph.node(sum(s * u for s, u in zip(S, U)))
@@ -301,13 +303,64 @@ class RecursiveDynamics:
             c = kinematics[i][1]
             parent = [0] * 6 if link["parent"] < 0 else self._to_child(link, accelerations[link["parent"]])
             a = self._nodes([x + y for x, y in zip(parent, c)])
-            if i in solved:
+            if i in solved and len(link["joint"]) > 1:
+                U, _, D_inv, u, joints, d = solved[i]
+                rest = [self.graph.node(x - sum(y * z for y, z in zip(col, a))) for x, col in zip(u, U)]
+                for r, j in enumerate(joints):
+                    qdd[j] = self.graph.node(sum(D_inv[r][s] * rest[s] for s in range(len(joints))))
+                a = self._nodes([x + sum(S[k] * qdd[j] for S, j in zip(link["S"], joints)) for k, x in enumerate(a)])
+                pivots += d
+            elif i in solved:
                 U, D, D_inv, u, j = solved[i]
                 qdd[j] = self.graph.node(D_inv * (u - sum(x * y for x, y in zip(U, a))))
                 a = self._nodes([x + s * qdd[j] for x, s in zip(a, link["S"][0])])
                 pivots.append(D)
             accelerations.append(a)
         return qdd, pivots
+
+
+    def _several(self, link, IA, pA, tau):
+        """(U (k columns of 6), D (k, k), D^-1 (k, k), u (k,), joints, LDL pivots (k,)) of a
+        joint of k > 1 coordinates: U = I^A S, D = S^T U, u = tau_joint - S^T p^A."""
+        cols, joints = link["S"], link["joint"]
+        U = [self._times(IA, S) for S in cols]
+        D = self._symmetric(len(cols), lambda r, s: sum(x * y for x, y in zip(cols[r], U[s])))
+        u = [self.graph.node(tau[j] - sum(x * p for x, p in zip(S, pA))) for S, j in zip(cols, joints)]
+        D_inv, d = self._spd_inverse(D)
+        return U, D, D_inv, u, joints, d
+
+    def _articulated_several(self, IA, pA, c, U, D, D_inv, u):
+        """(I^a, p^a) handed to the parent by a joint of several coordinates: I^A - U D^-1 U^T,
+        p^A + I^a c + U D^-1 u."""
+        k = len(U)
+        W = [[self.graph.node(sum(U[s][r] * D_inv[s][t] for s in range(k))) for r in range(6)] for t in range(k)]
+        Ia = self._symmetric(6, lambda r, s: IA[r][s] - sum(W[t][r] * U[t][s] for t in range(k)))
+        Du = [self.graph.node(sum(D_inv[t][s] * u[s] for s in range(k))) for t in range(k)]
+        pa = self._nodes([p + x + sum(U[t][r] * Du[t] for t in range(k))
+                          for r, (p, x) in enumerate(zip(pA, self._times(Ia, c)))])
+        return Ia, pa
+
+    def _spd_inverse(self, D):
+        """(D^-1, pivots) of a symmetric positive definite (k, k) matrix of nodes by D = L diag(d)
+        L^T written out (k <= 6: a joint's coordinates); the pivots d are positive exactly when
+        D is positive definite."""
+        k, node = len(D), self.graph.node
+        L, d = [[0] * k for _ in range(k)], []
+        for j in range(k):
+            d.append(node(D[j][j] - sum(L[j][m] ** 2 * d[m] for m in range(j))))
+            inv = node(1 / d[j])
+            for i in range(j + 1, k):
+                L[i][j] = node((D[i][j] - sum(L[i][m] * L[j][m] * d[m] for m in range(j))) * inv)
+        columns = []
+        for e in range(k):                         # D x = unit vector e: L y = e, L^T x = y / d
+            y = []
+            for i in range(k):
+                y.append(node((1 if i == e else 0) - sum(L[i][m] * y[m] for m in range(i))))
+            x = [0] * k
+            for i in reversed(range(k)):
+                x[i] = node(y[i] / d[i] - sum(L[m][i] * x[m] for m in range(i + 1, k)))
+            columns.append(x)
+        return [[columns[s][r] for s in range(k)] for r in range(k)], d
 
 
 def recursive_dynamics(links, o, model, T, parts, qdd, frozen, samples=3):
