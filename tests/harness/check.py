@@ -75,6 +75,11 @@ BODY_KERNELS = ("inverse_dynamics", "gravity_forces", "bias_forces")
 CONTACT_KERNELS = ("contacts", "contact_bias", "contact_rates")
 #: the kernels only a module of a model with velocity constraints has
 NONHOLONOMIC_KERNELS = ("nonholonomic", "nonholonomic_dq", "constraint_gamma_dq")
+#: the parameter derivatives only a module generated with sensitivities has: not drawn here;
+#: tests/gradients compares them with central differences of the kernels they differentiate
+#: (which this harness checks against the reference) and the sensitivities they give with
+#: central differences of whole runs
+SENSITIVITY_KERNELS = ("rhs_dp", "momentum_rate_dp", "mass_matvec_dp", "transport_dp")
 
 
 @dataclass
