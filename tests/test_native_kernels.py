@@ -355,3 +355,19 @@ def test_the_background_compile_of_kernels_runs_detached_and_leaves_level_1_obje
     for name in ("forward_dynamics", "energy"):
         kernel = native.native_kernel(mod, name, folder)
         assert (kernel.level, kernel.cached) == (1, True), name
+
+
+def test_the_glue_background_process_compiles_kernels_at_the_default_level(monkeypatch, tmp_path):
+    """jit.first_run's background process (the glue of a method's first use, with the model's
+    kernel table) has no one waiting: no level-0 first tier there, no process of its own for
+    level 1; the environment is given back as it was."""
+    from lagrange_gen.jit import first_run
+    monkeypatch.delenv(native.OPT_ENV, raising=False)
+    monkeypatch.setattr(first_run.os, "nice", lambda increment: 0)
+    seen = []
+    monkeypatch.setattr(first_run, "compile_for_next_time",
+                        lambda *args, **kwargs: seen.append((os.environ.get(native.OPT_ENV),
+                                                             native.tiers_allowed(1))))
+    first_run.main(["rk4", "m", "f", str(tmp_path / "lock")])
+    assert seen == [(str(native.OPT_LEVEL), False)]
+    assert native.OPT_ENV not in os.environ

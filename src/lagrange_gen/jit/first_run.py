@@ -176,14 +176,22 @@ def compile_for_next_time(method, name, path, controlled=False) -> float:
 
 
 def main(argv) -> int:
+    from .native import OPT_ENV, OPT_LEVEL
     method, name, path, lock = argv[:4]
+    level_given = OPT_ENV in os.environ
     try:
         try:
             os.nice(10)
         except (AttributeError, OSError):      # no os.nice (Windows), or not allowed
             pass
+        # no one waits here: the model's kernels at LLVM's default level at once, not level 0
+        # first with yet another process for the better level (jit/native_background.py)
+        if not level_given:
+            os.environ[OPT_ENV] = str(OPT_LEVEL)
         compile_for_next_time(method, name, path, controlled=argv[4:] == ["controlled"])
     finally:
+        if not level_given:
+            os.environ.pop(OPT_ENV, None)
         release_lock(Path(lock))
     return 0
 
