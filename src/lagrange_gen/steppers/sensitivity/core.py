@@ -175,24 +175,32 @@ def velocity_tangent(kern, q, v, t, p, cols, Sq, Sm, Sv, tw):
 
 
 @njit(**FAST)
-def kick_tangent(kern, q, u, t, hk, p, cols, Sq, Sm, du, tw):
-    """The kick H(q) u + b(q) = m + hk f(q, u, t) at its solution u: du (n, c) from
-    (H - hk f_v) du = Sm - (D(q; u) - hk f_q) Sq - (d(H u)/dp - hk f_p) E - d b. Leaves H(q) in
-    tw.H and D(q; u) in tw.D (the caller's d(H(q) u + b), with momentum_columns).
-    Returns OK or SINGULAR_NEWTON."""
+def momentum_tangent_rhs(kern, q, u, t, hk, p, cols, Sq, Sm, out, tw):
+    """The right-hand side of the tangent of a momentum update H(q) u + b(q) = m + hk f(q, u, t):
+    out (n, c) = Sm - (D(q; u) - hk f_q) Sq - (d(H u)/dp - hk f_p) E - d b. Leaves H(q) in
+    tw.H, D(q; u) = d(H u)/dq in tw.D and f_q, f_v in tw.Jq, tw.Jqd (the callers' matrices)."""
     n = kern.N_COORDS
     kern.mass_matrix(q, t, p, tw.H)
     kern.mass_matvec_dq(q, u, t, p, tw.D)
     kern.momentum_rate_jacobian(q, u, t, p, tw.Jq, tw.Jqd)
-    copy_matrix(du, Sm)
-    matmul_add(tw.D, Sq, du, -1.0, n)
-    matmul_add(tw.Jq, Sq, du, hk, n)
+    copy_matrix(out, Sm)
+    matmul_add(tw.D, Sq, out, -1.0, n)
+    matmul_add(tw.Jq, Sq, out, hk, n)
     if cols.shape[0]:
         kern.mass_matvec_dp(q, u, t, p, tw.Jp2)
         kern.momentum_rate_dp(q, u, t, p, tw.Jp)
-        add_parameter_columns(tw.Jp2, cols, du, -1.0, n)
-        add_parameter_columns(tw.Jp, cols, du, hk, n)
-    transport_tangent(kern, q, t, p, cols, Sq, du, -1.0, tw)
+        add_parameter_columns(tw.Jp2, cols, out, -1.0, n)
+        add_parameter_columns(tw.Jp, cols, out, hk, n)
+    transport_tangent(kern, q, t, p, cols, Sq, out, -1.0, tw)
+
+
+@njit(**FAST)
+def kick_tangent(kern, q, u, t, hk, p, cols, Sq, Sm, du, tw):
+    """The kick H(q) u + b(q) = m + hk f(q, u, t) at its solution u: du (n, c) from
+    (H - hk f_v) du = momentum_tangent_rhs. Leaves H(q) in tw.H and D(q; u) in tw.D (the
+    caller's d(H(q) u + b), with momentum_columns). Returns OK or SINGULAR_NEWTON."""
+    n = kern.N_COORDS
+    momentum_tangent_rhs(kern, q, u, t, hk, p, cols, Sq, Sm, du, tw)
     for i in range(n):
         for j in range(n):
             tw.A[i, j] = tw.H[i, j] - hk * tw.Jqd[i, j]

@@ -13,8 +13,8 @@ from ...jit.cache import njit
 from ..methods import midpoint as _method
 from ..core.options import FAST
 from ..core.status import OK, SINGULAR_NEWTON
-from .core import (add_parameter_columns, copy_matrix, factor, matmul_add, momentum_tangent,
-                   sensitivity_loop, solve_columns, transport_tangent, velocity_tangent)
+from .core import (add_parameter_columns, factor, matmul_add, momentum_tangent,
+                   momentum_tangent_rhs, sensitivity_loop, solve_columns, velocity_tangent)
 
 
 @njit(**FAST)
@@ -31,18 +31,8 @@ def step(kern, q0, v0, q, v, t, h, p, settings, ws, tw, cols):
     S, Sm, dvb, dqb, A = tw.S, tw.Sm, tw.T1, tw.T2, tw.A
     Sq = S[:n]
     vb, qb, tm, hh = ws.vb, ws.qb, t + 0.5 * h, 0.5 * h
-    kern.mass_matrix(qb, tm, p, tw.H)
-    kern.mass_matvec_dq(qb, vb, tm, p, tw.D)
-    kern.momentum_rate_jacobian(qb, vb, tm, p, tw.Jq, tw.Jqd)
-    copy_matrix(dvb, Sm)
-    matmul_add(tw.D, Sq, dvb, -1.0, n)
-    matmul_add(tw.Jq, Sq, dvb, hh, n)
-    if cols.shape[0]:
-        kern.mass_matvec_dp(qb, vb, tm, p, tw.Jp2)
-        kern.momentum_rate_dp(qb, vb, tm, p, tw.Jp)
-        add_parameter_columns(tw.Jp2, cols, dvb, -1.0, n)
-        add_parameter_columns(tw.Jp, cols, dvb, hh, n)
-    transport_tangent(kern, qb, tm, p, cols, Sq, dvb, -1.0, tw)     # R gains b(qb)
+    # R gains b(qb) (momentum_tangent_rhs's transport term)
+    momentum_tangent_rhs(kern, qb, vb, tm, hh, p, cols, Sq, Sm, dvb, tw)
     for i in range(n):
         for j in range(n):
             A[i, j] = tw.H[i, j] + hh * tw.D[i, j] - hh * hh * tw.Jq[i, j] - hh * tw.Jqd[i, j]
